@@ -1,0 +1,323 @@
+/*
+ * meshcsg — exact constructive solid geometry on closed triangle meshes.
+ *
+ * One public header. Conventions that hold for every function below:
+ *
+ *  - Status: every fallible function returns an mcsg_status; MCSG_OK (0) is success.
+ *    When an mcsg_error pointer is given (it may always be NULL), it receives the status
+ *    and a one-line message naming the file and line (or byte offset) where that applies.
+ *  - Options: every function that allocates takes `const mcsg_options *` (NULL, or a
+ *    zero-initialised struct, means defaults: malloc/realloc/free, no logging).
+ *  - Ownership: memory the library returns (mesh arrays, trees, buffers) is allocated
+ *    with the options' allocator and must be released with the matching mcsg_*_free
+ *    function, passing options with the same allocator. Input meshes passed by pointer
+ *    are only read, never kept: the library copies what it needs.
+ *  - The library never exits, never prints and keeps no global mutable state; it
+ *    reports through return values and the optional logging callback only. Distinct
+ *    objects may be used from different threads at the same time.
+ *  - On error, output arguments are left empty (zeroed mesh, NULL pointers) and nothing
+ *    is leaked, including when an allocation fails half-way.
+ */
+#ifndef MESHCSG_H
+#define MESHCSG_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MCSG_VERSION_MAJOR 0
+#define MCSG_VERSION_MINOR 1
+#define MCSG_VERSION_PATCH 0
+
+/* ------------------------------------------------------------------------------------ */
+/* Status and errors                                                                     */
+
+typedef enum mcsg_status {
+    MCSG_OK = 0,
+    MCSG_ERR_NOMEM,        /* an allocation failed */
+    MCSG_ERR_IO,           /* a file could not be opened, read or written */
+    MCSG_ERR_PARSE,        /* malformed input (mesh file or CSG text) */
+    MCSG_ERR_FORMAT,       /* unknown file format, or a variant meshcsg does not read */
+    MCSG_ERR_UNSUPPORTED,  /* well-formed input that uses a feature outside meshcsg */
+    MCSG_ERR_INVALID_ARG,  /* the caller passed an invalid argument */
+    MCSG_ERR_INVALID_MESH, /* a mesh is not usable (e.g. indices out of range) */
+    MCSG_ERR_LIMIT         /* the input exceeds a hard limit (e.g. 2^32-1 vertices) */
+} mcsg_status;
+
+/* A short English description of a status code ("out of memory", ...). Never NULL. */
+const char *mcsg_status_string(mcsg_status status);
+
+#define MCSG_ERROR_MESSAGE_SIZE 512
+
+/* Filled by a failing call when the caller passes a non-NULL pointer. The message is a
+ * single line without a trailing newline, e.g. "box.off:12: expected 3 vertex indices". */
+typedef struct mcsg_error {
+    mcsg_status status;
+    char message[MCSG_ERROR_MESSAGE_SIZE];
+} mcsg_error;
+
+/* ------------------------------------------------------------------------------------ */
+/* Options: allocator hook and logging                                                   */
+
+/* Custom allocator. Either all three functions are set, or none (then the C library's
+ * malloc/realloc/free are used). realloc_fn(user, NULL, n) must behave like malloc_fn.
+ * The library never calls free_fn with NULL. */
+typedef struct mcsg_allocator {
+    void *(*malloc_fn)(void *user, size_t size);
+    void *(*realloc_fn)(void *user, void *ptr, size_t size);
+    void (*free_fn)(void *user, void *ptr);
+    void *user;
+} mcsg_allocator;
+
+typedef enum mcsg_log_level {
+    MCSG_LOG_DEBUG = 0,
+    MCSG_LOG_INFO = 1,
+    MCSG_LOG_WARNING = 2
+} mcsg_log_level;
+
+/* Logging callback: `message` is one line without trailing newline, valid only during
+ * the call. Called from the thread that called the library function. */
+typedef void (*mcsg_log_fn)(void *user, mcsg_log_level level, const char *message);
+
+/* Zero means default for every field. */
+typedef struct mcsg_options {
+    mcsg_allocator allocator; /* zero: malloc/realloc/free */
+    mcsg_log_fn log;          /* NULL: messages are dropped */
+    void *log_user;           /* passed to log */
+    int threads;              /* worker threads for evaluation; 0: all cores */
+} mcsg_options;
+
+/* Release a buffer returned by the library (e.g. from mcsg_mesh_write_memory).
+ * free(NULL) is a no-op. */
+void mcsg_free(void *ptr, const mcsg_options *opts);
+
+/* ------------------------------------------------------------------------------------ */
+/* Meshes                                                                                */
+
+/* A triangle mesh. Vertex i is (vertices[3i], vertices[3i+1], vertices[3i+2]); triangle t
+ * is (triangles[3t], triangles[3t+1], triangles[3t+2]), counter-clockwise seen from
+ * outside for a correctly oriented closed mesh. Counts never exceed UINT32_MAX.
+ * A mesh returned by the library owns its arrays: release it with mcsg_mesh_free. */
+typedef struct mcsg_mesh {
+    double *vertices;
+    uint32_t *triangles;
+    size_t vertex_count;
+    size_t triangle_count;
+} mcsg_mesh;
+
+/* Free the arrays of a library-allocated mesh and zero the struct. NULL is a no-op. */
+void mcsg_mesh_free(mcsg_mesh *mesh, const mcsg_options *opts);
+
+/* Deep copy `src` into `*dst` (which is overwritten, not freed). */
+mcsg_status mcsg_mesh_copy(const mcsg_mesh *src, const mcsg_options *opts, mcsg_mesh *dst,
+                           mcsg_error *err);
+
+/* Reverse the orientation of every triangle in place (swaps two indices per triangle). */
+void mcsg_mesh_flip(mcsg_mesh *mesh);
+
+/* Apply an affine map in place: p' = M[0..2][0..2] * p + M[.][3], with `matrix` a
+ * row-major 3x4 matrix. If the 3x3 part has a negative determinant (a mirror), triangle
+ * orientation is reversed so that the mesh keeps facing outward. Coordinates are
+ * rounded to double (this is how transformed CSG leaves are defined). */
+void mcsg_mesh_transform(mcsg_mesh *mesh, const double matrix[12]);
+
+/* ------------------------------------------------------------------------------------ */
+/* Mesh files                                                                            */
+
+typedef enum mcsg_format {
+    MCSG_FORMAT_AUTO = 0,   /* reading: detect from content and name; writing: from name */
+    MCSG_FORMAT_OFF,        /* OFF, COFF, NOFF, CNOFF, STOFF... (ASCII) */
+    MCSG_FORMAT_OBJ,        /* Wavefront OBJ: v and f records */
+    MCSG_FORMAT_STL_ASCII,  /* "solid ... endsolid" */
+    MCSG_FORMAT_STL_BINARY, /* 80-byte header, float32 little-endian */
+    MCSG_FORMAT_PLY_ASCII,
+    MCSG_FORMAT_PLY_BINARY_LE,
+    MCSG_FORMAT_PLY_BINARY_BE
+} mcsg_format;
+
+/* Human-readable name of a format ("OFF", "binary STL", ...). Never NULL. */
+const char *mcsg_format_name(mcsg_format format);
+
+/* Format implied by a file name's extension (case-insensitive): .off .obj .stl .ply.
+ * For .stl this is MCSG_FORMAT_STL_BINARY and for .ply MCSG_FORMAT_PLY_BINARY_LE (the
+ * compact choices for writing; reading detects the variant from the content).
+ * MCSG_FORMAT_AUTO if the extension is not recognised. */
+mcsg_format mcsg_format_from_path(const char *path);
+
+/* Read a mesh file. With MCSG_FORMAT_AUTO the format is detected from the content (PLY
+ * and OFF headers, STL ASCII vs binary by size and keywords) and the extension. Polygons
+ * are fan-triangulated. For STL, vertices with bit-identical coordinates (with -0 == +0)
+ * are welded into one. Numbers are parsed exactly (correctly rounded, independent of the
+ * C locale). Errors name `path` and the line (text formats) or byte offset (binary).
+ * On success `*out` owns new arrays; release with mcsg_mesh_free. */
+mcsg_status mcsg_mesh_read(const char *path, mcsg_format format, const mcsg_options *opts,
+                           mcsg_mesh *out, mcsg_error *err);
+
+/* Same as mcsg_mesh_read, from a memory buffer. `name` (may be NULL) is used in error
+ * messages and for extension-based detection. */
+mcsg_status mcsg_mesh_read_memory(const void *data, size_t size, mcsg_format format,
+                                  const char *name, const mcsg_options *opts,
+                                  mcsg_mesh *out, mcsg_error *err);
+
+/* Write a mesh file. MCSG_FORMAT_AUTO picks the format from the extension. Text formats
+ * write the shortest decimal that reads back to the identical double. Binary STL stores
+ * float32: coordinates that are not exactly representable are rounded, and a warning
+ * with their count goes to the log. The file is written under a temporary name and
+ * renamed, so a failed write never leaves a partial file at `path`. */
+mcsg_status mcsg_mesh_write(const char *path, mcsg_format format, const mcsg_mesh *mesh,
+                            const mcsg_options *opts, mcsg_error *err);
+
+/* Serialise a mesh to a new buffer (`format` must not be AUTO). Release *data with
+ * mcsg_free. */
+mcsg_status mcsg_mesh_write_memory(mcsg_format format, const mcsg_mesh *mesh,
+                                   const mcsg_options *opts, void **data, size_t *size,
+                                   mcsg_error *err);
+
+/* ------------------------------------------------------------------------------------ */
+/* Validation                                                                            */
+
+#define MCSG_NO_INDEX UINT32_MAX
+
+/* What mcsg_mesh_check found. Edges are counted as undirected vertex pairs after
+ * identifying vertices with identical coordinates. Each example_* field holds the first
+ * offender found (vertex indices for edges, a triangle index, a vertex index), or
+ * MCSG_NO_INDEX when there is none. */
+typedef struct mcsg_check_report {
+    size_t vertex_count;
+    size_t triangle_count;
+    size_t out_of_range_indices;  /* triangle corners referencing no vertex */
+    size_t nonfinite_vertices;    /* a NaN or infinite coordinate */
+    size_t degenerate_triangles;  /* exactly zero area (repeated or collinear corners) */
+    size_t duplicate_triangles;   /* same three vertices as an earlier triangle */
+    size_t boundary_edges;        /* used by one triangle */
+    size_t nonmanifold_edges;     /* used by more than two triangles */
+    size_t inconsistent_edges;    /* used twice in the same direction */
+    size_t duplicate_vertices;    /* coordinates identical to an earlier vertex (info) */
+    size_t unused_vertices;       /* referenced by no triangle (info) */
+    size_t components;            /* connected components over shared edges */
+    double volume;                /* signed volume, rounded (meaningful when closed) */
+    int inverted;                 /* 1: closed, consistent, and the exact volume sign is
+                                     negative: every triangle faces inward */
+    uint32_t example_out_of_range_triangle;
+    uint32_t example_nonfinite_vertex;
+    uint32_t example_degenerate_triangle;
+    uint32_t example_duplicate_triangle;
+    uint32_t example_boundary_edge[2];
+    uint32_t example_nonmanifold_edge[2];
+    uint32_t example_inconsistent_edge[2];
+} mcsg_check_report;
+
+/* Examine a mesh. Returns MCSG_OK when the examination ran (whatever it found); the
+ * findings are in *report. Fails only on allocation failure or invalid arguments. */
+mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
+                            mcsg_check_report *report, mcsg_error *err);
+
+/* 1 if the report describes a closed, consistently oriented, edge-manifold mesh with
+ * finite coordinates, valid indices and no degenerate or duplicate triangles (it may be
+ * inverted: flipping fixes that), 0 otherwise. */
+int mcsg_check_report_is_valid(const mcsg_check_report *report);
+
+/* ------------------------------------------------------------------------------------ */
+/* Primitives, tessellated exactly as OpenSCAD does                                      */
+
+/* Number of fragments OpenSCAD uses for a circle of radius r: 3 for r < 2^-20; with
+ * fn > 0, max(fn, 3); otherwise ceil(max(min(360/fa, 2*pi*r/fs), 5)). OpenSCAD's
+ * defaults are fn = 0, fa = 12, fs = 2. */
+int mcsg_fragments(double r, double fn, double fa, double fs);
+
+/* Tessellation controls, as OpenSCAD's $fn, $fa, $fs. */
+typedef struct mcsg_resolution {
+    double fn, fa, fs;
+} mcsg_resolution;
+
+/* OpenSCAD's cube: a box from the origin to size (or centred). A size <= 0 in any axis
+ * gives an empty mesh. 8 vertices, 12 triangles. */
+mcsg_status mcsg_make_cube(const double size[3], int center, const mcsg_options *opts,
+                           mcsg_mesh *out, mcsg_error *err);
+
+/* OpenSCAD's sphere: n = mcsg_fragments(r) points per ring, (n+1)/2 rings at polar
+ * angles 180*(i+0.5)/rings degrees, each ring a polygon cap at the poles. r <= 0 gives an
+ * empty mesh. Triangles: 2n(rings-1) + 2(n-2). */
+mcsg_status mcsg_make_sphere(double r, mcsg_resolution res, const mcsg_options *opts,
+                             mcsg_mesh *out, mcsg_error *err);
+
+/* OpenSCAD's cylinder (a cone when r1 or r2 is 0) from z=0 to z=h, or centred.
+ * Fragments from max(r1, r2). h <= 0 or r1 = r2 = 0 gives an empty mesh. */
+mcsg_status mcsg_make_cylinder(double h, double r1, double r2, int center,
+                               mcsg_resolution res, const mcsg_options *opts,
+                               mcsg_mesh *out, mcsg_error *err);
+
+/* ------------------------------------------------------------------------------------ */
+/* CSG trees                                                                             */
+
+/* A CSG tree: leaves hold meshes (already transformed), inner nodes are operations.
+ * Nodes are numbered 0..node_count-1 in creation order; a child is always created
+ * before its parent, so trees of any depth are handled without recursion. */
+typedef struct mcsg_tree mcsg_tree;
+
+typedef uint32_t mcsg_node_id;
+#define MCSG_NO_NODE UINT32_MAX
+
+typedef enum mcsg_node_kind {
+    MCSG_NODE_LEAF = 0,
+    MCSG_NODE_UNION,        /* no children: the empty set */
+    MCSG_NODE_INTERSECTION, /* no children: the empty set (OpenSCAD's rule) */
+    MCSG_NODE_DIFFERENCE    /* first child minus all the others */
+} mcsg_node_kind;
+
+/* Name of a node kind: "leaf", "union", "intersection", "difference". */
+const char *mcsg_node_kind_name(mcsg_node_kind kind);
+
+/* Create an empty tree. It keeps a copy of *opts (allocator and logger). */
+mcsg_status mcsg_tree_create(const mcsg_options *opts, mcsg_tree **out, mcsg_error *err);
+
+/* Free a tree and every mesh it holds. NULL is a no-op. */
+void mcsg_tree_free(mcsg_tree *tree);
+
+/* Add a leaf holding a copy of `mesh`, transformed by `matrix` (row-major 3x4, NULL for
+ * identity; see mcsg_mesh_transform). `label` (may be NULL) describes the leaf for
+ * humans, e.g. "sphere(r=5) at a.scad:3:1"; it is copied. */
+mcsg_status mcsg_tree_add_leaf(mcsg_tree *tree, const mcsg_mesh *mesh, const double matrix[12],
+                               const char *label, mcsg_node_id *out, mcsg_error *err);
+
+/* Add an operation over existing nodes. Each node can be the child of one parent only
+ * (MCSG_ERR_INVALID_ARG otherwise). `label` may be NULL. */
+mcsg_status mcsg_tree_add_op(mcsg_tree *tree, mcsg_node_kind op, const mcsg_node_id *children,
+                             size_t child_count, const char *label, mcsg_node_id *out,
+                             mcsg_error *err);
+
+/* Choose the root. Without a call, the root is the last node added. */
+mcsg_status mcsg_tree_set_root(mcsg_tree *tree, mcsg_node_id node, mcsg_error *err);
+
+/* Queries. An out-of-range node id returns MCSG_NO_NODE / 0 / NULL. */
+mcsg_node_id mcsg_tree_root(const mcsg_tree *tree);
+size_t mcsg_tree_node_count(const mcsg_tree *tree);
+size_t mcsg_tree_leaf_count(const mcsg_tree *tree);
+mcsg_node_kind mcsg_tree_node_kind(const mcsg_tree *tree, mcsg_node_id node);
+size_t mcsg_tree_child_count(const mcsg_tree *tree, mcsg_node_id node);
+mcsg_node_id mcsg_tree_child(const mcsg_tree *tree, mcsg_node_id node, size_t index);
+const char *mcsg_tree_node_label(const mcsg_tree *tree, mcsg_node_id node); /* never NULL */
+const mcsg_mesh *mcsg_tree_leaf_mesh(const mcsg_tree *tree, mcsg_node_id node);
+
+/* ------------------------------------------------------------------------------------ */
+/* CSG language (OpenSCAD subset; see docs/csg-language.md)                              */
+
+/* Parse a CSG file into a new tree. import() paths resolve relative to the file's
+ * directory. Errors name the file, line and column. */
+mcsg_status mcsg_scad_read(const char *path, const mcsg_options *opts, mcsg_tree **out,
+                           mcsg_error *err);
+
+/* Parse CSG text from memory. `name` (may be NULL) appears in messages; import() paths
+ * resolve relative to `base_dir` (NULL: the current directory). */
+mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *name,
+                                  const char *base_dir, const mcsg_options *opts,
+                                  mcsg_tree **out, mcsg_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MESHCSG_H */

@@ -1,0 +1,258 @@
+/*
+ * Fixed-capacity exact integers and the basic exact predicates of exact.h.
+ *
+ * Filters follow Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
+ * Geometric Predicates" (1997): a double evaluation whose error bound proves the sign,
+ * else an exact evaluation. The bounds assume no overflow or underflow, so the filter
+ * also refuses when a value is not finite or its magnitude sum is below 2^-960 (where
+ * products could lose bits to underflow); the exact path has no such limits.
+ */
+#include "exact.h"
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* Unit roundoff of double arithmetic. */
+_Static_assert(GMP_NUMB_BITS == 64, "mci_big assumes 64-bit limbs");
+
+#define EPS (DBL_EPSILON / 2)
+/* Below this magnitude sum a product may be subnormal and the relative bounds fail. */
+#define FILTER_MIN_MAGNITUDE 0x1p-960
+
+static int trailing_zeros(uint64_t m)
+{
+    int n = 0;
+    while (!(m & 1)) {
+        m >>= 1;
+        n++;
+    }
+    return n;
+}
+
+/* x = significand * 2^exponent with an odd significand (x finite, nonzero). */
+static void split_double(double x, uint64_t *significand, int *exponent)
+{
+    int e;
+    double f = frexp(fabs(x), &e);
+    uint64_t m = (uint64_t)ldexp(f, 53);
+    int tz = trailing_zeros(m);
+    *significand = m >> tz;
+    *exponent = e - 53 + tz;
+}
+
+int mci_lsb_exponent(double x)
+{
+    uint64_t m;
+    int e;
+    if (x == 0)
+        return INT_MAX;
+    split_double(x, &m, &e);
+    return e;
+}
+
+static void big_normalize(mci_big *r, int n, int negative)
+{
+    while (n > 0 && r->limb[n - 1] == 0)
+        n--;
+    r->size = negative ? -n : n;
+}
+
+void mci_big_from_double(mci_big *r, double x, int e0)
+{
+    uint64_t m;
+    int e, shift, word, bit;
+    if (x == 0) {
+        r->size = 0;
+        return;
+    }
+    split_double(x, &m, &e);
+    shift = e - e0;
+    word = shift / GMP_NUMB_BITS;
+    bit = shift % GMP_NUMB_BITS;
+    memset(r->limb, 0, (size_t)(word + 2) * sizeof(mp_limb_t));
+    r->limb[word] = (mp_limb_t)(m << bit);
+    r->limb[word + 1] = bit ? (mp_limb_t)(m >> (GMP_NUMB_BITS - bit)) : 0;
+    big_normalize(r, word + 2, x < 0);
+}
+
+int mci_big_sign(const mci_big *a)
+{
+    return (a->size > 0) - (a->size < 0);
+}
+
+static int abs_size(const mci_big *a)
+{
+    return a->size < 0 ? -a->size : a->size;
+}
+
+/* Compare magnitudes: -1, 0 or +1. */
+static int compare_abs(const mci_big *a, const mci_big *b)
+{
+    int na = abs_size(a), nb = abs_size(b);
+    if (na != nb)
+        return na < nb ? -1 : 1;
+    return mpn_cmp(a->limb, b->limb, na);
+}
+
+/* r = a + (negate_b ? -b : b); r may alias a or b. */
+static void big_add_signed(mci_big *r, const mci_big *a, const mci_big *b, int negate_b)
+{
+    int na = abs_size(a), nb = abs_size(b);
+    int neg_a = a->size < 0, neg_b = (b->size < 0) != negate_b;
+    mci_big result;
+    if (nb == 0) {
+        *r = *a;
+        return;
+    }
+    if (na == 0) {
+        *r = *b;
+        r->size = neg_b ? -nb : nb;
+        return;
+    }
+    if (neg_a == neg_b) {
+        const mci_big *big = na >= nb ? a : b, *small = na >= nb ? b : a;
+        int nbig = na >= nb ? na : nb, nsmall = na >= nb ? nb : na;
+        result.limb[nbig] = mpn_add(result.limb, big->limb, nbig, small->limb, nsmall);
+        big_normalize(&result, nbig + 1, neg_a);
+    } else if (compare_abs(a, b) >= 0) {
+        mpn_sub(result.limb, a->limb, na, b->limb, nb);
+        big_normalize(&result, na, neg_a);
+    } else {
+        mpn_sub(result.limb, b->limb, nb, a->limb, na);
+        big_normalize(&result, nb, neg_b);
+    }
+    *r = result;
+}
+
+void mci_big_add(mci_big *r, const mci_big *a, const mci_big *b)
+{
+    big_add_signed(r, a, b, 0);
+}
+
+void mci_big_sub(mci_big *r, const mci_big *a, const mci_big *b)
+{
+    big_add_signed(r, a, b, 1);
+}
+
+void mci_big_mul(mci_big *r, const mci_big *a, const mci_big *b)
+{
+    int na = abs_size(a), nb = abs_size(b);
+    mci_big result;
+    if (na == 0 || nb == 0) {
+        r->size = 0;
+        return;
+    }
+    if (na >= nb)
+        mpn_mul(result.limb, a->limb, na, b->limb, nb);
+    else
+        mpn_mul(result.limb, b->limb, nb, a->limb, na);
+    big_normalize(&result, na + nb, (a->size < 0) != (b->size < 0));
+    *r = result;
+}
+
+/* Smallest lsb exponent among n doubles (INT_MAX if all are zero). */
+static int min_lsb_exponent(const double *v, int n)
+{
+    int e0 = INT_MAX;
+    for (int i = 0; i < n; i++) {
+        int e = mci_lsb_exponent(v[i]);
+        if (e < e0)
+            e0 = e;
+    }
+    return e0;
+}
+
+static int orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    double v[6] = {ax, ay, bx, by, cx, cy};
+    mci_big big[6], l, r;
+    int e0 = min_lsb_exponent(v, 6);
+    if (e0 == INT_MAX)
+        return 0;
+    for (int i = 0; i < 6; i++)
+        mci_big_from_double(&big[i], v[i], e0);
+    mci_big_sub(&big[0], &big[0], &big[4]); /* ax - cx */
+    mci_big_sub(&big[1], &big[1], &big[5]); /* ay - cy */
+    mci_big_sub(&big[2], &big[2], &big[4]); /* bx - cx */
+    mci_big_sub(&big[3], &big[3], &big[5]); /* by - cy */
+    mci_big_mul(&l, &big[0], &big[3]);
+    mci_big_mul(&r, &big[1], &big[2]);
+    mci_big_sub(&l, &l, &r);
+    return mci_big_sign(&l);
+}
+
+int mci_orient2d(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    double left = (ax - cx) * (by - cy);
+    double right = (ay - cy) * (bx - cx);
+    double det = left - right;
+    double magnitude = fabs(left) + fabs(right);
+    /* Shewchuk's ccwerrboundA. */
+    double bound = (3.0 + 16.0 * EPS) * EPS * magnitude;
+    if (isfinite(magnitude) && magnitude >= FILTER_MIN_MAGNITUDE && fabs(det) > bound)
+        return det > 0 ? 1 : -1;
+    return orient2d_exact(ax, ay, bx, by, cx, cy);
+}
+
+bool mci_triangle_is_degenerate(const double a[3], const double b[3], const double c[3])
+{
+    /* The cross product (b-a) x (c-a) vanishes iff its three components, the
+     * orientations of the projections onto the yz, zx and xy planes, all vanish. */
+    return mci_orient2d(a[1], a[2], b[1], b[2], c[1], c[2]) == 0 &&
+           mci_orient2d(a[2], a[0], b[2], b[0], c[2], c[0]) == 0 &&
+           mci_orient2d(a[0], a[1], b[0], b[1], c[0], c[1]) == 0;
+}
+
+void mci_det3_big(mci_big *r, const double a[3], const double b[3], const double c[3],
+                  int e0)
+{
+    const double *rows[3] = {a, b, c};
+    mci_big x[9], minor, t, u;
+    for (int i = 0; i < 9; i++)
+        mci_big_from_double(&x[i], rows[i / 3][i % 3], e0);
+    r->size = 0;
+    for (int i = 0; i < 3; i++) {
+        /* Cofactor expansion along a: a_i * (b_j c_k - b_k c_j), (i,j,k) cyclic. */
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        mci_big_mul(&t, &x[3 + j], &x[6 + k]);
+        mci_big_mul(&u, &x[3 + k], &x[6 + j]);
+        mci_big_sub(&minor, &t, &u);
+        mci_big_mul(&t, &x[i], &minor);
+        mci_big_add(r, r, &t);
+    }
+}
+
+static int det3_exact(const double a[3], const double b[3], const double c[3])
+{
+    double v[9] = {a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]};
+    mci_big det;
+    int e0 = min_lsb_exponent(v, 9);
+    if (e0 == INT_MAX)
+        return 0;
+    mci_det3_big(&det, a, b, c, e0);
+    return mci_big_sign(&det);
+}
+
+int mci_det3_sign(const double a[3], const double b[3], const double c[3])
+{
+    double det = 0, magnitude = 0, amplified_underflow = 0;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        double p = b[j] * c[k], q = b[k] * c[j];
+        det += a[i] * (p - q);
+        magnitude += fabs(a[i]) * (fabs(p) + fabs(q));
+        amplified_underflow += fabs(a[i]);
+    }
+    /* Each of the three terms carries at most 3 roundings, the sum 2 more: 5 eps of the
+     * magnitude, and 8 eps leaves slack for rounding `magnitude` itself and for underflow
+     * in the last products (<= 2^-1074 each, far below 3 eps * 2^-960). An underflow in
+     * p or q (absolute error <= 2^-1075 each) is multiplied by |a_i|: that term is added
+     * explicitly, since |a_i| can be as large as 2^1024. */
+    double bound = 8.0 * EPS * magnitude + amplified_underflow * 0x1p-1072;
+    if (isfinite(bound) && magnitude >= FILTER_MIN_MAGNITUDE && fabs(det) > bound)
+        return det > 0 ? 1 : -1;
+    return det3_exact(a, b, c);
+}

@@ -1,0 +1,85 @@
+/*
+ * Internal helpers shared by every module: the allocation context, error and log
+ * formatting, and a growable byte buffer. Nothing here is part of the public API.
+ * Internal cross-module symbols use the prefix mci_ ("meshcsg internal").
+ */
+#ifndef MESHCSG_INTERNAL_H
+#define MESHCSG_INTERNAL_H
+
+#include "meshcsg.h"
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(__GNUC__) || defined(__clang__)
+#define MCI_PRINTF(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define MCI_PRINTF(fmt, args)
+#endif
+
+/* Resolved options: the allocator is always complete, the logger may be NULL. */
+typedef struct mci_ctx {
+    mcsg_allocator alloc;
+    mcsg_log_fn log;
+    void *log_user;
+    int threads;
+} mci_ctx;
+
+/* Fill *ctx from opts (NULL or zero fields mean defaults). */
+void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts);
+
+/* Allocation through the context. All return NULL on failure (or on size overflow for
+ * the _array variants) and never print. mci_free(ctx, NULL) is a no-op. */
+void *mci_malloc(const mci_ctx *ctx, size_t size);
+void *mci_realloc(const mci_ctx *ctx, void *ptr, size_t size);
+void mci_free(const mci_ctx *ctx, void *ptr);
+void *mci_malloc_array(const mci_ctx *ctx, size_t count, size_t elem_size);
+void *mci_calloc_array(const mci_ctx *ctx, size_t count, size_t elem_size);
+void *mci_realloc_array(const mci_ctx *ctx, void *ptr, size_t count, size_t elem_size);
+char *mci_strdup(const mci_ctx *ctx, const char *s);
+
+/* Record an error (if err is non-NULL) and return `status`, so that callers can write
+ * `return mci_fail(err, MCSG_ERR_PARSE, "%s:%zu: ...", name, line);`. */
+mcsg_status mci_fail(mcsg_error *err, mcsg_status status, const char *fmt, ...)
+    MCI_PRINTF(3, 4);
+
+/* The standard out-of-memory failure, with a short context such as "reading x.obj". */
+mcsg_status mci_fail_nomem(mcsg_error *err, const char *what);
+
+/* Send one formatted line to the log callback, if any. */
+void mci_log(const mci_ctx *ctx, mcsg_log_level level, const char *fmt, ...) MCI_PRINTF(3, 4);
+
+/* A growable array of bytes (or of fixed-size elements, managed by the caller). */
+typedef struct mci_buf {
+    unsigned char *data;
+    size_t len; /* bytes used */
+    size_t cap; /* bytes allocated */
+} mci_buf;
+
+/* Make room for `extra` more bytes. Returns false on allocation failure or overflow. */
+bool mci_buf_reserve(const mci_ctx *ctx, mci_buf *buf, size_t extra);
+/* Append bytes (reserving as needed). Returns false on allocation failure. */
+bool mci_buf_append(const mci_ctx *ctx, mci_buf *buf, const void *bytes, size_t n);
+/* Append printf-formatted text (no terminating NUL is kept in len). */
+bool mci_buf_printf(const mci_ctx *ctx, mci_buf *buf, const char *fmt, ...) MCI_PRINTF(3, 4);
+void mci_buf_free(const mci_ctx *ctx, mci_buf *buf);
+
+/* Release everything a mesh owns and zero it (the internal form of mcsg_mesh_free). */
+void mci_mesh_free(const mci_ctx *ctx, mcsg_mesh *mesh);
+/* Allocate arrays for a mesh of the given size (contents uninitialised). */
+mcsg_status mci_mesh_alloc(const mci_ctx *ctx, mcsg_mesh *mesh, size_t vertex_count,
+                           size_t triangle_count, mcsg_error *err);
+
+/* Read a whole file into memory (NUL-terminated for the text parsers; the NUL is not
+ * counted in *size). */
+mcsg_status mci_read_file(const mci_ctx *ctx, const char *path, unsigned char **data,
+                          size_t *size, mcsg_error *err);
+
+/* Write `size` bytes to `path` through a temporary file in the same directory that is
+ * renamed over `path` only once everything was written and flushed. */
+mcsg_status mci_write_file_atomic(const char *path, const void *data, size_t size,
+                                  mcsg_error *err);
+
+#endif /* MESHCSG_INTERNAL_H */

@@ -1,0 +1,97 @@
+/*
+ * A minimal test harness: CHECK-style assertions that count and report failures and
+ * keep going, plus helpers to find test data. Each test file defines test cases with
+ * TEST(name) and lists them in main via RUN(name); main returns test_summary().
+ */
+#ifndef MCSG_TESTLIB_H
+#define MCSG_TESTLIB_H
+
+#include "meshcsg.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+extern int test_failures;
+extern int test_checks;
+
+void test_fail(const char *file, int line, const char *fmt, ...);
+
+#define CHECK(cond)                                                                       \
+    do {                                                                                  \
+        test_checks++;                                                                    \
+        if (!(cond))                                                                      \
+            test_fail(__FILE__, __LINE__, "CHECK(%s)", #cond);                            \
+    } while (0)
+
+#define CHECK_MSG(cond, ...)                                                              \
+    do {                                                                                  \
+        test_checks++;                                                                    \
+        if (!(cond))                                                                      \
+            test_fail(__FILE__, __LINE__, __VA_ARGS__);                                   \
+    } while (0)
+
+#define CHECK_EQ_SIZE(a, b)                                                               \
+    do {                                                                                  \
+        size_t a_ = (size_t)(a), b_ = (size_t)(b);                                        \
+        test_checks++;                                                                    \
+        if (a_ != b_)                                                                     \
+            test_fail(__FILE__, __LINE__, "%s == %s: %zu != %zu", #a, #b, a_, b_);       \
+    } while (0)
+
+#define CHECK_EQ_DOUBLE(a, b)                                                             \
+    do {                                                                                  \
+        double a_ = (a), b_ = (b);                                                        \
+        test_checks++;                                                                    \
+        if (!(a_ == b_))                                                                  \
+            test_fail(__FILE__, __LINE__, "%s == %s: %.17g != %.17g", #a, #b, a_, b_);   \
+    } while (0)
+
+/* Status check: prints the error message when a call that should succeed fails. */
+#define CHECK_OK(call, errp)                                                              \
+    do {                                                                                  \
+        mcsg_status st_ = (call);                                                         \
+        test_checks++;                                                                    \
+        if (st_ != MCSG_OK)                                                               \
+            test_fail(__FILE__, __LINE__, "%s failed: %s", #call, (errp)->message);       \
+    } while (0)
+
+/* The message of a failing call must contain `needle`. */
+#define CHECK_CONTAINS(haystack, needle)                                                  \
+    do {                                                                                  \
+        test_checks++;                                                                    \
+        if (!strstr((haystack), (needle)))                                                \
+            test_fail(__FILE__, __LINE__, "expected \"%s\" in \"%s\"", (needle),          \
+                      (haystack));                                                        \
+    } while (0)
+
+#define TEST(name) static void name(void)
+#define RUN(name)                                                                         \
+    do {                                                                                  \
+        int before_ = test_failures;                                                      \
+        name();                                                                           \
+        printf("%s %s\n", test_failures == before_ ? "ok  " : "FAIL", #name);             \
+        test_cases++;                                                                     \
+        if (test_failures != before_)                                                     \
+            test_cases_failed++;                                                          \
+    } while (0)
+
+extern int test_cases;
+extern int test_cases_failed;
+
+/* Prints "N passed, M failed" and returns the process exit code. A test binary that ran
+ * no check at all fails: a test that checks nothing must not pass. */
+int test_summary(void);
+
+/* Path of a shared model (../shared/models/NAME); the test fails if the folder is
+ * missing, since CI always has it. Returns a static buffer. */
+const char *test_shared_model(const char *name);
+/* Path of a file under tests/data. Static buffer. */
+const char *test_data(const char *name);
+/* Path of a scratch file in the build tree. Static buffer. */
+const char *test_tmp(const char *name);
+
+/* Read a mesh from a string in the given format; aborts the test case on failure. */
+bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg_error *err);
+
+#endif
