@@ -1,0 +1,25 @@
+# meshcsg convert: every format round-trips the bunny with its counts and stays valid.
+. "$(dirname "$0")/common.bash"
+
+for fmt in off obj stl-ascii stl-binary ply-ascii ply-binary ply-binary-be; do
+  ext=${fmt%%-*}
+  run 0 convert "$MODELS/bunny.obj" "$WORK/bunny-$fmt.$ext" --format "$fmt"
+  contains "14290 vertices, 28576 triangles"
+  run 0 check "$WORK/bunny-$fmt.$ext"
+  contains "ok: 14290 vertices, 28576 triangles, 1 component"
+  run 0 convert "$WORK/bunny-$fmt.$ext" "$WORK/back-$fmt.off"
+done
+# OFF, OBJ and PLY keep doubles exactly: converting back gives the same OFF text.
+run 0 convert "$MODELS/bunny.obj" "$WORK/ref.off"
+for fmt in obj ply-ascii ply-binary ply-binary-be; do
+  if cmp -s "$WORK/ref.off" "$WORK/back-$fmt.off"; then passed=$((passed + 1))
+  else echo "FAIL: $fmt round trip changed the mesh"; failed=$((failed + 1)); fi
+done
+
+run 2 convert "$MODELS/cube.obj" "$WORK/out.xyz"
+contains "cannot tell the output format"
+run 2 convert "$MODELS/cube.obj" "$WORK/out.off" --format nope
+run 1 convert "$WORK/none.obj" "$WORK/out.off"
+contains "none.obj"
+[ ! -e "$WORK/out.off" ] && passed=$((passed + 1)) || { echo "FAIL: partial output left"; failed=$((failed + 1)); }
+finish

@@ -1,0 +1,480 @@
+/*
+ * meshcsg command-line tool: a thin client of the public API (include/meshcsg.h).
+ *
+ *   meshcsg check [-o FIXED] FILE...     validate meshes (or every leaf of a .scad file)
+ *   meshcsg tree FILE.scad               print the parsed CSG tree
+ *   meshcsg convert IN OUT [--format F]  convert between mesh formats
+ *   meshcsg demo [-n N]                  run the built-in ring scene through what exists
+ *
+ * Exit status: 0 on success (check: every mesh valid), 1 when a check finds a problem
+ * or an operation fails, 2 on a usage error.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "meshcsg.h"
+#include "scenes.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+
+#define EXIT_PROBLEM 1
+#define EXIT_USAGE 2
+
+static void log_to_stderr(void *user, mcsg_log_level level, const char *message)
+{
+    (void)user;
+    if (level >= MCSG_LOG_WARNING)
+        fprintf(stderr, "meshcsg: warning: %s\n", message);
+}
+
+static mcsg_options cli_options(void)
+{
+    mcsg_options opts;
+    memset(&opts, 0, sizeof opts);
+    opts.log = log_to_stderr;
+    return opts;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static int has_extension(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n >= e && strcasecmp(path + n - e, ext) == 0;
+}
+
+static int is_csg_file(const char *path)
+{
+    return has_extension(path, ".scad") || has_extension(path, ".csg");
+}
+
+static void fail_line(const mcsg_error *err)
+{
+    fprintf(stderr, "meshcsg: %s\n", err->message);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* check                                                                               */
+
+static void print_vertex(const mcsg_mesh *m, uint32_t v)
+{
+    const double *p = m->vertices + 3 * (size_t)v;
+    printf("vertex %u (%.17g %.17g %.17g)", v, p[0], p[1], p[2]);
+}
+
+static void print_edge_problem(const char *name, const mcsg_mesh *m, size_t count,
+                               const uint32_t edge[2], const char *what)
+{
+    if (!count)
+        return;
+    printf("%s: error: %zu %s, e.g. between ", name, count, what);
+    print_vertex(m, edge[0]);
+    printf(" and ");
+    print_vertex(m, edge[1]);
+    printf("\n");
+}
+
+static void print_triangle_problem(const char *name, size_t count, uint32_t example,
+                                   const char *what)
+{
+    if (count)
+        printf("%s: error: %zu %s, e.g. triangle %u\n", name, count, what, example);
+}
+
+static void print_problems(const char *name, const mcsg_mesh *m, const mcsg_check_report *r)
+{
+    if (r->triangle_count == 0)
+        printf("%s: error: the mesh has no triangles\n", name);
+    print_triangle_problem(name, r->out_of_range_indices, r->example_out_of_range_triangle,
+                           "triangle corners reference no vertex (index out of range)");
+    if (r->nonfinite_vertices)
+        printf("%s: error: %zu vertices have NaN or infinite coordinates, e.g. vertex %u\n",
+               name, r->nonfinite_vertices, r->example_nonfinite_vertex);
+    print_triangle_problem(name, r->degenerate_triangles, r->example_degenerate_triangle,
+                           "degenerate triangles (zero area)");
+    print_triangle_problem(name, r->duplicate_triangles, r->example_duplicate_triangle,
+                           "duplicate triangles (same three vertices as another)");
+    print_edge_problem(name, m, r->boundary_edges, r->example_boundary_edge,
+                       "boundary edges (the surface is open)");
+    print_edge_problem(name, m, r->nonmanifold_edges, r->example_nonmanifold_edge,
+                       "non-manifold edges (shared by more than two triangles)");
+    print_edge_problem(name, m, r->inconsistent_edges, r->example_inconsistent_edge,
+                       "inconsistently oriented edges (neighbours face opposite ways)");
+}
+
+/* Check one mesh; flips it in place when it is consistently inverted. Returns 1 when
+ * the mesh is valid. */
+static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts)
+{
+    mcsg_check_report r;
+    mcsg_error err;
+    if (mcsg_mesh_check(m, opts, &r, &err) != MCSG_OK) {
+        fail_line(&err);
+        return 0;
+    }
+    if (!mcsg_check_report_is_valid(&r)) {
+        print_problems(name, m, &r);
+        return 0;
+    }
+    if (r.inverted) {
+        mcsg_mesh_flip(m);
+        printf("%s: warning: the mesh is inside out (volume %.17g): every triangle faces "
+               "inward; flipped\n", name, r.volume);
+        r.volume = -r.volume;
+    }
+    printf("%s: ok: %zu vertices, %zu triangles, %zu component%s, volume %.17g\n", name,
+           r.vertex_count, r.triangle_count, r.components, r.components == 1 ? "" : "s",
+           r.volume);
+    if (r.duplicate_vertices)
+        printf("%s: note: %zu vertices repeat the coordinates of another vertex\n", name,
+               r.duplicate_vertices);
+    if (r.unused_vertices)
+        printf("%s: note: %zu vertices are used by no triangle\n", name, r.unused_vertices);
+    return 1;
+}
+
+static int check_csg_file(const char *path, const mcsg_options *opts)
+{
+    mcsg_tree *tree;
+    mcsg_error err;
+    int valid = 1;
+    if (mcsg_scad_read(path, opts, &tree, &err) != MCSG_OK) {
+        fail_line(&err);
+        return 0;
+    }
+    for (mcsg_node_id id = 0; id < mcsg_tree_node_count(tree); id++) {
+        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, id);
+        mcsg_mesh copy;
+        char name[1024];
+        if (!leaf || leaf->triangle_count == 0)
+            continue; /* empty leaves (e.g. sphere(r=0)) are the empty set, not errors */
+        snprintf(name, sizeof name, "%s: leaf %s", path, mcsg_tree_node_label(tree, id));
+        if (mcsg_mesh_copy(leaf, opts, &copy, &err) != MCSG_OK) {
+            fail_line(&err);
+            valid = 0;
+            break;
+        }
+        valid &= check_mesh(name, &copy, opts);
+        mcsg_mesh_free(&copy, opts);
+    }
+    mcsg_tree_free(tree);
+    return valid;
+}
+
+static int check_mesh_file(const char *path, const char *fixed_out, const mcsg_options *opts)
+{
+    mcsg_mesh mesh;
+    mcsg_error err;
+    int valid;
+    if (mcsg_mesh_read(path, MCSG_FORMAT_AUTO, opts, &mesh, &err) != MCSG_OK) {
+        fail_line(&err);
+        return 0;
+    }
+    valid = check_mesh(path, &mesh, opts);
+    if (valid && fixed_out &&
+        mcsg_mesh_write(fixed_out, MCSG_FORMAT_AUTO, &mesh, opts, &err) != MCSG_OK) {
+        fail_line(&err);
+        valid = 0;
+    }
+    mcsg_mesh_free(&mesh, opts);
+    return valid;
+}
+
+static int cmd_check(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    const char *fixed_out = NULL;
+    int files = 0, all_valid = 1;
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            fixed_out = argv[++i];
+            continue;
+        }
+        files++;
+    }
+    if (files == 0 || (fixed_out && files != 1)) {
+        fprintf(stderr, "usage: meshcsg check [-o FIXED] FILE...  (-o takes one input)\n");
+        return EXIT_USAGE;
+    }
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "-o") == 0) {
+            i++;
+            continue;
+        }
+        all_valid &= is_csg_file(argv[i]) ? check_csg_file(argv[i], &opts)
+                                          : check_mesh_file(argv[i], fixed_out, &opts);
+    }
+    return all_valid ? 0 : EXIT_PROBLEM;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* tree                                                                                */
+
+typedef struct tree_stats {
+    size_t leaves, faces, min_faces, max_faces, max_depth;
+} tree_stats;
+
+/* Indentation is capped so that a 10,000-deep tree prints lines of bounded width. */
+#define MAX_INDENT 32
+
+static void print_node(const mcsg_tree *tree, mcsg_node_id id, size_t depth,
+                       tree_stats *stats)
+{
+    size_t indent = depth < MAX_INDENT ? depth : MAX_INDENT;
+    mcsg_node_kind kind = mcsg_tree_node_kind(tree, id);
+    printf("%*s", (int)(2 * indent), "");
+    if (depth > MAX_INDENT)
+        printf("[depth %zu] ", depth);
+    if (kind == MCSG_NODE_LEAF) {
+        size_t faces = mcsg_tree_leaf_mesh(tree, id)->triangle_count;
+        printf("leaf %u: %s, %zu triangles\n", id, mcsg_tree_node_label(tree, id), faces);
+        stats->leaves++;
+        stats->faces += faces;
+        stats->min_faces = faces < stats->min_faces ? faces : stats->min_faces;
+        stats->max_faces = faces > stats->max_faces ? faces : stats->max_faces;
+    } else {
+        printf("%s (%zu children)  %s\n", mcsg_node_kind_name(kind),
+               mcsg_tree_child_count(tree, id), mcsg_tree_node_label(tree, id));
+    }
+    if (depth > stats->max_depth)
+        stats->max_depth = depth;
+}
+
+typedef struct stack_entry {
+    mcsg_node_id node;
+    size_t depth;
+} stack_entry;
+
+/* Depth-first, children in order, with an explicit stack: trees may be very deep. */
+static int print_tree(const mcsg_tree *tree, tree_stats *stats)
+{
+    size_t n = mcsg_tree_node_count(tree), top = 0;
+    stack_entry *stack = malloc((n + 1) * sizeof *stack);
+    if (!stack)
+        return 0;
+    if (mcsg_tree_root(tree) != MCSG_NO_NODE)
+        stack[top++] = (stack_entry){mcsg_tree_root(tree), 0};
+    while (top > 0) {
+        stack_entry e = stack[--top];
+        size_t children = mcsg_tree_child_count(tree, e.node);
+        print_node(tree, e.node, e.depth, stats);
+        for (size_t i = children; i-- > 0;)
+            stack[top++] = (stack_entry){mcsg_tree_child(tree, e.node, i), e.depth + 1};
+    }
+    free(stack);
+    return 1;
+}
+
+static int cmd_tree(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    tree_stats stats = {0, 0, SIZE_MAX, 0, 0};
+    mcsg_tree *tree;
+    mcsg_error err;
+    if (argc != 1) {
+        fprintf(stderr, "usage: meshcsg tree FILE.scad\n");
+        return EXIT_USAGE;
+    }
+    if (mcsg_scad_read(argv[0], &opts, &tree, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    if (!print_tree(tree, &stats)) {
+        fprintf(stderr, "meshcsg: out of memory printing the tree\n");
+        mcsg_tree_free(tree);
+        return EXIT_PROBLEM;
+    }
+    printf("%zu nodes, %zu leaves, %zu triangles (per leaf: min %zu, max %zu), depth %zu\n",
+           mcsg_tree_node_count(tree), stats.leaves, stats.faces,
+           stats.leaves ? stats.min_faces : 0, stats.max_faces, stats.max_depth);
+    mcsg_tree_free(tree);
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* convert                                                                             */
+
+static const struct {
+    const char *name;
+    mcsg_format format;
+} format_names[] = {
+    {"off", MCSG_FORMAT_OFF},
+    {"obj", MCSG_FORMAT_OBJ},
+    {"stl", MCSG_FORMAT_STL_BINARY},
+    {"stl-binary", MCSG_FORMAT_STL_BINARY},
+    {"stl-ascii", MCSG_FORMAT_STL_ASCII},
+    {"ply", MCSG_FORMAT_PLY_BINARY_LE},
+    {"ply-binary", MCSG_FORMAT_PLY_BINARY_LE},
+    {"ply-binary-be", MCSG_FORMAT_PLY_BINARY_BE},
+    {"ply-ascii", MCSG_FORMAT_PLY_ASCII},
+};
+
+static int parse_format(const char *name, mcsg_format *out)
+{
+    for (size_t i = 0; i < sizeof format_names / sizeof format_names[0]; i++) {
+        if (strcasecmp(name, format_names[i].name) == 0) {
+            *out = format_names[i].format;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int cmd_convert(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    mcsg_format format = MCSG_FORMAT_AUTO;
+    const char *paths[2];
+    int npaths = 0;
+    mcsg_mesh mesh;
+    mcsg_error err;
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "--format") == 0 && i + 1 < argc) {
+            if (!parse_format(argv[++i], &format)) {
+                fprintf(stderr, "meshcsg: unknown format '%s' (off, obj, stl, stl-ascii, "
+                        "stl-binary, ply, ply-ascii, ply-binary, ply-binary-be)\n", argv[i]);
+                return EXIT_USAGE;
+            }
+        } else if (npaths < 2) {
+            paths[npaths++] = argv[i];
+        } else {
+            npaths = 3;
+        }
+    }
+    if (npaths != 2) {
+        fprintf(stderr, "usage: meshcsg convert IN OUT [--format FORMAT]\n");
+        return EXIT_USAGE;
+    }
+    if (format == MCSG_FORMAT_AUTO && mcsg_format_from_path(paths[1]) == MCSG_FORMAT_AUTO) {
+        fprintf(stderr, "meshcsg: %s: cannot tell the output format from the extension; "
+                "use .off .obj .stl .ply or --format\n", paths[1]);
+        return EXIT_USAGE;
+    }
+    if (mcsg_mesh_read(paths[0], MCSG_FORMAT_AUTO, &opts, &mesh, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    if (mcsg_mesh_write(paths[1], format, &mesh, &opts, &err) != MCSG_OK) {
+        fail_line(&err);
+        mcsg_mesh_free(&mesh, &opts);
+        return EXIT_PROBLEM;
+    }
+    printf("%s -> %s: %zu vertices, %zu triangles\n", paths[0], paths[1], mesh.vertex_count,
+           mesh.triangle_count);
+    mcsg_mesh_free(&mesh, &opts);
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* demo                                                                                */
+
+static int demo_check_leaves(const mcsg_tree *tree, const mcsg_options *opts,
+                             size_t *faces)
+{
+    int valid = 1;
+    for (mcsg_node_id id = 0; id < mcsg_tree_node_count(tree); id++) {
+        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, id);
+        mcsg_check_report r;
+        mcsg_error err;
+        if (!leaf)
+            continue;
+        *faces += leaf->triangle_count;
+        if (mcsg_mesh_check(leaf, opts, &r, &err) != MCSG_OK) {
+            fail_line(&err);
+            return 0;
+        }
+        if (!mcsg_check_report_is_valid(&r) || r.inverted) {
+            printf("demo: leaf %s is not a valid outward closed mesh\n",
+                   mcsg_tree_node_label(tree, id));
+            valid = 0;
+        }
+    }
+    return valid;
+}
+
+static int cmd_demo(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    int spheres = 200, valid;
+    size_t faces = 0;
+    mcsg_tree *tree;
+    mcsg_error err;
+    double t0, t1, t2;
+    if (argc == 2 && strcmp(argv[0], "-n") == 0 && atoi(argv[1]) > 0) {
+        spheres = atoi(argv[1]);
+    } else if (argc != 0) {
+        fprintf(stderr, "usage: meshcsg demo [-n SPHERES]\n");
+        return EXIT_USAGE;
+    }
+    t0 = now_seconds();
+    if (scene_ring_spheres(spheres, 1, &opts, &tree, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    t1 = now_seconds();
+    valid = demo_check_leaves(tree, &opts, &faces);
+    t2 = now_seconds();
+    printf("demo scene: the paper's ring (Fig. 15a) with %d spheres alternately added and "
+           "carved: %zu leaves, %zu triangles, tree depth %d\n",
+           spheres, mcsg_tree_leaf_count(tree), faces, spheres);
+    printf("  build scene      %8.3f s\n", t1 - t0);
+    printf("  validate leaves  %8.3f s  (%s)\n", t2 - t1,
+           valid ? "every leaf closed, oriented, manifold" : "INVALID LEAVES");
+    printf("evaluation is not built yet: meshcsg cannot compute the CSG result so far, so "
+           "no result mesh is written.\n");
+    mcsg_tree_free(tree);
+    return valid ? 0 : EXIT_PROBLEM;
+}
+
+/* ---------------------------------------------------------------------------------- */
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+            "meshcsg %d.%d.%d - exact CSG on closed triangle meshes\n"
+            "usage:\n"
+            "  meshcsg check [-o FIXED] FILE...    validate meshes (.off .obj .stl .ply) or\n"
+            "                                      every leaf of a CSG file (.scad .csg);\n"
+            "                                      -o writes the (re-oriented) mesh\n"
+            "  meshcsg tree FILE.scad              print the parsed CSG tree\n"
+            "  meshcsg convert IN OUT [--format F] convert between mesh formats\n"
+            "  meshcsg demo [-n SPHERES]           build and validate the built-in scene\n"
+            "exit status: 0 ok, 1 a problem was found or an operation failed, 2 usage error\n",
+            MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    if (strcmp(argv[1], "check") == 0)
+        return cmd_check(argc - 2, argv + 2);
+    if (strcmp(argv[1], "tree") == 0)
+        return cmd_tree(argc - 2, argv + 2);
+    if (strcmp(argv[1], "convert") == 0)
+        return cmd_convert(argc - 2, argv + 2);
+    if (strcmp(argv[1], "demo") == 0)
+        return cmd_demo(argc - 2, argv + 2);
+    if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("meshcsg %d.%d.%d\n", MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR,
+               MCSG_VERSION_PATCH);
+        return 0;
+    }
+    fprintf(stderr, "meshcsg: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return EXIT_USAGE;
+}
