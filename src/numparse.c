@@ -1,0 +1,482 @@
+/*
+ * Exact, locale-independent conversion between decimal text and doubles.
+ *
+ * Parsing follows the decimal floating-point syntax of C11 7.22.1.3 (strtod) without hex
+ * floats, and rounds correctly (IEEE 754 round-to-nearest-even) by three exact paths:
+ *
+ *  1. Clinger's fast path: at most 15-16 digits (mantissa < 2^53) and |exponent| <= 22,
+ *     where one IEEE multiply or divide of two exact doubles rounds once, correctly.
+ *  2. A 128-bit integer path for up to 19 significant digits: the value is an exact
+ *     integer product m * 10^e, or the quotient (m * 2^s) / 10^k with a sticky bit for
+ *     the remainder, rounded to 53 bits by round_to_double.
+ *  3. A GMP mpn path for everything else, on fixed-size stack arrays so that it never
+ *     allocates (mpn functions leave memory management to the caller). Only the first
+ *     MAX_SIG_DIGITS digits are kept, plus a sticky digit: a double or a midpoint
+ *     between two doubles has at most 767 significant digits, so digits beyond 800 can
+ *     only tell "a little above" from "exactly", which the sticky digit preserves.
+ *
+ * Formatting tries printf's %.15g, %.16g and %.17g (17 digits always round-trip) and
+ * keeps the first that parses back to the same double; the locale's decimal point,
+ * whatever it is, is then replaced by '.'.
+ */
+#include "numparse.h"
+
+#include <float.h>
+#include <gmp.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#if GMP_NAIL_BITS != 0
+#error "numparse.c assumes GMP limbs without nail bits"
+#endif
+
+__extension__ typedef unsigned __int128 u128;
+
+/* Significant digits kept for the exact path (see the file comment). */
+#define MAX_SIG_DIGITS 800
+/* Explicit exponents saturate here: far beyond any double, far from int64 overflow. */
+#define EXPONENT_CAP 100000000
+/* Decimal digits that fit one limb as a power of ten, for building big integers. */
+#if GMP_NUMB_BITS >= 64
+#define LIMB_DIGITS 19
+#else
+#define LIMB_DIGITS 9
+#endif
+/* A big integer holds at most D * 2^s with D < 10^801 and 2^s <= 2^66 * 10^1125 (see
+ * parse_big_fraction), i.e. below 2^3805 bits; round up generously. */
+#define BIG_BITS 3900
+#define BIG_LIMBS (BIG_BITS / GMP_NUMB_BITS + 2)
+
+/* The decimal value digits[0..count) * 10^exp10, digits being values 0..9 without
+ * leading or trailing zeros (count == 0 means zero). */
+typedef struct decimal {
+    unsigned char digits[MAX_SIG_DIGITS + 1];
+    size_t count;
+    int64_t exp10;
+} decimal;
+
+typedef struct bignum {
+    mp_limb_t limb[BIG_LIMBS];
+    mp_size_t size; /* limbs in use; the top one is non-zero unless size == 0 */
+} bignum;
+
+static const double exact_pow10[23] = {
+    1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+    1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+};
+
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static char lower(char c) { return (c >= 'A' && c <= 'Z') ? (char)(c - 'A' + 'a') : c; }
+
+/* Case-insensitive match of the lower-case word at s, bounded by end. */
+static bool match_word(const char *s, const char *end, const char *word)
+{
+    size_t n = strlen(word);
+    if ((size_t)(end - s) < n)
+        return false;
+    for (size_t i = 0; i < n; i++)
+        if (lower(s[i]) != word[i])
+            return false;
+    return true;
+}
+
+static int bit_length64(uint64_t x)
+{
+    int n = 0;
+    for (int half = 32; half > 0; half /= 2) {
+        if (x >> half) {
+            n += half;
+            x >>= half;
+        }
+    }
+    return n + (int)x;
+}
+
+static int bit_length128(u128 x)
+{
+    uint64_t hi = (uint64_t)(x >> 64);
+    return hi ? 64 + bit_length64(hi) : bit_length64((uint64_t)x);
+}
+
+static const uint64_t pow10_u64[20] = {
+    1ull, 10ull, 100ull, 1000ull, 10000ull, 100000ull, 1000000ull, 10000000ull,
+    100000000ull, 1000000000ull, 10000000000ull, 100000000000ull, 1000000000000ull,
+    10000000000000ull, 100000000000000ull, 1000000000000000ull, 10000000000000000ull,
+    100000000000000000ull, 1000000000000000000ull, 10000000000000000000ull,
+};
+
+/* 10^k for 0 <= k <= 38 (10^38 < 2^128). */
+static u128 pow10_u128(int k)
+{
+    return k <= 19 ? (u128)pow10_u64[k] : (u128)pow10_u64[19] * pow10_u64[k - 19];
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Rounding an exact binary value to a double                                          */
+
+/* Round (top + epsilon) * 2^e2 to the nearest double, ties to even, where top has its
+ * bit 63 set and `sticky` says whether epsilon (below one unit of top) is non-zero.
+ * Handles subnormals (fewer mantissa bits kept) and overflow to infinity. */
+static double round_to_double(uint64_t top, int64_t e2, bool sticky)
+{
+    int64_t leading = e2 + 63; /* binary exponent of the leading bit */
+    int64_t drop = 11;         /* 64 - 53 bits dropped for a normal double */
+    u128 kept, rest, half;
+    if (leading > 1023)
+        return INFINITY;
+    if (leading < -1022)
+        drop += -1022 - leading; /* subnormal: fewer bits above 2^-1074 */
+    if (drop > 64)
+        return 0.0; /* below half of the smallest subnormal */
+    kept = (u128)top >> drop;
+    rest = (u128)top & ((((u128)1) << drop) - 1);
+    half = ((u128)1) << (drop - 1);
+    if (rest > half || (rest == half && (sticky || (kept & 1))))
+        kept++;
+    /* kept <= 2^53 is exact as a double, and so is the scaled result unless it
+     * overflows, where ldexp returns the correctly rounded infinity. */
+    return ldexp((double)(uint64_t)kept, (int)(e2 + drop));
+}
+
+/* Round (x + epsilon) * 2^e2, x != 0, with the same meaning of sticky. */
+static double round_u128(u128 x, int64_t e2, bool sticky)
+{
+    int bits = bit_length128(x);
+    if (bits > 64) {
+        int shift = bits - 64;
+        sticky = sticky || (x & ((((u128)1) << shift) - 1)) != 0;
+        return round_to_double((uint64_t)(x >> shift), e2 + shift, sticky);
+    }
+    return round_to_double((uint64_t)x << (64 - bits), e2 - (64 - bits), sticky);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Big integers on the stack (GMP mpn)                                                 */
+
+static int64_t big_bit_length(const bignum *x)
+{
+    if (x->size == 0)
+        return 0;
+    return (int64_t)(x->size - 1) * GMP_NUMB_BITS +
+           bit_length64((uint64_t)x->limb[x->size - 1]);
+}
+
+/* x = x * mul + add, with mul, add < 2^GMP_NUMB_BITS. The caller guarantees room. */
+static void big_mul_add(bignum *x, mp_limb_t mul, mp_limb_t add)
+{
+    mp_limb_t carry;
+    if (x->size == 0) {
+        x->limb[0] = add;
+        x->size = add != 0;
+        return;
+    }
+    carry = mpn_mul_1(x->limb, x->limb, x->size, mul);
+    carry += mpn_add_1(x->limb, x->limb, x->size, add); /* cannot overflow the limb */
+    if (carry)
+        x->limb[x->size++] = carry;
+}
+
+/* 10^k for 0 <= k <= LIMB_DIGITS. */
+static mp_limb_t limb_pow10(int k) { return (mp_limb_t)pow10_u64[k]; }
+
+/* x = x * 10^k. */
+static void big_mul_pow10(bignum *x, int64_t k)
+{
+    for (; k >= LIMB_DIGITS; k -= LIMB_DIGITS)
+        big_mul_add(x, limb_pow10(LIMB_DIGITS), 0);
+    if (k > 0)
+        big_mul_add(x, limb_pow10((int)k), 0);
+}
+
+static void big_from_digits(bignum *x, const decimal *d)
+{
+    x->size = 0;
+    for (size_t i = 0; i < d->count; i += LIMB_DIGITS) {
+        size_t n = d->count - i < LIMB_DIGITS ? d->count - i : LIMB_DIGITS;
+        mp_limb_t chunk = 0;
+        for (size_t j = 0; j < n; j++)
+            chunk = chunk * 10 + d->digits[i + j];
+        big_mul_add(x, limb_pow10((int)n), chunk);
+    }
+}
+
+/* x = x * 2^s. */
+static void big_shift_left(bignum *x, int64_t s)
+{
+    mp_size_t limbs = (mp_size_t)(s / GMP_NUMB_BITS);
+    unsigned bits = (unsigned)(s % GMP_NUMB_BITS);
+    mp_limb_t carry = 0;
+    if (x->size == 0)
+        return;
+    if (bits)
+        carry = mpn_lshift(x->limb, x->limb, x->size, bits);
+    if (carry)
+        x->limb[x->size++] = carry;
+    if (limbs) {
+        memmove(x->limb + limbs, x->limb, (size_t)x->size * sizeof(mp_limb_t));
+        memset(x->limb, 0, (size_t)limbs * sizeof(mp_limb_t));
+        x->size += limbs;
+    }
+}
+
+/* Round (x + sticky epsilon) * 2^e2 to a double, x != 0. */
+static double round_big(const bignum *x, int64_t e2, bool sticky)
+{
+    int64_t bits = big_bit_length(x);
+    u128 acc = 0;
+    int64_t acc_bits = 0;
+    mp_size_t i = x->size;
+    /* Gather limbs from the top until they hold at least 64 significant bits. */
+    while (i > 0 && acc_bits < 64) {
+        i--;
+        acc = (acc << GMP_NUMB_BITS) | x->limb[i];
+        acc_bits = bits - (int64_t)i * GMP_NUMB_BITS;
+    }
+    if (i > 0 && !mpn_zero_p(x->limb, i))
+        sticky = true;
+    return round_u128(acc, e2 + (int64_t)i * GMP_NUMB_BITS, sticky);
+}
+
+/* d * 10^exp10 with exp10 >= 0: an exact integer. */
+static double parse_big_integer(const decimal *d)
+{
+    bignum x;
+    big_from_digits(&x, d);
+    big_mul_pow10(&x, d->exp10);
+    return round_big(&x, 0, false);
+}
+
+/* d / 10^k with k = -exp10 > 0: scale d by 2^s so that the quotient has at least 66
+ * bits (53 + round bit + margin), divide exactly and keep the remainder as sticky. */
+static double parse_big_fraction(const decimal *d)
+{
+    bignum num, den, quot, rem;
+    int64_t shift;
+    den.limb[0] = 1;
+    den.size = 1;
+    big_mul_pow10(&den, -d->exp10);
+    big_from_digits(&num, d);
+    shift = big_bit_length(&den) + 66 - big_bit_length(&num);
+    if (shift < 0)
+        shift = 0;
+    big_shift_left(&num, shift);
+    mpn_tdiv_qr(quot.limb, rem.limb, 0, num.limb, num.size, den.limb, den.size);
+    quot.size = num.size - den.size + 1;
+    while (quot.size > 0 && quot.limb[quot.size - 1] == 0)
+        quot.size--;
+    return round_big(&quot, -shift, !mpn_zero_p(rem.limb, den.size));
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Choosing the path                                                                   */
+
+/* Exact value of d for at most 19 digits. */
+static double parse_small(const decimal *d)
+{
+    uint64_t m = 0;
+    int64_t e = d->exp10;
+    for (size_t i = 0; i < d->count; i++)
+        m = m * 10 + d->digits[i];
+#if FLT_EVAL_METHOD == 0 /* one rounding per operation (not x87 extended precision) */
+    if (m < ((uint64_t)1 << 53) && e >= -22 && e <= 22)
+        return e >= 0 ? (double)m * exact_pow10[e] : (double)m / exact_pow10[-e];
+#endif
+    if (e >= 0 && e <= 38) {
+        u128 p = pow10_u128((int)e);
+        if ((u128)m <= ~(u128)0 / p)
+            return round_u128((u128)m * p, 0, false);
+    }
+    if (e < 0 && e >= -21) {
+        /* 10^21 < 2^70 and the numerator has 127 bits: the quotient has >= 57. */
+        int shift = 127 - bit_length64(m);
+        u128 num = (u128)m << shift, den = pow10_u128((int)-e);
+        return round_u128(num / den, -shift, num % den != 0);
+    }
+    return e >= 0 ? parse_big_integer(d) : parse_big_fraction(d);
+}
+
+static double decimal_to_double(const decimal *d)
+{
+    int64_t magnitude = (int64_t)d->count + d->exp10; /* value < 10^magnitude */
+    if (d->count == 0)
+        return 0.0;
+    if (magnitude - 1 >= 309) /* value >= 1e309 > DBL_MAX */
+        return INFINITY;
+    if (magnitude < -324) /* value < 1e-325, below half of 2^-1074 */
+        return 0.0;
+    if (d->count <= 19)
+        return parse_small(d);
+    return d->exp10 >= 0 ? parse_big_integer(d) : parse_big_fraction(d);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Scanning the text                                                                   */
+
+/* Append one mantissa digit: leading zeros are dropped, digits beyond MAX_SIG_DIGITS
+ * only count (their position raises the exponent) and set *dropped_nonzero. */
+static void add_digit(decimal *d, char c, int64_t *dropped, bool *dropped_nonzero)
+{
+    if (d->count == 0 && c == '0')
+        return;
+    if (d->count < MAX_SIG_DIGITS) {
+        d->digits[d->count++] = (unsigned char)(c - '0');
+        return;
+    }
+    (*dropped)++;
+    if (c != '0')
+        *dropped_nonzero = true;
+}
+
+/* Parse "e[+-]digits" at *p; leave *p alone (exponent 0) if no digit follows. */
+static int64_t scan_exponent(const char **p, const char *end)
+{
+    const char *s = *p;
+    bool negative = false;
+    int64_t value = 0;
+    if (s >= end || (*s != 'e' && *s != 'E'))
+        return 0;
+    s++;
+    if (s < end && (*s == '+' || *s == '-'))
+        negative = *s++ == '-';
+    if (s >= end || !is_digit(*s))
+        return 0;
+    for (; s < end && is_digit(*s); s++)
+        if (value < EXPONENT_CAP)
+            value = value * 10 + (*s - '0');
+    *p = s;
+    return negative ? -value : value;
+}
+
+/* Scan digits, an optional '.', digits and an exponent into *d. Returns the first byte
+ * after the number, or NULL when there is no digit at all. */
+static const char *scan_decimal(const char *s, const char *end, decimal *d)
+{
+    int64_t dropped = 0, fraction_digits = 0;
+    bool dropped_nonzero = false, any_digit = false;
+    d->count = 0;
+    for (; s < end && is_digit(*s); s++, any_digit = true)
+        add_digit(d, *s, &dropped, &dropped_nonzero);
+    if (s < end && *s == '.') {
+        for (s++; s < end && is_digit(*s); s++, fraction_digits++, any_digit = true)
+            add_digit(d, *s, &dropped, &dropped_nonzero);
+    }
+    if (!any_digit)
+        return NULL;
+    d->exp10 = scan_exponent(&s, end) - fraction_digits + dropped;
+    while (d->count > 0 && d->digits[d->count - 1] == 0 && !dropped_nonzero) {
+        d->count--;
+        d->exp10++;
+    }
+    if (dropped_nonzero) { /* a sticky digit just below the kept ones */
+        d->digits[d->count++] = 1;
+        d->exp10--;
+    }
+    return s;
+}
+
+/* The n-char-sequence of "nan(...)": digits, letters and '_' (C11 7.22.1.3). */
+static bool is_nan_char(char c)
+{
+    return is_digit(c) || c == '_' || (lower(c) >= 'a' && lower(c) <= 'z');
+}
+
+/* "inf", "infinity" or "nan" (optionally "nan(chars)"), case-insensitive. */
+static const char *scan_special(const char *s, const char *end, double *value)
+{
+    if (match_word(s, end, "infinity")) {
+        *value = INFINITY;
+        return s + 8;
+    }
+    if (match_word(s, end, "inf")) {
+        *value = INFINITY;
+        return s + 3;
+    }
+    if (match_word(s, end, "nan")) {
+        const char *p = s + 3;
+        *value = NAN;
+        if (p < end && *p == '(') {
+            const char *q = p + 1;
+            while (q < end && is_nan_char(*q))
+                q++;
+            if (q < end && *q == ')')
+                p = q + 1;
+        }
+        return p;
+    }
+    return NULL;
+}
+
+bool mci_parse_double(const char *s, const char *end, double *out, const char **next)
+{
+    bool negative = false;
+    const char *after;
+    double value = 0.0;
+    decimal d;
+    if (s < end && (*s == '+' || *s == '-'))
+        negative = *s++ == '-';
+    if (s < end && (is_digit(*s) || *s == '.')) {
+        after = scan_decimal(s, end, &d);
+        if (after)
+            value = decimal_to_double(&d);
+    } else {
+        after = scan_special(s, end, &value);
+    }
+    if (!after)
+        return false;
+    *out = negative ? -value : value;
+    *next = after;
+    return true;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Formatting                                                                          */
+
+/* Replace each run of characters that cannot be part of a C-locale number (the
+ * locale's decimal point, possibly multi-byte) with '.'. Returns the new length. */
+static size_t normalise_decimal_point(char *text, size_t len)
+{
+    size_t out = 0;
+    for (size_t i = 0; i < len;) {
+        char c = text[i];
+        if (is_digit(c) || c == 'e' || c == 'E' || c == '+' || c == '-') {
+            text[out++] = c;
+            i++;
+            continue;
+        }
+        while (i < len && !(is_digit(text[i]) || text[i] == 'e' || text[i] == 'E' ||
+                            text[i] == '+' || text[i] == '-'))
+            i++;
+        text[out++] = '.';
+    }
+    text[out] = '\0';
+    return out;
+}
+
+size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
+{
+    char text[64] = "0";
+    size_t len = 1;
+    if (isnan(value) || isinf(value)) {
+        const char *word = isnan(value) ? "nan" : value < 0 ? "-inf" : "inf";
+        len = strlen(word);
+        memcpy(buf, word, len + 1);
+        return len;
+    }
+    for (int precision = 15; precision <= 17; precision++) {
+        double back;
+        const char *next;
+        int n = snprintf(text, sizeof text, "%.*g", precision, value);
+        if (n < 0 || (size_t)n >= sizeof text)
+            continue; /* cannot happen for a finite double; 17 digits will be tried */
+        len = normalise_decimal_point(text, (size_t)n);
+        if (precision == 17)
+            break;
+        if (mci_parse_double(text, text + len, &back, &next) && back == value)
+            break;
+    }
+    memcpy(buf, text, len + 1);
+    return len;
+}
