@@ -223,29 +223,43 @@ int mcsg_check_report_is_valid(const mcsg_check_report *report);
 /* ------------------------------------------------------------------------------------ */
 /* Primitives, tessellated exactly as OpenSCAD does                                      */
 
-/* Number of fragments OpenSCAD uses for a circle of radius r: 3 for r < 2^-20; with
- * fn > 0, max(fn, 3); otherwise ceil(max(min(360/fa, 2*pi*r/fs), 5)). OpenSCAD's
- * defaults are fn = 0, fa = 12, fs = 2. */
+/* Number of fragments OpenSCAD uses for a circle of radius r: 3 for r < 2^-20 or an
+ * infinite or NaN fn; with fn > 0, max(fn, 3) truncated to an integer; otherwise
+ * ceil(max(min(360/fa, 2*pi*r/fs), 5)). OpenSCAD's defaults are fn = 0, fa = 12, fs = 2.
+ * fa and fs are used as given here (results beyond INT_MAX saturate). */
 int mcsg_fragments(double r, double fn, double fa, double fs);
 
-/* Tessellation controls, as OpenSCAD's $fn, $fa, $fs. */
+/* Tessellation controls, as OpenSCAD's $fn, $fa, $fs. For mcsg_make_sphere and
+ * mcsg_make_cylinder a zero fa or fs means OpenSCAD's default (12, 2), so a zeroed struct
+ * gives OpenSCAD's default tessellation; other values below 0.01 are clamped to 0.01, as
+ * OpenSCAD clamps $fa and $fs. */
 typedef struct mcsg_resolution {
     double fn, fa, fs;
 } mcsg_resolution;
 
-/* OpenSCAD's cube: a box from the origin to size (or centred). A size <= 0 in any axis
- * gives an empty mesh. 8 vertices, 12 triangles. */
+/* The primitives below produce OpenSCAD's vertices bit for bit. OpenSCAD's polygons are
+ * split into triangles counter-clockwise seen from outside: convex caps as a fan from
+ * their first vertex, quads (a, b, c, d) as (a, b, c) + (a, c, d). An empty result is a
+ * mesh with no vertices and no triangles (and MCSG_OK). Huge fragment counts fail with
+ * MCSG_ERR_LIMIT beyond 2^32-1 vertices or triangles. */
+
+/* OpenSCAD's cube: a box from the origin to size (or centred). A size <= 0 or non-finite
+ * in any axis gives an empty mesh. 8 vertices (corner i has x from bit 0, y from bit 1,
+ * z from bit 2), 12 triangles. */
 mcsg_status mcsg_make_cube(const double size[3], int center, const mcsg_options *opts,
                            mcsg_mesh *out, mcsg_error *err);
 
 /* OpenSCAD's sphere: n = mcsg_fragments(r) points per ring, (n+1)/2 rings at polar
- * angles 180*(i+0.5)/rings degrees, each ring a polygon cap at the poles. r <= 0 gives an
- * empty mesh. Triangles: 2n(rings-1) + 2(n-2). */
+ * angles 180*(i+0.5)/rings degrees, the first and last ring closed by a polygon cap.
+ * r <= 0 or non-finite gives an empty mesh. Vertices n*rings; triangles
+ * 2n(rings-1) + 2(n-2). */
 mcsg_status mcsg_make_sphere(double r, mcsg_resolution res, const mcsg_options *opts,
                              mcsg_mesh *out, mcsg_error *err);
 
-/* OpenSCAD's cylinder (a cone when r1 or r2 is 0) from z=0 to z=h, or centred.
- * Fragments from max(r1, r2). h <= 0 or r1 = r2 = 0 gives an empty mesh. */
+/* OpenSCAD's cylinder from z=0 to z=h (or centred): a circle of radius r1 at the bottom,
+ * r2 at the top, fragments from max(r1, r2). A zero radius gives a single apex vertex (a
+ * cone: n+1 vertices, n + (n-2) triangles); otherwise 2n vertices, 2n + 2(n-2) triangles.
+ * h <= 0, a negative radius, r1 = r2 = 0 or a non-finite value gives an empty mesh. */
 mcsg_status mcsg_make_cylinder(double h, double r1, double r2, int center,
                                mcsg_resolution res, const mcsg_options *opts,
                                mcsg_mesh *out, mcsg_error *err);
@@ -284,7 +298,9 @@ mcsg_status mcsg_tree_add_leaf(mcsg_tree *tree, const mcsg_mesh *mesh, const dou
                                const char *label, mcsg_node_id *out, mcsg_error *err);
 
 /* Add an operation over existing nodes. Each node can be the child of one parent only
- * (MCSG_ERR_INVALID_ARG otherwise). `label` may be NULL. */
+ * (MCSG_ERR_INVALID_ARG otherwise, also for an id listed twice). `label` may be NULL.
+ * The new node's id (MCSG_NO_NODE on failure) is stored in *out (which may be NULL, or
+ * point into `children`) once everything else is done. */
 mcsg_status mcsg_tree_add_op(mcsg_tree *tree, mcsg_node_kind op, const mcsg_node_id *children,
                              size_t child_count, const char *label, mcsg_node_id *out,
                              mcsg_error *err);
@@ -306,7 +322,13 @@ const mcsg_mesh *mcsg_tree_leaf_mesh(const mcsg_tree *tree, mcsg_node_id node);
 /* CSG language (OpenSCAD subset; see docs/csg-language.md)                              */
 
 /* Parse a CSG file into a new tree. import() paths resolve relative to the file's
- * directory. Errors name the file, line and column. */
+ * directory. Errors name the file, line and column ("part.scad:3:5: ..."):
+ * MCSG_ERR_PARSE for malformed text, MCSG_ERR_UNSUPPORTED for OpenSCAD features outside
+ * the subset, MCSG_ERR_LIMIT for hard limits (expressions nested deeper than 256), and
+ * import errors with the mesh reader's status. Warnings (e.g. unknown arguments, which
+ * OpenSCAD ignores) go to the log. The empty set (an empty group, cube(0), ...) is a
+ * union node without children. Leaves and operations carry labels such as
+ * "sphere(r=5, $fn=32) at part.scad:3:5". */
 mcsg_status mcsg_scad_read(const char *path, const mcsg_options *opts, mcsg_tree **out,
                            mcsg_error *err);
 

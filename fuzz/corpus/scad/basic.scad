@@ -1,0 +1,4 @@
+difference() {
+  cube(10, center = true);
+  sphere(r = 6, $fn = 24);
+}

@@ -1,0 +1,3 @@
+cube(1);
+/* unterminated comment
+cube(2);

@@ -1,0 +1,1 @@
+for (i = [0:3]) translate([i, 0, 0]) cube(1);
