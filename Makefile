@@ -51,8 +51,7 @@ bench: deps
 
 fuzz:
 	@bash tools/ensure-deps.sh clang
-	CC=clang cmake -S . -B $(BUILD)/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMCSG_FUZZ=ON \
-	  -DCMAKE_C_FLAGS="-fsanitize=fuzzer-no-link,address,undefined" $(CMAKE_FLAGS) >/dev/null
+	CC=clang cmake -S . -B $(BUILD)/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMCSG_FUZZ=ON $(CMAKE_FLAGS) >/dev/null
 	cmake --build $(BUILD)/fuzz -j $(JOBS)
 	bash fuzz/run.sh $(BUILD)/fuzz $(FUZZ_SECONDS)
 

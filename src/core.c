@@ -188,7 +188,9 @@ mcsg_status mci_read_file(const mci_ctx *ctx, const char *path, unsigned char **
         return mci_fail(err, MCSG_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     for (;;) {
         size_t got;
-        if (!mci_buf_reserve(ctx, &buf, 1 << 20)) {
+        /* Grow only when full (the buffer doubles), so a small file costs one small
+         * allocation and a large one a logarithmic number of copies. */
+        if (buf.cap - buf.len < 2 && !mci_buf_reserve(ctx, &buf, buf.cap ? buf.cap : 65536)) {
             fclose(f);
             mci_buf_free(ctx, &buf);
             return mci_fail_nomem(err, "reading a file");
