@@ -41,24 +41,6 @@ static mcsg_status read_text(const char *text, mcsg_format format, const char *n
     return read_bytes(text, strlen(text), format, name, NULL, out, err);
 }
 
-static bool same_double(double a, double b)
-{
-    return (isnan(a) && isnan(b)) || memcmp(&a, &b, sizeof a) == 0;
-}
-
-static bool meshes_identical(const mcsg_mesh *a, const mcsg_mesh *b)
-{
-    if (a->vertex_count != b->vertex_count || a->triangle_count != b->triangle_count)
-        return false;
-    for (size_t i = 0; i < 3 * a->vertex_count; i++)
-        if (!same_double(a->vertices[i], b->vertices[i]))
-            return false;
-    for (size_t i = 0; i < 3 * a->triangle_count; i++)
-        if (a->triangles[i] != b->triangles[i])
-            return false;
-    return true;
-}
-
 /* Read `text` expecting failure with `status` and a message containing `where` (e.g.
  * "bad.off:7:") and `what`. */
 #define CHECK_READ_FAILS(text, format, name, status, where, what)                         \
@@ -228,7 +210,7 @@ TEST(round_trip_exact_formats)
             CHECK_OK(read_bytes(data, size, detect ? MCSG_FORMAT_AUTO : exact_formats[f],
                                 NULL, NULL, &back, &err),
                      &err);
-            CHECK_MSG(meshes_identical(&mesh, &back), "%s round trip (detect=%d) differs",
+            CHECK_MSG(test_same_mesh(&mesh, &back), "%s round trip (detect=%d) differs",
                       mcsg_format_name(exact_formats[f]), detect);
             mcsg_mesh_free(&back, NULL);
         }
@@ -248,7 +230,7 @@ TEST(round_trip_through_files)
         const char *path = test_tmp(names[i]);
         CHECK_OK(mcsg_mesh_write(path, MCSG_FORMAT_AUTO, &mesh, NULL, &err), &err);
         CHECK_OK(mcsg_mesh_read(path, MCSG_FORMAT_AUTO, NULL, &back, &err), &err);
-        CHECK_MSG(meshes_identical(&mesh, &back), "%s differs", names[i]);
+        CHECK_MSG(test_same_mesh(&mesh, &back), "%s differs", names[i]);
         mcsg_mesh_free(&back, NULL);
     }
 }
@@ -305,7 +287,7 @@ TEST(round_trip_stl)
         size_t size = 0;
         CHECK_OK(mcsg_mesh_write_memory(formats[f], &mesh, &opts, &data, &size, &err), &err);
         CHECK_OK(read_bytes(data, size, MCSG_FORMAT_AUTO, "t.stl", NULL, &back, &err), &err);
-        CHECK_MSG(meshes_identical(&mesh, &back), "%s round trip differs",
+        CHECK_MSG(test_same_mesh(&mesh, &back), "%s round trip differs",
                   mcsg_format_name(formats[f]));
         mcsg_mesh_free(&back, NULL);
         if (f == 1)
@@ -335,7 +317,7 @@ TEST(stl_round_trip_soup)
         mcsg_mesh back;
         CHECK_OK(mcsg_mesh_write_memory(formats[f], &soup, NULL, &data, &size, &err), &err);
         CHECK_OK(read_bytes(data, size, formats[f], NULL, NULL, &back, &err), &err);
-        CHECK_MSG(meshes_identical(&soup, &back), "%s soup differs",
+        CHECK_MSG(test_same_mesh(&soup, &back), "%s soup differs",
                   mcsg_format_name(formats[f]));
         mcsg_mesh_free(&back, NULL);
         mcsg_free(data, NULL);
@@ -946,59 +928,6 @@ TEST(ply_binary_errors)
 /* ---------------------------------------------------------------------------------- */
 /* Hostile counts and allocation failures                                              */
 
-/* An allocator that counts calls, fails the Nth one (0: never), tracks live blocks and
- * the largest request. */
-typedef struct test_allocator {
-    long calls, fail_at, live;
-    size_t largest;
-} test_allocator;
-
-static void *test_malloc(void *user, size_t size)
-{
-    test_allocator *a = user;
-    void *p;
-    if (++a->calls == a->fail_at)
-        return NULL;
-    if (size > a->largest)
-        a->largest = size;
-    p = malloc(size);
-    if (p)
-        a->live++;
-    return p;
-}
-
-static void *test_realloc(void *user, void *ptr, size_t size)
-{
-    test_allocator *a = user;
-    void *p;
-    if (++a->calls == a->fail_at)
-        return NULL;
-    if (size > a->largest)
-        a->largest = size;
-    p = realloc(ptr, size);
-    if (p && !ptr)
-        a->live++;
-    return p;
-}
-
-static void test_free(void *user, void *ptr)
-{
-    test_allocator *a = user;
-    a->live--;
-    free(ptr);
-}
-
-static mcsg_options options_with(test_allocator *a)
-{
-    mcsg_options opts;
-    memset(&opts, 0, sizeof opts);
-    opts.allocator.malloc_fn = test_malloc;
-    opts.allocator.realloc_fn = test_realloc;
-    opts.allocator.free_fn = test_free;
-    opts.allocator.user = a;
-    return opts;
-}
-
 TEST(hostile_counts_allocate_little)
 {
     static const char *const texts[] = {
@@ -1011,8 +940,8 @@ TEST(hostile_counts_allocate_little)
         "property list uchar int vertex_indices\nend_header\n0 0 0\n",
     };
     for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
-        test_allocator a = {0, 0, 0, 0};
-        mcsg_options opts = options_with(&a);
+        test_allocator a = {0, 0, false, 0, 0};
+        mcsg_options opts = test_allocator_options(&a);
         mcsg_mesh m;
         mcsg_error err;
         mcsg_status st = read_bytes(texts[i], strlen(texts[i]), MCSG_FORMAT_AUTO, "h", &opts,
@@ -1023,56 +952,53 @@ TEST(hostile_counts_allocate_little)
     }
 }
 
+/* What an allocation-failure run reads (path) or writes (mesh), and in which format. */
+typedef struct io_case {
+    const char *path;
+    const mcsg_mesh *mesh;
+    mcsg_format format;
+} io_case;
+
+/* Read the file and free the mesh: no mesh is returned on failure. */
+static mcsg_status read_file(const void *ctx, const mcsg_options *opts, mcsg_error *err)
+{
+    const io_case *c = ctx;
+    mcsg_mesh m;
+    mcsg_status st = mcsg_mesh_read(c->path, c->format, opts, &m, err);
+    if (st == MCSG_OK)
+        mcsg_mesh_free(&m, opts);
+    else
+        CHECK(m.vertices == NULL && m.triangles == NULL);
+    return st;
+}
+
+/* Write the mesh to memory and free the data: no data is returned on failure. */
+static mcsg_status write_memory(const void *ctx, const mcsg_options *opts, mcsg_error *err)
+{
+    const io_case *c = ctx;
+    void *data = NULL;
+    size_t size = 0;
+    mcsg_status st = mcsg_mesh_write_memory(c->format, c->mesh, opts, &data, &size, err);
+    if (st == MCSG_OK)
+        mcsg_free(data, opts);
+    else
+        CHECK(data == NULL);
+    return st;
+}
+
 /* Read `path` failing the 1st, 2nd, ... allocation until the read succeeds: each run
  * must fail cleanly with NOMEM and free everything. */
 static void check_allocation_failures_read(const char *path, mcsg_format format)
 {
-    for (long n = 1; n < 10000; n++) {
-        test_allocator a = {0, n, 0, 0};
-        mcsg_options opts = options_with(&a);
-        mcsg_mesh m;
-        mcsg_error err = {MCSG_OK, ""};
-        mcsg_status st = mcsg_mesh_read(path, format, &opts, &m, &err);
-        if (st == MCSG_OK) {
-            mcsg_mesh_free(&m, &opts);
-            CHECK_MSG(a.live == 0, "%s: %ld blocks leaked", path, a.live);
-            if (a.calls < n)
-                return; /* no allocation failed: done */
-            continue;   /* a failure that needs no error (an optional trim) */
-        }
-        CHECK_MSG(st == MCSG_ERR_NOMEM, "%s: allocation %ld: status %d: %s", path, n, (int)st,
-                  err.message);
-        CHECK_MSG(a.live == 0, "%s: allocation %ld failed: %ld blocks leaked", path, n,
-                  a.live);
-        CHECK(m.vertices == NULL && m.triangles == NULL);
-        if (st != MCSG_ERR_NOMEM || a.live != 0)
-            return;
-    }
-    CHECK_MSG(false, "%s: never succeeded", path);
+    io_case c = {path, NULL, format};
+    test_allocation_failures(path, read_file, &c, true);
 }
 
+/* The same for writing `mesh` to memory. */
 static void check_allocation_failures_write(const mcsg_mesh *mesh, mcsg_format format)
 {
-    for (long n = 1; n < 10000; n++) {
-        test_allocator a = {0, n, 0, 0};
-        mcsg_options opts = options_with(&a);
-        void *data = NULL;
-        size_t size = 0;
-        mcsg_error err;
-        mcsg_status st = mcsg_mesh_write_memory(format, mesh, &opts, &data, &size, &err);
-        if (st == MCSG_OK) {
-            mcsg_free(data, &opts);
-            CHECK_EQ_SIZE(a.live, 0);
-            if (a.calls < n)
-                return;
-            continue;
-        }
-        CHECK_MSG(st == MCSG_ERR_NOMEM && data == NULL && a.live == 0,
-                  "%s: allocation %ld: status %d, %ld live", mcsg_format_name(format), n,
-                  (int)st, a.live);
-        if (st != MCSG_ERR_NOMEM)
-            return;
-    }
+    io_case c = {NULL, mesh, format};
+    test_allocation_failures(mcsg_format_name(format), write_memory, &c, true);
 }
 
 TEST(allocation_failures)

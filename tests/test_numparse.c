@@ -48,11 +48,6 @@ static uint64_t bits_of(double d)
     return bits;
 }
 
-static bool same_double(double a, double b)
-{
-    return (isnan(a) && isnan(b)) || bits_of(a) == bits_of(b);
-}
-
 /* Parse `text` with both parsers from an exactly-sized heap copy (no terminator, so
  * ASan catches any read past `end`) and compare value and end position. */
 static void compare_with_strtod(const char *text)
@@ -71,7 +66,7 @@ static void compare_with_strtod(const char *text)
             test_fail(__FILE__, __LINE__, "\"%s\": parsed but strtod rejects it", text);
     } else if (!ok) {
         test_fail(__FILE__, __LINE__, "\"%s\": rejected, strtod gives %.17g", text, ref);
-    } else if (!same_double(ours, ref) || next - copy != ref_end - text) {
+    } else if (!test_same_double(ours, ref) || next - copy != ref_end - text) {
         test_fail(__FILE__, __LINE__, "\"%s\": got %a (%td chars), strtod %a (%td chars)",
                   text, ours, next - copy, ref, ref_end - text);
     }
@@ -87,7 +82,7 @@ static void quick_compare(const char *text)
     double ours = 0, ref = strtod(text, &ref_end);
     bool ok = mci_parse_double(text, text + len, &ours, &next);
     test_checks++;
-    if (!ok || !same_double(ours, ref) || next != ref_end)
+    if (!ok || !test_same_double(ours, ref) || next != ref_end)
         test_fail(__FILE__, __LINE__, "\"%s\": got %a, strtod %a", text, ours, ref);
 }
 
@@ -325,7 +320,7 @@ TEST(format_round_trip)
             continue;
         len = mci_format_double(out, d);
         CHECK_MSG(len == strlen(out) && len < MCI_DOUBLE_TEXT_MAX, "length of %s", out);
-        CHECK_MSG(mci_parse_double(out, out + len, &back, &next) && same_double(back, d) &&
+        CHECK_MSG(mci_parse_double(out, out + len, &back, &next) && test_same_double(back, d) &&
                       next == out + len,
                   "%a -> %s -> %a", d, out, back);
         CHECK_MSG(isinf(d) || shortest_is_right(d, out), "%a formatted as %s", d, out);
@@ -361,7 +356,7 @@ TEST(locale_independence)
         if (!isfinite(d))
             continue;
         len = mci_format_double(out, d);
-        CHECK_MSG(mci_parse_double(out, out + len, &back, &next) && same_double(back, d),
+        CHECK_MSG(mci_parse_double(out, out + len, &back, &next) && test_same_double(back, d),
                   "%a -> %s", d, out);
     }
     setlocale(LC_NUMERIC, "C");

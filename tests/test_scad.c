@@ -102,27 +102,6 @@ static const mcsg_mesh *any_leaf(const mcsg_tree *tree)
     return NULL;
 }
 
-static bool same_mesh(const mcsg_mesh *a, const mcsg_mesh *b)
-{
-    return a && b && a->vertex_count == b->vertex_count &&
-           a->triangle_count == b->triangle_count &&
-           memcmp(a->vertices, b->vertices, a->vertex_count * 3 * sizeof(double)) == 0 &&
-           memcmp(a->triangles, b->triangles, a->triangle_count * 3 * sizeof(uint32_t)) == 0;
-}
-
-static double signed_volume(const mcsg_mesh *m)
-{
-    double v = 0;
-    for (size_t t = 0; m && t < m->triangle_count; t++) {
-        const double *a = m->vertices + 3 * m->triangles[3 * t];
-        const double *b = m->vertices + 3 * m->triangles[3 * t + 1];
-        const double *c = m->vertices + 3 * m->triangles[3 * t + 2];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-             a[2] * (b[0] * c[1] - b[1] * c[0]);
-    }
-    return v / 6;
-}
-
 /* Axis-aligned bounds: lo[3], hi[3]. */
 static void bounds(const mcsg_mesh *m, double lo[3], double hi[3])
 {
@@ -158,7 +137,8 @@ static const char *root_label(const mcsg_tree *tree)
 static void check_same_as(const char *text, const mcsg_mesh *want)
 {
     mcsg_tree *tree = parse(text);
-    CHECK_MSG(same_mesh(only_leaf(tree), want), "\"%s\" differs from the direct mesh", text);
+    CHECK_MSG(test_same_mesh(only_leaf(tree), want), "\"%s\" differs from the direct mesh",
+              text);
     mcsg_tree_free(tree);
 }
 
@@ -352,7 +332,7 @@ TEST(mirrors_keep_meshes_outward)
     for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
         log_capture log;
         mcsg_tree *tree = parse_logged(texts[i], &log);
-        CHECK_MSG(signed_volume(only_leaf(tree)) > 0, "\"%s\" is inverted", texts[i]);
+        CHECK_MSG(test_signed_volume(only_leaf(tree)) > 0, "\"%s\" is inverted", texts[i]);
         mcsg_tree_free(tree);
     }
     {
@@ -487,7 +467,7 @@ TEST(polyhedron_forms)
         CHECK(m && m->vertex_count == 4 && m->triangle_count == 4);
         /* OpenSCAD's faces are clockwise from outside: reversed, the tetrahedron is
          * outward. */
-        CHECK_EQ_DOUBLE(signed_volume(m), 1.0 / 6);
+        CHECK_EQ_DOUBLE(test_signed_volume(m), 1.0 / 6);
         CHECK(m && m->triangles[0] == 2 && m->triangles[1] == 1 && m->triangles[2] == 0);
         if (i == 3)
             CHECK_CONTAINS(log.text, "`triangles` is deprecated");
@@ -504,7 +484,7 @@ TEST(polyhedron_polygons_and_2d_points)
         "[[0,1,2,3],[4,7,6,5],[0,4,5,1],[1,5,6,2],[2,6,7,3],[3,7,4,0],[0,1]]);", &log);
     const mcsg_mesh *m = only_leaf(tree);
     CHECK(m && m->vertex_count == 8 && m->triangle_count == 12);
-    CHECK_EQ_DOUBLE(signed_volume(m), 1);
+    CHECK_EQ_DOUBLE(test_signed_volume(m), 1);
     CHECK_CONTAINS(log.text, "ignoring faces[6]");
     CHECK(strcmp(root_label(tree), "polyhedron(8 points, 7 faces) at t.scad:1:1") == 0);
     mcsg_tree_free(tree);
@@ -559,7 +539,7 @@ TEST(import_relative_to_the_file)
     CHECK(tree && mcsg_tree_leaf_count(tree) == 2);
     tetra = mcsg_tree_leaf_mesh(tree, mcsg_tree_child(tree, root(tree), 0));
     cube = mcsg_tree_leaf_mesh(tree, mcsg_tree_child(tree, root(tree), 1));
-    CHECK(tetra && tetra->vertex_count == 4 && signed_volume(tetra) > 0);
+    CHECK(tetra && tetra->vertex_count == 4 && test_signed_volume(tetra) > 0);
     CHECK(cube && cube->vertex_count == 8 && cube->vertices[3] == 3); /* moved by 2 */
     CHECK_CONTAINS(mcsg_tree_node_label(tree, root(tree)), "assembly.scad:2:1");
     mcsg_tree_free(tree);
@@ -587,7 +567,7 @@ TEST(openscad_exported_csg)
     CHECK_MSG(log.warnings == 0, "unexpected warnings:\n%s", log.text);
     for (mcsg_node_id id = 0; tree && id < mcsg_tree_node_count(tree); id++) {
         const mcsg_mesh *m = mcsg_tree_leaf_mesh(tree, id);
-        CHECK_MSG(!m || signed_volume(m) > 0, "leaf %s is inverted",
+        CHECK_MSG(!m || test_signed_volume(m) > 0, "leaf %s is inverted",
                   mcsg_tree_node_label(tree, id));
     }
     mcsg_tree_free(tree);
@@ -880,64 +860,22 @@ TEST(api_arguments)
     CHECK(mcsg_scad_read(NULL, NULL, &tree, &err) == MCSG_ERR_INVALID_ARG);
 }
 
-typedef struct failing_alloc {
-    long remaining; /* allocations that still succeed; negative: unlimited */
-    long live;
-} failing_alloc;
-
-static void *fail_malloc(void *user, size_t size)
+/* Read the CSG text `text` and free the tree: a tree exactly when the read succeeds. */
+static mcsg_status read_scad(const void *text, const mcsg_options *opts, mcsg_error *err)
 {
-    failing_alloc *f = user;
-    void *p;
-    if (f->remaining == 0)
-        return NULL;
-    f->remaining -= f->remaining > 0;
-    p = malloc(size);
-    f->live += p != NULL;
-    return p;
-}
-
-static void *fail_realloc(void *user, void *ptr, size_t size)
-{
-    failing_alloc *f = user;
-    void *p;
-    if (f->remaining == 0)
-        return NULL;
-    f->remaining -= f->remaining > 0;
-    p = realloc(ptr, size);
-    f->live += p != NULL && ptr == NULL;
-    return p;
-}
-
-static void fail_free(void *user, void *ptr)
-{
-    ((failing_alloc *)user)->live--;
-    free(ptr);
+    mcsg_tree *tree = NULL;
+    mcsg_status st = mcsg_scad_read_memory(text, strlen(text), "t.scad", data_dir(), opts,
+                                           &tree, err);
+    CHECK(st == MCSG_OK ? tree != NULL : tree == NULL);
+    mcsg_tree_free(tree);
+    return st;
 }
 
 /* Fail allocation 1, 2, ... until the whole read succeeds: each failure must be a
  * clean MCSG_ERR_NOMEM with nothing leaked. */
 static void check_allocation_failures(const char *text)
 {
-    for (long n = 0;; n++) {
-        failing_alloc f = {n, 0};
-        mcsg_options opts;
-        mcsg_tree *tree = NULL;
-        mcsg_error err;
-        mcsg_status st;
-        memset(&opts, 0, sizeof opts);
-        opts.allocator = (mcsg_allocator){fail_malloc, fail_realloc, fail_free, &f};
-        st = mcsg_scad_read_memory(text, strlen(text), "t.scad", data_dir(), &opts, &tree,
-                                   &err);
-        CHECK_MSG(st == MCSG_OK || st == MCSG_ERR_NOMEM, "allocation %ld: %s", n, err.message);
-        CHECK(st == MCSG_OK ? tree != NULL : tree == NULL);
-        mcsg_tree_free(tree);
-        CHECK_MSG(f.live == 0, "%ld blocks leaked when allocation %ld failed", f.live, n);
-        if (st != MCSG_ERR_NOMEM) {
-            CHECK(n > 10);
-            break;
-        }
-    }
+    CHECK(test_allocation_failures("CSG read", read_scad, text, false) > 10);
 }
 
 TEST(every_allocation_failure_is_clean)

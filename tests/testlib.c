@@ -1,5 +1,6 @@
 #include "testlib.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -61,4 +62,122 @@ bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg
 {
     mcsg_status st = mcsg_mesh_read_memory(text, strlen(text), format, "string", NULL, out, err);
     return st == MCSG_OK;
+}
+
+double test_signed_volume(const mcsg_mesh *m)
+{
+    double v = 0;
+    for (size_t t = 0; m && t < m->triangle_count; t++) {
+        const double *a = m->vertices + 3 * m->triangles[3 * t];
+        const double *b = m->vertices + 3 * m->triangles[3 * t + 1];
+        const double *c = m->vertices + 3 * m->triangles[3 * t + 2];
+        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+             a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return v / 6;
+}
+
+bool test_same_double(double a, double b)
+{
+    return (isnan(a) && isnan(b)) || memcmp(&a, &b, sizeof a) == 0;
+}
+
+bool test_same_mesh(const mcsg_mesh *a, const mcsg_mesh *b)
+{
+    if (!a || !b || a->vertex_count != b->vertex_count ||
+        a->triangle_count != b->triangle_count)
+        return false;
+    for (size_t i = 0; i < 3 * a->vertex_count; i++)
+        if (!test_same_double(a->vertices[i], b->vertices[i]))
+            return false;
+    for (size_t i = 0; i < 3 * a->triangle_count; i++)
+        if (a->triangles[i] != b->triangles[i])
+            return false;
+    return true;
+}
+
+/* Counts one malloc or realloc call; false when this call is to fail. */
+static bool allocation_allowed(test_allocator *a, size_t size)
+{
+    a->calls++;
+    if (a->fail_at > 0 && (a->calls == a->fail_at || (a->sticky && a->calls > a->fail_at)))
+        return false;
+    if (size > a->largest)
+        a->largest = size;
+    return true;
+}
+
+/* The allocator functions behind test_allocator_options. */
+static void *test_malloc(void *user, size_t size)
+{
+    test_allocator *a = user;
+    void *p = allocation_allowed(a, size) ? malloc(size) : NULL;
+    a->live += p != NULL;
+    return p;
+}
+
+static void *test_realloc(void *user, void *ptr, size_t size)
+{
+    if (!ptr)
+        return test_malloc(user, size);
+    return allocation_allowed(user, size) ? realloc(ptr, size) : NULL;
+}
+
+static void test_free(void *user, void *ptr)
+{
+    ((test_allocator *)user)->live--;
+    free(ptr);
+}
+
+mcsg_options test_allocator_options(test_allocator *a)
+{
+    mcsg_options opts;
+    memset(&opts, 0, sizeof opts);
+    opts.allocator = (mcsg_allocator){test_malloc, test_realloc, test_free, a};
+    return opts;
+}
+
+/* One run with allocation `fail_at` failing; false if a check failed. Sets *clean_calls
+ * to the allocation count when no allocation failed. */
+static bool allocation_failure_run(const char *what, test_alloc_run run,
+                                   const void *ctx, long fail_at, bool sticky,
+                                   bool may_absorb, long *clean_calls)
+{
+    test_allocator a = {0, fail_at, sticky, 0, 0};
+    mcsg_options opts = test_allocator_options(&a);
+    mcsg_error err = {MCSG_OK, ""};
+    int before = test_failures;
+    mcsg_status st = run(ctx, &opts, &err);
+    const char *mode = sticky ? " and later" : "";
+    CHECK_MSG(a.live == 0, "%s: allocation %ld%s failed: %ld blocks leaked", what, fail_at,
+              mode, a.live);
+    if (a.calls < fail_at)
+        *clean_calls = a.calls;
+    else if (st == MCSG_OK)
+        CHECK_MSG(may_absorb, "%s: succeeded although allocation %ld%s failed", what, fail_at,
+                  mode);
+    if (st != MCSG_OK) {
+        CHECK_MSG(st == MCSG_ERR_NOMEM && a.calls >= fail_at,
+                  "%s: allocation %ld%s failed: status %s (%ld calls): %s", what, fail_at,
+                  mode, mcsg_status_string(st), a.calls, err.message);
+        CHECK_CONTAINS(err.message, "out of memory");
+    }
+    return test_failures == before;
+}
+
+long test_allocation_failures(const char *what, test_alloc_run run, const void *ctx,
+                              bool may_absorb)
+{
+    const long most = 100000;
+    for (long n = 1; n <= most; n++) {
+        long calls = -1;
+        if (!allocation_failure_run(what, run, ctx, n, false, may_absorb, &calls))
+            return -1;
+        if (calls >= 0)
+            return calls;
+        if (!allocation_failure_run(what, run, ctx, n, true, may_absorb, &calls))
+            return -1;
+    }
+    test_fail(__FILE__, __LINE__, "%s: still failing after %ld allocations", what, most);
+    return -1;
 }

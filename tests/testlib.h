@@ -94,4 +94,43 @@ const char *test_tmp(const char *name);
 /* Read a mesh from a string in the given format; aborts the test case on failure. */
 bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg_error *err);
 
+/* ---- mesh helpers ---- */
+
+/* Signed volume of a triangle mesh (positive when outward); 0 for NULL. */
+double test_signed_volume(const mcsg_mesh *m);
+/* Equal bit for bit, except that any NaN equals any NaN. */
+bool test_same_double(double a, double b);
+/* Same counts, vertices (test_same_double) and triangles; false if either is NULL. */
+bool test_same_mesh(const mcsg_mesh *a, const mcsg_mesh *b);
+
+/* ---- allocation failures ---- */
+
+/* A counting allocator for mcsg_options. Call number fail_at of malloc or realloc fails
+ * (1: the first; 0: none), and with `sticky` every later call fails too. realloc(NULL)
+ * counts as a malloc. `live` counts blocks not yet freed, `largest` the largest request. */
+typedef struct test_allocator {
+    long calls;
+    long fail_at;
+    bool sticky;
+    long live;
+    size_t largest;
+} test_allocator;
+
+/* Default options whose allocator is `a`. */
+mcsg_options test_allocator_options(test_allocator *a);
+
+/* One run of the code under test with `opts`: it checks its own results, frees all it
+ * allocated before returning, and returns its status (the message in *err). */
+typedef mcsg_status (*test_alloc_run)(const void *ctx, const mcsg_options *opts,
+                                      mcsg_error *err);
+
+/* Runs `run` failing allocation 1, 2, ... (each once alone and once with all later ones)
+ * until a run makes no failing allocation. Every run must end with nothing allocated, and
+ * each other run must fail with MCSG_ERR_NOMEM and an "out of memory" message, or, if
+ * `may_absorb`, may succeed (the failed allocation was optional, e.g. a trim). Returns the
+ * allocation count of the run without failure, or -1 after reporting the first problem.
+ * `what` names the case in messages. */
+long test_allocation_failures(const char *what, test_alloc_run run, const void *ctx,
+                              bool may_absorb);
+
 #endif
