@@ -7,6 +7,7 @@
 #   make fuzz       libFuzzer (clang) on every parser for FUZZ_SECONDS each (default 60)
 
 JOBS ?= 2
+MAKEFLAGS += --no-print-directory
 FUZZ_SECONDS ?= 60
 BUILD := build
 CMAKE_FLAGS := -DMCSG_WERROR=ON
