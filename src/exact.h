@@ -11,14 +11,21 @@
 
 #include <gmp.h>
 #include <stdbool.h>
+#include <stdint.h>
 
-/* Capacity in limbs: a product of three 2150-bit integers plus 64 bits of sums. */
-#define MCI_BIG_LIMBS 108
+/* Capacity in limbs. Scaled to a common exponent, a finite double is an integer of at
+ * most 53 + 971 + 1074 = 2098 bits, a difference 2099; the kernel's highest-degree
+ * polynomial (orient2d of three three-plane points) has degree 20 in such numbers:
+ * 20 * 2099 bits + carries < 657 limbs. Operations touch only the limbs in use. */
+#define MCI_BIG_LIMBS 704
 
 typedef struct mci_big {
     int size; /* number of limbs used, negative for negative numbers, 0 for zero */
     mp_limb_t limb[MCI_BIG_LIMBS];
 } mci_big;
+
+/* x = significand * 2^exponent with an odd significand; x finite and nonzero. */
+void mci_split_double(double x, uint64_t *significand, int *exponent);
 
 /* Exponent of the lowest bit of a finite double's 53-bit integer significand: x is an
  * integer multiple of 2^mci_lsb_exponent(x). Returns INT_MAX for 0. */
@@ -26,6 +33,9 @@ int mci_lsb_exponent(double x);
 
 /* *r = x * 2^-e0 exactly; requires x finite and e0 <= mci_lsb_exponent(x). */
 void mci_big_from_double(mci_big *r, double x, int e0);
+void mci_big_set_int(mci_big *r, int value);
+void mci_big_copy(mci_big *r, const mci_big *a);
+void mci_big_neg(mci_big *r, const mci_big *a);
 void mci_big_add(mci_big *r, const mci_big *a, const mci_big *b);
 void mci_big_sub(mci_big *r, const mci_big *a, const mci_big *b);
 void mci_big_mul(mci_big *r, const mci_big *a, const mci_big *b);

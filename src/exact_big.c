@@ -22,25 +22,35 @@ _Static_assert(GMP_NUMB_BITS == 64, "mci_big assumes 64-bit limbs");
 /* Below this magnitude sum a product may be subnormal and the relative bounds fail. */
 #define FILTER_MIN_MAGNITUDE 0x1p-960
 
+/* Index of the lowest set bit of m != 0 (portable: a de Bruijn multiply-and-lookup). */
 static int trailing_zeros(uint64_t m)
 {
-    int n = 0;
-    while (!(m & 1)) {
-        m >>= 1;
-        n++;
-    }
-    return n;
+    static const int8_t table[64] = {
+        0,  1,  2,  53, 3,  7,  54, 27, 4,  38, 41, 8,  34, 55, 48, 28,
+        62, 5,  39, 46, 44, 42, 22, 9,  24, 35, 59, 56, 49, 18, 29, 11,
+        63, 52, 6,  26, 37, 40, 33, 47, 61, 45, 43, 21, 23, 58, 17, 10,
+        51, 25, 36, 32, 60, 20, 57, 16, 50, 31, 19, 15, 30, 14, 13, 12};
+    return table[((m & -m) * 0x022fdd63cc95386dULL) >> 58];
 }
 
-/* x = significand * 2^exponent with an odd significand (x finite, nonzero). */
-static void split_double(double x, uint64_t *significand, int *exponent)
+/* x = significand * 2^exponent with an odd significand (x finite, nonzero), read from
+ * the IEEE 754 fields. */
+void mci_split_double(double x, uint64_t *significand, int *exponent)
 {
-    int e;
-    double f = frexp(fabs(x), &e);
-    uint64_t m = (uint64_t)ldexp(f, 53);
-    int tz = trailing_zeros(m);
+    uint64_t bits, m;
+    int biased, tz;
+    memcpy(&bits, &x, sizeof bits);
+    biased = (int)((bits >> 52) & 0x7ff);
+    m = bits & 0xfffffffffffffULL;
+    if (biased) {
+        m |= 1ULL << 52;
+        *exponent = biased - 1075;
+    } else {
+        *exponent = -1074; /* subnormal */
+    }
+    tz = trailing_zeros(m);
     *significand = m >> tz;
-    *exponent = e - 53 + tz;
+    *exponent += tz;
 }
 
 int mci_lsb_exponent(double x)
@@ -49,7 +59,7 @@ int mci_lsb_exponent(double x)
     int e;
     if (x == 0)
         return INT_MAX;
-    split_double(x, &m, &e);
+    mci_split_double(x, &m, &e);
     return e;
 }
 
@@ -57,6 +67,22 @@ static void big_normalize(mci_big *r, int n, int negative)
 {
     while (n > 0 && r->limb[n - 1] == 0)
         n--;
+    r->size = negative ? -n : n;
+}
+
+static int abs_size(const mci_big *a)
+{
+    return a->size < 0 ? -a->size : a->size;
+}
+
+/* r = limbs[0..n) with the given sign; limbs may live anywhere (a scratch array). */
+static void big_assign(mci_big *r, const mp_limb_t *limbs, int n, int negative)
+{
+    /* Strip high zero limbs first: a product's n = na + nb may exceed the capacity by
+     * one even though its value (bounded by the degree analysis in exact.h) fits. */
+    while (n > 0 && limbs[n - 1] == 0)
+        n--;
+    memcpy(r->limb, limbs, (size_t)n * sizeof(mp_limb_t));
     r->size = negative ? -n : n;
 }
 
@@ -68,7 +94,7 @@ void mci_big_from_double(mci_big *r, double x, int e0)
         r->size = 0;
         return;
     }
-    split_double(x, &m, &e);
+    mci_split_double(x, &m, &e);
     shift = e - e0;
     word = shift / GMP_NUMB_BITS;
     bit = shift % GMP_NUMB_BITS;
@@ -78,14 +104,29 @@ void mci_big_from_double(mci_big *r, double x, int e0)
     big_normalize(r, word + 2, x < 0);
 }
 
+void mci_big_set_int(mci_big *r, int value)
+{
+    r->limb[0] = (mp_limb_t)(value < 0 ? -(long)value : value);
+    big_normalize(r, 1, value < 0);
+}
+
+void mci_big_copy(mci_big *r, const mci_big *a)
+{
+    if (r != a) {
+        memcpy(r->limb, a->limb, (size_t)abs_size(a) * sizeof(mp_limb_t));
+        r->size = a->size;
+    }
+}
+
+void mci_big_neg(mci_big *r, const mci_big *a)
+{
+    mci_big_copy(r, a);
+    r->size = -r->size;
+}
+
 int mci_big_sign(const mci_big *a)
 {
     return (a->size > 0) - (a->size < 0);
-}
-
-static int abs_size(const mci_big *a)
-{
-    return a->size < 0 ? -a->size : a->size;
 }
 
 /* Compare magnitudes: -1, 0 or +1. */
@@ -102,29 +143,28 @@ static void big_add_signed(mci_big *r, const mci_big *a, const mci_big *b, int n
 {
     int na = abs_size(a), nb = abs_size(b);
     int neg_a = a->size < 0, neg_b = (b->size < 0) != negate_b;
-    mci_big result;
+    mp_limb_t sum[MCI_BIG_LIMBS];
     if (nb == 0) {
-        *r = *a;
+        mci_big_copy(r, a);
         return;
     }
     if (na == 0) {
-        *r = *b;
+        mci_big_copy(r, b);
         r->size = neg_b ? -nb : nb;
         return;
     }
     if (neg_a == neg_b) {
         const mci_big *big = na >= nb ? a : b, *small = na >= nb ? b : a;
         int nbig = na >= nb ? na : nb, nsmall = na >= nb ? nb : na;
-        result.limb[nbig] = mpn_add(result.limb, big->limb, nbig, small->limb, nsmall);
-        big_normalize(&result, nbig + 1, neg_a);
+        sum[nbig] = mpn_add(sum, big->limb, nbig, small->limb, nsmall);
+        big_assign(r, sum, nbig + 1, neg_a);
     } else if (compare_abs(a, b) >= 0) {
-        mpn_sub(result.limb, a->limb, na, b->limb, nb);
-        big_normalize(&result, na, neg_a);
+        mpn_sub(sum, a->limb, na, b->limb, nb);
+        big_assign(r, sum, na, neg_a);
     } else {
-        mpn_sub(result.limb, b->limb, nb, a->limb, na);
-        big_normalize(&result, nb, neg_b);
+        mpn_sub(sum, b->limb, nb, a->limb, na);
+        big_assign(r, sum, nb, neg_b);
     }
-    *r = result;
 }
 
 void mci_big_add(mci_big *r, const mci_big *a, const mci_big *b)
@@ -140,17 +180,16 @@ void mci_big_sub(mci_big *r, const mci_big *a, const mci_big *b)
 void mci_big_mul(mci_big *r, const mci_big *a, const mci_big *b)
 {
     int na = abs_size(a), nb = abs_size(b);
-    mci_big result;
+    mp_limb_t product[2 * MCI_BIG_LIMBS];
     if (na == 0 || nb == 0) {
         r->size = 0;
         return;
     }
     if (na >= nb)
-        mpn_mul(result.limb, a->limb, na, b->limb, nb);
+        mpn_mul(product, a->limb, na, b->limb, nb);
     else
-        mpn_mul(result.limb, b->limb, nb, a->limb, na);
-    big_normalize(&result, na + nb, (a->size < 0) != (b->size < 0));
-    *r = result;
+        mpn_mul(product, b->limb, nb, a->limb, na);
+    big_assign(r, product, na + nb, (a->size < 0) != (b->size < 0));
 }
 
 /* Smallest lsb exponent among n doubles (INT_MAX if all are zero). */

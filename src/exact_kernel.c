@@ -1,0 +1,505 @@
+/*
+ * Exact plane-based kernel (see exact_kernel.h and docs/exact-arithmetic.md).
+ *
+ * Follows the plane-based representation of Sugihara & Iri and Campen & Kobbelt, with
+ * points defined implicitly by the input, and the filtered-then-exact evaluation of
+ * Shewchuk; implicit points are kept in the "indirect" homogeneous form of Attene
+ * (2020, "Indirect predicates for geometric constructions"): base vertex plus an offset
+ * (Y, W), so that predicates evaluate small local differences.
+ *
+ * Filter: every double operation carries a running bound (mci_fv). For v = a op b
+ * computed in round-to-nearest with unit roundoff u = 2^-53:
+ *   add/sub: e = ea + eb + u|v| + eta
+ *   mul:     e = |a|eb + |b|ea + ea eb + u|v| + eta
+ * where eta = 2^-1074 covers underflow (a subnormal result's absolute rounding error).
+ * The sign of v is certain when |v| > e (1 + 2^-30): the factor absorbs the rounding of
+ * the bound's own computation (relative error below 3u per operation, and predicates are
+ * far shallower than 2^20 operations). An overflow makes v or e infinite or NaN, and the
+ * comparison then fails, so overflow always falls through to the exact stage.
+ *
+ * Exact stage: all input coordinates of one predicate are scaled to integers at their
+ * smallest lsb exponent and the same formulas are evaluated with mci_big.
+ */
+#include "exact_kernel.h"
+#include "exact.h"
+
+#include <limits.h>
+#include <math.h>
+#include <string.h>
+
+#define UNIT_ROUNDOFF 0x1p-53
+#define UNDERFLOW_ERROR 0x1p-1074
+#define BOUND_SAFETY (1.0 + 0x1p-30)
+
+/* ---------------------------------------------------------------------------------- */
+/* Filtered arithmetic                                                                 */
+
+static inline mci_fv fv_exact(double x)
+{
+    return (mci_fv){x, 0.0};
+}
+
+static inline mci_fv fv_add(mci_fv a, mci_fv b)
+{
+    double v = a.v + b.v;
+    return (mci_fv){v, a.e + b.e + UNIT_ROUNDOFF * fabs(v) + UNDERFLOW_ERROR};
+}
+
+static inline mci_fv fv_sub(mci_fv a, mci_fv b)
+{
+    double v = a.v - b.v;
+    return (mci_fv){v, a.e + b.e + UNIT_ROUNDOFF * fabs(v) + UNDERFLOW_ERROR};
+}
+
+static inline mci_fv fv_mul(mci_fv a, mci_fv b)
+{
+    double v = a.v * b.v;
+    return (mci_fv){v, fabs(a.v) * b.e + fabs(b.v) * a.e + a.e * b.e +
+                           UNIT_ROUNDOFF * fabs(v) + UNDERFLOW_ERROR};
+}
+
+static inline mci_fv fv_neg(mci_fv a)
+{
+    return (mci_fv){-a.v, a.e};
+}
+
+/* Difference of two input coordinates. */
+static inline mci_fv fv_diff(double a, double b)
+{
+    return fv_sub(fv_exact(a), fv_exact(b));
+}
+
+static inline int fv_sign(mci_fv a)
+{
+    if (a.e == 0)
+        return (a.v > 0) - (a.v < 0);
+    if (fabs(a.v) > a.e * BOUND_SAFETY)
+        return a.v > 0 ? 1 : -1;
+    return MCI_UNCERTAIN;
+}
+
+static mci_fv fv_dot(const mci_fv x[3], const mci_fv y[3])
+{
+    return fv_add(fv_add(fv_mul(x[0], y[0]), fv_mul(x[1], y[1])), fv_mul(x[2], y[2]));
+}
+
+/* Component k of x cross y. */
+static mci_fv fv_cross_component(const mci_fv x[3], const mci_fv y[3], int k)
+{
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    return fv_sub(fv_mul(x[i], y[j]), fv_mul(x[j], y[i]));
+}
+
+/* Determinant of the rows r0, r1, r2. */
+static mci_fv fv_det3(const mci_fv r0[3], const mci_fv r1[3], const mci_fv r2[3])
+{
+    mci_fv c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = fv_cross_component(r1, r2, k);
+    return fv_dot(r0, c);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Exact stage: two instantiations of the same formulas                                */
+
+static int point_vertex_count(const mci_point *p)
+{
+    return p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 5 : 9;
+}
+
+/* Degrees of a point's X (offset from an origin vertex) and W in the coordinates. */
+static int x_degree(const mci_point *p)
+{
+    return p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 4 : 7;
+}
+
+static int w_degree(const mci_point *p)
+{
+    return x_degree(p) - 1;
+}
+
+/* The integer scale of one predicate's inputs: e0 is the smallest lsb exponent (every
+ * coordinate is an integer multiple of 2^e0), top the largest msb exponent. */
+typedef struct input_scale {
+    int e0, top;
+} input_scale;
+
+static void scale_vertices(input_scale *s, const double *const *v, int n)
+{
+    for (int i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            double x = v[i][k];
+            int lsb, msb;
+            if (x == 0)
+                continue;
+            lsb = mci_lsb_exponent(x);
+            msb = ilogb(x);
+            s->e0 = lsb < s->e0 ? lsb : s->e0;
+            s->top = msb > s->top ? msb : s->top;
+        }
+    }
+}
+
+static input_scale scale_of(const mci_point *const *points, int npoints,
+                            const mci_plane *const *planes, int nplanes)
+{
+    input_scale s = {INT_MAX, INT_MIN};
+    for (int i = 0; i < npoints; i++)
+        scale_vertices(&s, points[i]->v, point_vertex_count(points[i]));
+    for (int i = 0; i < nplanes; i++) {
+        const double *v[3] = {planes[i]->a, planes[i]->b, planes[i]->c};
+        scale_vertices(&s, v, 3);
+    }
+    if (s.e0 == INT_MAX) /* every coordinate is zero */
+        s.e0 = s.top = 0;
+    return s;
+}
+
+/* Whether every intermediate of a polynomial of this degree fits a signed 128-bit
+ * integer. Scaled coordinates are below 2^(top+1-e0), differences below 2^D with
+ * D = top + 2 - e0. Each formula of the kernel stays below 2^(degree (D + 1) + 8): a
+ * normal is below 2^(2D+1), a TPI's W below 2^(6D+6) and X below 2^(7D+9), orient2d of
+ * three TPIs below 2^(20D+27), and so on (docs/exact-arithmetic.md lists each). */
+static bool fits_i128(input_scale s, int degree)
+{
+    return degree * (s.top + 2 - s.e0 + 1) + 8 <= 126;
+}
+
+__extension__ typedef __int128 i128;
+__extension__ typedef unsigned __int128 u128;
+
+static i128 i128_from_double(double x, int e0)
+{
+    uint64_t m;
+    int e;
+    u128 magnitude;
+    if (x == 0)
+        return 0;
+    mci_split_double(x, &m, &e);
+    magnitude = (u128)m << (e - e0);
+    return x < 0 ? -(i128)magnitude : (i128)magnitude;
+}
+
+#define NUM i128
+#define NUM_FROM_DOUBLE(r, x, e0) (*(r) = i128_from_double((x), (e0)))
+#define NUM_ADD(r, a, b) (*(r) = *(a) + *(b))
+#define NUM_SUB(r, a, b) (*(r) = *(a) - *(b))
+#define NUM_MUL(r, a, b) (*(r) = *(a) * *(b))
+#define NUM_SET_INT(r, i) (*(r) = (i))
+#define NUM_SIGN(a) ((*(a) > 0) - (*(a) < 0))
+#define EVAL(name) i128_##name
+#include "exact_kernel_eval.inc"
+#undef NUM
+#undef NUM_FROM_DOUBLE
+#undef NUM_ADD
+#undef NUM_SUB
+#undef NUM_MUL
+#undef NUM_SET_INT
+#undef NUM_SIGN
+#undef EVAL
+
+#define NUM mci_big
+#define NUM_FROM_DOUBLE(r, x, e0) mci_big_from_double((r), (x), (e0))
+#define NUM_ADD(r, a, b) mci_big_add((r), (a), (b))
+#define NUM_SUB(r, a, b) mci_big_sub((r), (a), (b))
+#define NUM_MUL(r, a, b) mci_big_mul((r), (a), (b))
+#define NUM_SET_INT(r, i) mci_big_set_int((r), (i))
+#define NUM_SIGN(a) mci_big_sign(a)
+#define EVAL(name) big_##name
+#include "exact_kernel_eval.inc"
+#undef NUM
+#undef NUM_FROM_DOUBLE
+#undef NUM_ADD
+#undef NUM_SUB
+#undef NUM_MUL
+#undef NUM_SET_INT
+#undef NUM_SIGN
+#undef EVAL
+
+/* ---------------------------------------------------------------------------------- */
+/* Planes and points                                                                   */
+
+void mci_plane_init(mci_plane *plane, const double *a, const double *b, const double *c)
+{
+    mci_fv d1[3], d2[3];
+    plane->a = a;
+    plane->b = b;
+    plane->c = c;
+    for (int k = 0; k < 3; k++) {
+        d1[k] = fv_diff(b[k], a[k]);
+        d2[k] = fv_diff(c[k], a[k]);
+    }
+    for (int k = 0; k < 3; k++)
+        plane->n[k] = fv_cross_component(d1, d2, k);
+}
+
+void mci_point_explicit(mci_point *p, const double *x)
+{
+    memset(p, 0, sizeof *p);
+    p->kind = MCI_POINT_EXPLICIT;
+    p->v[0] = x;
+    p->w = fv_exact(1.0);
+    p->w_sign = 1;
+}
+
+/* Exact sign of a constructed point's W, computed from scratch. */
+static int exact_w_sign(const mci_point *p)
+{
+    input_scale s = scale_of(&p, 1, NULL, 0);
+    if (fits_i128(s, w_degree(p)))
+        return i128_w_sign(p, s.e0);
+    return big_w_sign(p, s.e0);
+}
+
+/* Make the stored W positive (negating the offsets with it); false if W is 0. */
+static bool normalize_w(mci_point *p)
+{
+    int sign = fv_sign(p->w);
+    if (sign == MCI_UNCERTAIN)
+        sign = exact_w_sign(p);
+    if (sign == 0) {
+        p->w_sign = 0;
+        return false;
+    }
+    if (sign < 0) {
+        p->w = fv_neg(p->w);
+        for (int k = 0; k < 3; k++)
+            p->y[k] = fv_neg(p->y[k]);
+    }
+    p->w_sign = 1;
+    return true;
+}
+
+bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane)
+{
+    mci_fv u[3], to_plane[3], s;
+    p->kind = MCI_POINT_LPI;
+    p->v[0] = l0;
+    p->v[1] = l1;
+    p->v[2] = plane->a;
+    p->v[3] = plane->b;
+    p->v[4] = plane->c;
+    for (int k = 0; k < 3; k++) {
+        u[k] = fv_diff(l1[k], l0[k]);
+        to_plane[k] = fv_diff(plane->a[k], l0[k]);
+    }
+    p->w = fv_dot(plane->n, u);
+    s = fv_dot(plane->n, to_plane);
+    for (int k = 0; k < 3; k++)
+        p->y[k] = fv_mul(u[k], s);
+    return normalize_w(p);
+}
+
+bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const mci_plane *p3)
+{
+    const mci_plane *planes[3] = {p1, p2, p3};
+    mci_fv rows[3][3], rhs[3], swapped[3][3];
+    p->kind = MCI_POINT_TPI;
+    for (int i = 0; i < 3; i++) {
+        mci_fv to_plane[3];
+        p->v[3 * i] = planes[i]->a;
+        p->v[3 * i + 1] = planes[i]->b;
+        p->v[3 * i + 2] = planes[i]->c;
+        for (int k = 0; k < 3; k++) {
+            rows[i][k] = planes[i]->n[k];
+            to_plane[k] = fv_diff(planes[i]->a[k], p1->a[k]);
+        }
+        rhs[i] = i == 0 ? fv_exact(0.0) : fv_dot(planes[i]->n, to_plane);
+    }
+    p->w = fv_det3(rows[0], rows[1], rows[2]);
+    for (int col = 0; col < 3; col++) {
+        for (int i = 0; i < 3; i++) {
+            for (int k = 0; k < 3; k++)
+                swapped[i][k] = k == col ? rhs[i] : rows[i][k];
+        }
+        p->y[col] = fv_det3(swapped[0], swapped[1], swapped[2]);
+    }
+    return normalize_w(p);
+}
+
+void mci_point_approx(const mci_point *p, double out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = p->v[0][k] + p->y[k].v / p->w.v;
+}
+
+/* Offset of p from `origin`, scaled by p's W: (base - origin) W + Y. */
+static void fv_offset(const mci_point *p, const double *origin, mci_fv out[3])
+{
+    for (int k = 0; k < 3; k++) {
+        if (p->v[0] == origin)
+            out[k] = p->y[k];
+        else
+            out[k] = fv_add(fv_mul(fv_diff(p->v[0][k], origin[k]), p->w), p->y[k]);
+    }
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* orient3d                                                                            */
+
+int mci_orient3d_filtered(const mci_point *p, const mci_plane *plane)
+{
+    mci_fv x[3];
+    fv_offset(p, plane->a, x);
+    return fv_sign(fv_dot(plane->n, x));
+}
+
+int mci_orient3d_exact(const mci_point *p, const mci_plane *plane)
+{
+    input_scale s = scale_of(&p, 1, &plane, 1);
+    if (fits_i128(s, x_degree(p) + 2))
+        return i128_orient3d(p, plane, s.e0);
+    return big_orient3d(p, plane, s.e0);
+}
+
+int mci_orient3d(const mci_point *p, const mci_plane *plane)
+{
+    int s = mci_orient3d_filtered(p, plane);
+    return s != MCI_UNCERTAIN ? s : mci_orient3d_exact(p, plane);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Coordinate comparison, lexicographic order, equality                                */
+
+int mci_compare_coord_filtered(const mci_point *a, const mci_point *b, int axis)
+{
+    mci_fv xa[3];
+    fv_offset(a, b->v[0], xa);
+    return fv_sign(fv_sub(fv_mul(xa[axis], b->w), fv_mul(b->y[axis], a->w)));
+}
+
+int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
+{
+    const mci_point *points[2] = {a, b};
+    input_scale s = scale_of(points, 2, NULL, 0);
+    int da = x_degree(a) + w_degree(b), db = x_degree(b) + w_degree(a);
+    if (fits_i128(s, da > db ? da : db))
+        return i128_compare_coord(a, b, axis, s.e0);
+    return big_compare_coord(a, b, axis, s.e0);
+}
+
+static bool same_definition(const mci_point *a, const mci_point *b)
+{
+    return a->kind == b->kind &&
+           memcmp(a->v, b->v, (size_t)point_vertex_count(a) * sizeof a->v[0]) == 0;
+}
+
+int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
+{
+    int s;
+    if (same_definition(a, b))
+        return 0;
+    s = mci_compare_coord_filtered(a, b, axis);
+    return s != MCI_UNCERTAIN ? s : mci_compare_coord_exact(a, b, axis);
+}
+
+int mci_compare_lex(const mci_point *a, const mci_point *b)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        int s = mci_compare_coord(a, b, axis);
+        if (s != 0)
+            return s;
+    }
+    return 0;
+}
+
+bool mci_points_equal(const mci_point *a, const mci_point *b)
+{
+    return mci_compare_lex(a, b) == 0;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* orient2d in a projection                                                            */
+
+int mci_orient2d_projected_filtered(const mci_point *p, const mci_point *q,
+                                    const mci_point *r, int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    mci_fv xp[3], xq[3], rows[3][3];
+    fv_offset(p, r->v[0], xp);
+    fv_offset(q, r->v[0], xq);
+    rows[0][0] = xp[i], rows[0][1] = xp[j], rows[0][2] = p->w;
+    rows[1][0] = xq[i], rows[1][1] = xq[j], rows[1][2] = q->w;
+    rows[2][0] = r->y[i], rows[2][1] = r->y[j], rows[2][2] = r->w;
+    return fv_sign(fv_det3(rows[0], rows[1], rows[2]));
+}
+
+int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis)
+{
+    const mci_point *points[3] = {p, q, r};
+    input_scale s = scale_of(points, 3, NULL, 0);
+    if (fits_i128(s, x_degree(p) + x_degree(q) + x_degree(r)))
+        return i128_orient2d(points, axis, s.e0);
+    return big_orient2d(points, axis, s.e0);
+}
+
+int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
+                           int axis)
+{
+    int s = mci_orient2d_projected_filtered(p, q, r, axis);
+    return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Order along lines                                                                   */
+
+int mci_line_direction_sign_filtered(const mci_plane *p1, const mci_plane *p2, int axis)
+{
+    return fv_sign(fv_cross_component(p1->n, p2->n, axis));
+}
+
+int mci_line_direction_sign_exact(const mci_plane *p1, const mci_plane *p2, int axis)
+{
+    const mci_plane *planes[2] = {p1, p2};
+    input_scale s = scale_of(NULL, 0, planes, 2);
+    if (fits_i128(s, 4))
+        return i128_direction_sign(p1, p2, axis, s.e0);
+    return big_direction_sign(p1, p2, axis, s.e0);
+}
+
+static int line_direction_sign(const mci_plane *p1, const mci_plane *p2, int axis)
+{
+    int s = mci_line_direction_sign_filtered(p1, p2, axis);
+    return s != MCI_UNCERTAIN ? s : mci_line_direction_sign_exact(p1, p2, axis);
+}
+
+/* Along a line, the order of two of its points is their order in any coordinate in
+ * which the direction is nonzero, times the sign of that component. The largest
+ * approximate component is tried first: it is nonzero unless the planes are parallel. */
+int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_plane *p1,
+                            const mci_plane *p2)
+{
+    double magnitude[3];
+    int order[3] = {0, 1, 2};
+    for (int k = 0; k < 3; k++)
+        magnitude[k] = fabs(fv_cross_component(p1->n, p2->n, k).v);
+    for (int m = 0; m < 2; m++) {
+        for (int k = 0; k < 2 - m; k++) {
+            if (magnitude[order[k]] < magnitude[order[k + 1]]) {
+                int t = order[k];
+                order[k] = order[k + 1];
+                order[k + 1] = t;
+            }
+        }
+    }
+    for (int m = 0; m < 3; m++) {
+        int s = line_direction_sign(p1, p2, order[m]);
+        if (s != 0)
+            return s * mci_compare_coord(a, b, order[m]);
+    }
+    return 0;
+}
+
+int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double *l0,
+                           const double *l1)
+{
+    int axis = 0;
+    for (int k = 1; k < 3; k++) {
+        if (fabs(l1[k] - l0[k]) > fabs(l1[axis] - l0[axis]))
+            axis = k;
+    }
+    if (l1[axis] == l0[axis])
+        return 0;
+    return (l1[axis] > l0[axis] ? 1 : -1) * mci_compare_coord(a, b, axis);
+}

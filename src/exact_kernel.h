@@ -1,0 +1,126 @@
+/*
+ * The exact plane-based geometry kernel. Every geometric decision of the pipeline goes
+ * through the predicates below; see docs/exact-arithmetic.md for degrees and bounds.
+ *
+ * Inputs are the leaves' vertex coordinates exactly as given (finite doubles, no
+ * snapping). New points are never stored as coordinates: an implicit point is defined
+ * by the input vertices it comes from, and carries only a cached floating-point
+ * approximation of its homogeneous coordinates with a certified error bound:
+ *
+ *   explicit  an input vertex p
+ *   LPI       line through input vertices p, q  ∩  plane through input vertices a, b, c
+ *             (an edge crossing a face: the edge line depends on the edge alone, so a
+ *             point on an edge is defined identically from both faces sharing it)
+ *   TPI       intersection of three planes, each through three input vertices
+ *
+ * A point is stored as  base + Y / W  with `base` an input vertex (p for LPI, the first
+ * plane's first vertex for TPI) and (Y, W) homogeneous offsets:
+ *   LPI: u = q - p, n = (b - a) x (c - a),  W = n.u,  Y = u (n.(a - p))
+ *   TPI: n_k = normal of plane k, r_k = n_k.(a_k - base),  W = det[n1; n2; n3],
+ *        Y = Cramer numerators of n_k . y = r_k
+ * Each predicate first evaluates in doubles with a running error bound (mci_fv); when
+ * the bound does not prove the sign, it recomputes everything from the input doubles in
+ * exact integer arithmetic (mci_big on the stack: no heap, never fails).
+ */
+#ifndef MESHCSG_EXACT_KERNEL_H
+#define MESHCSG_EXACT_KERNEL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* A value known to within an error bound: |exact - v| <= e. */
+typedef struct mci_fv {
+    double v, e;
+} mci_fv;
+
+/* A plane through three input points, oriented by n = (b - a) x (c - a): for a triangle
+ * a, b, c counter-clockwise seen from outside, n points outward. The normal is cached
+ * with its error bound. Requires a, b, c not collinear for the predicates that divide by
+ * the plane (LPI, TPI); orient3d works for any plane. */
+typedef struct mci_plane {
+    const double *a, *b, *c;
+    mci_fv n[3];
+} mci_plane;
+
+void mci_plane_init(mci_plane *plane, const double *a, const double *b, const double *c);
+
+typedef enum mci_point_kind {
+    MCI_POINT_EXPLICIT = 0,
+    MCI_POINT_LPI = 1,
+    MCI_POINT_TPI = 2
+} mci_point_kind;
+
+typedef struct mci_point {
+    mci_point_kind kind;
+    /* Defining input vertices. explicit: v[0]. LPI: line v[0], v[1]; plane v[2..4].
+     * TPI: planes v[0..2], v[3..5], v[6..8]. base = v[0] in every case. */
+    const double *v[9];
+    /* Cached offset from v[0]: point = v[0] + (y[0], y[1], y[2]) / w, with w.v >= 0
+     * whenever the sign of W is known (the offsets are negated to make it so). */
+    mci_fv y[3], w;
+    int8_t w_sign; /* exact sign of the stored w (+1), or 0 if W is exactly 0 (no point) */
+} mci_point;
+
+/* Constructors. Each returns true when the point exists: always for explicit points;
+ * for LPI when the line is not parallel to the plane (n.u != 0, decided exactly); for
+ * TPI when the three normals are independent (det != 0, decided exactly). On false the
+ * point must not be used in predicates. Pointers must stay valid while the point is
+ * used: nothing is copied. */
+void mci_point_explicit(mci_point *p, const double *x);
+bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane);
+bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const mci_plane *p3);
+
+/* Side of point p with respect to the plane: +1 in front (the side n points to),
+ * -1 behind, 0 on the plane. */
+int mci_orient3d(const mci_point *p, const mci_plane *plane);
+
+/* sign(a[axis] - b[axis]), axis in 0..2. */
+int mci_compare_coord(const mci_point *a, const mci_point *b, int axis);
+
+/* Lexicographic order of (x, y, z): -1, 0 or +1. */
+int mci_compare_lex(const mci_point *a, const mci_point *b);
+
+/* True when a and b are the same point (whatever their definitions). */
+bool mci_points_equal(const mci_point *a, const mci_point *b);
+
+/* Orientation of p, q, r projected along `axis` onto the plane of the two other axes
+ * (i, j) = ((axis + 1) % 3, (axis + 2) % 3): +1 counter-clockwise seen from +axis, -1
+ * clockwise, 0 collinear in the projection. */
+int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
+                           int axis);
+
+/* Order of two points lying on the line of intersection of two planes, along the
+ * direction n1 x n2 (paper Eq. 1): sign((a - b) . (n1 x n2)). +1: a is ahead of b. The
+ * points must lie on both planes and the planes must not be parallel. */
+int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_plane *p1,
+                            const mci_plane *p2);
+
+/* Order of two points lying on the line through input vertices l0 != l1, along
+ * l1 - l0: sign((a - b) . (l1 - l0)). */
+int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double *l0,
+                           const double *l1);
+
+/* Approximate coordinates of a point (the nearest double is not guaranteed; used for
+ * output only after rounding decisions elsewhere, and for display). */
+void mci_point_approx(const mci_point *p, double out[3]);
+
+/* Each predicate above is the combination of two stages, exposed for tests (which check
+ * the exact stage on every case, not only where the filter gives up) and benchmarks
+ * (which measure how often the filter decides):
+ *   *_filtered: the floating-point stage; returns the sign, or MCI_UNCERTAIN;
+ *   *_exact:    the exact integer stage; always returns the sign. */
+#define MCI_UNCERTAIN 2
+
+int mci_orient3d_filtered(const mci_point *p, const mci_plane *plane);
+int mci_orient3d_exact(const mci_point *p, const mci_plane *plane);
+int mci_compare_coord_filtered(const mci_point *a, const mci_point *b, int axis);
+int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis);
+int mci_orient2d_projected_filtered(const mci_point *p, const mci_point *q,
+                                    const mci_point *r, int axis);
+int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis);
+/* Sign of component `axis` of n1 x n2 (the direction of a plane-plane line). */
+int mci_line_direction_sign_filtered(const mci_plane *p1, const mci_plane *p2, int axis);
+int mci_line_direction_sign_exact(const mci_plane *p1, const mci_plane *p2, int axis);
+
+#endif
