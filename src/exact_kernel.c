@@ -246,7 +246,8 @@ void mci_point_explicit(mci_point *p, const double *x)
 static int exact_w_sign(const mci_point *p)
 {
     input_scale s = scale_of(&p, 1, NULL, 0);
-    if (fits_i128(s, w_degree(p)))
+    /* point_at computes X as well as W, so X's degree decides. */
+    if (fits_i128(s, x_degree(p)))
         return i128_w_sign(p, s.e0);
     return big_w_sign(p, s.e0);
 }

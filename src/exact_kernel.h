@@ -28,7 +28,9 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-/* A value known to within an error bound: |exact - v| <= e. */
+/* A value known to within an error bound: |exact - v| <= e. After an overflow e (and
+ * v) may be +inf or NaN, which carries no information: every sign test fails on it and
+ * the exact stage decides. */
 typedef struct mci_fv {
     double v, e;
 } mci_fv;
