@@ -504,3 +504,74 @@ int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double 
         return 0;
     return (l1[axis] > l0[axis] ? 1 : -1) * mci_compare_coord(a, b, axis);
 }
+
+/* ---------------------------------------------------------------------------------- */
+/* Containment in a triangle                                                           */
+
+static int normal_sign_exact(const mci_plane *plane, int axis)
+{
+    mci_point a, b, c;
+    /* n_axis is twice the signed area of the triangle projected along `axis`. */
+    mci_point_explicit(&a, plane->a);
+    mci_point_explicit(&b, plane->b);
+    mci_point_explicit(&c, plane->c);
+    return mci_orient2d_projected_exact(&a, &b, &c, axis);
+}
+
+int mci_plane_projection_axis(const mci_plane *plane, int *sign)
+{
+    int order[3] = {0, 1, 2};
+    for (int m = 0; m < 2; m++) {
+        for (int k = 0; k < 2 - m; k++) {
+            if (fabs(plane->n[order[k]].v) < fabs(plane->n[order[k + 1]].v)) {
+                int t = order[k];
+                order[k] = order[k + 1];
+                order[k + 1] = t;
+            }
+        }
+    }
+    for (int m = 0; m < 3; m++) {
+        int s = fv_sign(plane->n[order[m]]);
+        if (s == MCI_UNCERTAIN)
+            s = normal_sign_exact(plane, order[m]);
+        if (s != 0) {
+            *sign = s;
+            return order[m];
+        }
+    }
+    *sign = 0;
+    return -1;
+}
+
+mci_containment mci_point_in_triangle(const mci_point *p, const mci_plane *triangle,
+                                      int *which)
+{
+    mci_point corner[3];
+    int side[3], zeros = 0, sign, axis = mci_plane_projection_axis(triangle, &sign);
+    *which = -1;
+    if (axis < 0)
+        return MCI_OUTSIDE;
+    mci_point_explicit(&corner[0], triangle->a);
+    mci_point_explicit(&corner[1], triangle->b);
+    mci_point_explicit(&corner[2], triangle->c);
+    for (int e = 0; e < 3; e++) {
+        side[e] = sign * mci_orient2d_projected(&corner[e], &corner[(e + 1) % 3], p, axis);
+        if (side[e] < 0)
+            return MCI_OUTSIDE;
+        zeros += side[e] == 0;
+    }
+    if (zeros == 0)
+        return MCI_INSIDE;
+    for (int e = 0; e < 3; e++) {
+        if (zeros == 1 && side[e] == 0) {
+            *which = e;
+            return MCI_ON_EDGE;
+        }
+        /* Two zero sides meet at the vertex they share: edge e-1 ends where e starts. */
+        if (zeros == 2 && side[e] == 0 && side[(e + 2) % 3] == 0) {
+            *which = e;
+            return MCI_ON_VERTEX;
+        }
+    }
+    return MCI_OUTSIDE; /* not reached for a non-degenerate triangle */
+}

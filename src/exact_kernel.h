@@ -102,6 +102,27 @@ int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_pl
 int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double *l0,
                            const double *l1);
 
+/* A projection axis for the plane: an axis k with (n)_k != 0 (decided exactly), the
+ * one with the largest approximate |n_k|. Projecting along k maps the plane onto the
+ * coordinate plane bijectively; *sign receives sign(n_k), the orientation of the
+ * triangle a, b, c in that projection. Returns -1 for a degenerate plane (n = 0). */
+int mci_plane_projection_axis(const mci_plane *plane, int *sign);
+
+typedef enum mci_containment {
+    MCI_OUTSIDE = 0,
+    MCI_INSIDE = 1,   /* in the open triangle */
+    MCI_ON_EDGE = 2,  /* in the relative interior of edge *which (0: ab, 1: bc, 2: ca) */
+    MCI_ON_VERTEX = 3 /* equal to vertex *which (0: a, 1: b, 2: c) */
+} mci_containment;
+
+/* Where a point lying on the plane of a non-degenerate triangle a, b, c is with respect
+ * to the triangle: the paper's plane-based inside test. Each edge's bounding plane is
+ * the plane through the edge parallel to the projection axis, so the side of the point
+ * is the projected orientation (e0, e1, p) times the triangle's own orientation. The
+ * point must lie on the plane (else this classifies its projection). */
+mci_containment mci_point_in_triangle(const mci_point *p, const mci_plane *triangle,
+                                      int *which);
+
 /* Approximate coordinates of a point (the nearest double is not guaranteed; used for
  * output only after rounding decisions elsewhere, and for display). */
 void mci_point_approx(const mci_point *p, double out[3]);
