@@ -45,6 +45,12 @@ int mci_big_sign(const mci_big *a);
  * for all finite inputs (floating-point filter first). */
 int mci_orient2d(double ax, double ay, double bx, double by, double cx, double cy);
 
+/* Sign of (q - p) x (c - r) in 2D for input coordinates: where c lies relative to the
+ * line through r parallel to p->q (the far end of a triangle's projection interval in
+ * the separating-axis test). Exact for all finite inputs. */
+int mci_cross2_diff_sign(const double p[2], const double q[2], const double r[2],
+                         const double c[2]);
+
 /* True when the triangle has exactly zero area: repeated or collinear corners. */
 bool mci_triangle_is_degenerate(const double a[3], const double b[3], const double c[3]);
 

@@ -236,6 +236,41 @@ int mci_orient2d(double ax, double ay, double bx, double by, double cx, double c
     return orient2d_exact(ax, ay, bx, by, cx, cy);
 }
 
+static int cross2_diff_exact(const double p[2], const double q[2], const double r[2],
+                             const double c[2])
+{
+    double v[8] = {p[0], p[1], q[0], q[1], r[0], r[1], c[0], c[1]};
+    mci_big x[8], l, t;
+    int e0 = min_lsb_exponent(v, 8);
+    if (e0 == INT_MAX)
+        return 0;
+    for (int i = 0; i < 8; i++)
+        mci_big_from_double(&x[i], v[i], e0);
+    mci_big_sub(&x[2], &x[2], &x[0]); /* q - p */
+    mci_big_sub(&x[3], &x[3], &x[1]);
+    mci_big_sub(&x[6], &x[6], &x[4]); /* c - r */
+    mci_big_sub(&x[7], &x[7], &x[5]);
+    mci_big_mul(&l, &x[2], &x[7]);
+    mci_big_mul(&t, &x[3], &x[6]);
+    mci_big_sub(&l, &l, &t);
+    return mci_big_sign(&l);
+}
+
+int mci_cross2_diff_sign(const double p[2], const double q[2], const double r[2],
+                         const double c[2])
+{
+    double left = (q[0] - p[0]) * (c[1] - r[1]);
+    double right = (q[1] - p[1]) * (c[0] - r[0]);
+    double det = left - right;
+    double magnitude = fabs(left) + fabs(right);
+    /* Four rounded differences and two products: each product is within 3 eps (plus
+     * second-order terms) of exact, the subtraction adds one more. */
+    if (isfinite(magnitude) && magnitude >= FILTER_MIN_MAGNITUDE &&
+        fabs(det) > (4.0 + 16.0 * EPS) * EPS * magnitude)
+        return det > 0 ? 1 : -1;
+    return cross2_diff_exact(p, q, r, c);
+}
+
 bool mci_triangle_is_degenerate(const double a[3], const double b[3], const double c[3])
 {
     /* The cross product (b-a) x (c-a) vanishes iff its three components, the

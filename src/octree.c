@@ -1,0 +1,412 @@
+/*
+ * Adaptive octree over all leaves' faces (paper §3.1) and candidate pairs (§3.2).
+ *
+ * Cells are closed boxes; children split their parent at the rounded midpoint, and
+ * siblings share the split coordinate exactly, so the leaf cells tile the root box.
+ * A face is listed in every cell its triangle touches, decided exactly
+ * (mci_triangle_touches_box), so any point common to two faces lies in a leaf cell
+ * listing both: candidate pairs from leaf cells are complete.
+ */
+#include "octree.h"
+#include "exact.h"
+#include "exact_kernel.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define DEFAULT_MAX_CELL_FACES 24
+#define DEFAULT_MAX_DEPTH 14
+#define NO_CHILD UINT32_MAX
+
+/* ---------------------------------------------------------------------------------- */
+/* Exact triangle-box overlap (separating axis theorem)                                */
+
+static bool bounding_boxes_separate(const double *a, const double *b, const double *c,
+                                    const double lo[3], const double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double min = a[k] < b[k] ? a[k] : b[k], max = a[k] > b[k] ? a[k] : b[k];
+        min = c[k] < min ? c[k] : min;
+        max = c[k] > max ? c[k] : max;
+        if (max < lo[k] || min > hi[k])
+            return true;
+    }
+    return false;
+}
+
+static void box_corner(const double lo[3], const double hi[3], int index, double out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = (index >> k) & 1 ? hi[k] : lo[k];
+}
+
+/* The triangle's plane separates when all eight corners are strictly on one side. */
+static bool plane_separates(const double *a, const double *b, const double *c,
+                            const double lo[3], const double hi[3])
+{
+    mci_plane plane;
+    int first = 0;
+    mci_plane_init(&plane, a, b, c);
+    for (int i = 0; i < 8; i++) {
+        double corner[3];
+        mci_point p;
+        int side;
+        box_corner(lo, hi, i, corner);
+        mci_point_explicit(&p, corner);
+        side = mci_orient3d(&p, &plane);
+        if (side == 0 || (i > 0 && side != first))
+            return false;
+        first = side;
+    }
+    return true;
+}
+
+/* Axis (q - p) x e_k: in the projection along k, the triangle covers the interval
+ * between the line through p, q and the parallel line through r; the box projects to a
+ * rectangle. Separated when all four rectangle corners lie strictly beyond one end. */
+static bool edge_axis_separates(const double *p, const double *q, const double *r,
+                                const double lo[3], const double hi[3], int k)
+{
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double P[2] = {p[i], p[j]}, Q[2] = {q[i], q[j]}, R[2] = {r[i], r[j]};
+    int r_side, below = 0, above = 0;
+    if (P[0] == Q[0] && P[1] == Q[1])
+        return false; /* the edge is parallel to axis k: no such axis */
+    r_side = mci_orient2d(P[0], P[1], Q[0], Q[1], R[0], R[1]);
+    for (int corner = 0; corner < 4; corner++) {
+        double C[2] = {corner & 1 ? hi[i] : lo[i], corner & 2 ? hi[j] : lo[j]};
+        int at_edge = mci_orient2d(P[0], P[1], Q[0], Q[1], C[0], C[1]);
+        int at_r = mci_cross2_diff_sign(P, Q, R, C);
+        /* Below the interval [min(0, f(r)), max(0, f(r))] of f = (q - p) x (x - p). */
+        below += r_side >= 0 ? at_edge < 0 : at_r < 0;
+        above += r_side >= 0 ? (r_side > 0 ? at_r > 0 : at_edge > 0) : at_edge > 0;
+    }
+    return below == 4 || above == 4;
+}
+
+bool mci_triangle_touches_box(const double *a, const double *b, const double *c,
+                              const double lo[3], const double hi[3])
+{
+    const double *corner[3] = {a, b, c};
+    if (bounding_boxes_separate(a, b, c, lo, hi))
+        return false;
+    for (int e = 0; e < 3; e++) {
+        for (int k = 0; k < 3; k++) {
+            if (edge_axis_separates(corner[e], corner[(e + 1) % 3], corner[(e + 2) % 3], lo,
+                                    hi, k))
+                return false;
+        }
+    }
+    return !plane_separates(a, b, c, lo, hi);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Building                                                                            */
+
+typedef struct builder {
+    const mci_ctx *ctx;
+    mci_octree *tree;
+    mci_octree_params params;
+    size_t cell_capacity, id_capacity;
+    uint32_t *stack;
+    size_t stack_len, stack_capacity;
+} builder;
+
+static const double *face_vertex(const mci_octree *t, uint32_t face, int k)
+{
+    const mcsg_mesh *m = t->leaves[t->face_leaf[face]];
+    uint32_t local = face - t->face_base[t->face_leaf[face]];
+    return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)local + (size_t)k];
+}
+
+static bool grow(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
+                 size_t elem)
+{
+    void *grown;
+    size_t cap = *capacity ? *capacity : 64;
+    if (need <= *capacity)
+        return true;
+    while (cap < need)
+        cap *= 2;
+    grown = mci_realloc_array(ctx, *array, cap, elem);
+    if (!grown)
+        return false;
+    *array = grown;
+    *capacity = cap;
+    return true;
+}
+
+static bool push_cell(builder *b, uint32_t cell)
+{
+    if (!grow(b->ctx, (void **)&b->stack, &b->stack_capacity, b->stack_len + 1,
+              sizeof *b->stack))
+        return false;
+    b->stack[b->stack_len++] = cell;
+    return true;
+}
+
+static size_t total_faces(const mcsg_mesh *const *leaves, size_t leaf_count)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < leaf_count; i++)
+        total += leaves[i]->triangle_count;
+    return total;
+}
+
+static bool index_faces(const mci_ctx *ctx, mci_octree *t)
+{
+    size_t total = total_faces(t->leaves, t->leaf_count);
+    t->face_base = mci_malloc_array(ctx, t->leaf_count + 1, sizeof *t->face_base);
+    t->face_leaf = mci_malloc_array(ctx, total, sizeof *t->face_leaf);
+    t->face_ids = mci_malloc_array(ctx, total, sizeof *t->face_ids);
+    if (!t->face_base || !t->face_leaf || !t->face_ids)
+        return false;
+    t->face_base[0] = 0;
+    for (size_t i = 0; i < t->leaf_count; i++) {
+        uint32_t end = t->face_base[i] + (uint32_t)t->leaves[i]->triangle_count;
+        t->face_base[i + 1] = end;
+        for (uint32_t f = t->face_base[i]; f < end; f++)
+            t->face_leaf[f] = (uint32_t)i;
+    }
+    for (size_t f = 0; f < total; f++)
+        t->face_ids[f] = (uint32_t)f;
+    t->face_id_count = total;
+    return true;
+}
+
+static void root_bounds(const mci_octree *t, mci_cell *root)
+{
+    for (int k = 0; k < 3; k++) {
+        root->lo[k] = 0;
+        root->hi[k] = 0;
+    }
+    for (uint32_t f = 0; f < t->face_id_count; f++) {
+        for (int v = 0; v < 3; v++) {
+            const double *p = face_vertex(t, f, v);
+            for (int k = 0; k < 3; k++) {
+                if ((f == 0 && v == 0) || p[k] < root->lo[k])
+                    root->lo[k] = p[k];
+                if ((f == 0 && v == 0) || p[k] > root->hi[k])
+                    root->hi[k] = p[k];
+            }
+        }
+    }
+}
+
+static bool cell_is_critical(const mci_octree *t, const mci_cell *cell)
+{
+    for (uint32_t i = 1; i < cell->count; i++) {
+        if (t->face_leaf[t->face_ids[cell->first + i]] !=
+            t->face_leaf[t->face_ids[cell->first]])
+            return true;
+    }
+    return false;
+}
+
+/* The rounded midpoint must fall strictly inside, or the cell cannot be split. */
+static bool split_points(const mci_cell *cell, double mid[3])
+{
+    for (int k = 0; k < 3; k++) {
+        mid[k] = cell->lo[k] + (cell->hi[k] - cell->lo[k]) / 2;
+        if (!(cell->lo[k] < mid[k] && mid[k] < cell->hi[k]))
+            return false;
+    }
+    return true;
+}
+
+/* Child `index` of `parent`: its box, and the parent's faces that touch it appended to
+ * face_ids. */
+static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
+                       const double mid[3])
+{
+    mci_octree *t = b->tree;
+    mci_cell *c = &t->cells[child];
+    const mci_cell *p = &t->cells[parent];
+    for (int k = 0; k < 3; k++) {
+        c->lo[k] = (index >> k) & 1 ? mid[k] : p->lo[k];
+        c->hi[k] = (index >> k) & 1 ? p->hi[k] : mid[k];
+    }
+    c->depth = (uint16_t)(p->depth + 1);
+    c->child = NO_CHILD;
+    c->critical = 0;
+    c->first = (uint32_t)t->face_id_count;
+    c->count = 0;
+    for (uint32_t i = 0; i < p->count; i++) {
+        uint32_t f = t->face_ids[p->first + i];
+        if (!mci_triangle_touches_box(face_vertex(t, f, 0), face_vertex(t, f, 1),
+                                      face_vertex(t, f, 2), c->lo, c->hi))
+            continue;
+        if (!grow(b->ctx, (void **)&t->face_ids, &b->id_capacity, t->face_id_count + 1,
+                  sizeof *t->face_ids))
+            return false;
+        t->face_ids[t->face_id_count++] = f;
+        c = &t->cells[child]; /* unchanged: cells are not reallocated here */
+        c->count++;
+    }
+    /* Pathological inputs (thousands of faces through one point) could repeat faces in
+     * cells beyond 32-bit ids; report that as a failure rather than wrap. */
+    return t->face_id_count < UINT32_MAX;
+}
+
+static bool split_cell(builder *b, uint32_t cell, const double mid[3])
+{
+    mci_octree *t = b->tree;
+    uint32_t first_child = (uint32_t)t->cell_count;
+    if (!grow(b->ctx, (void **)&t->cells, &b->cell_capacity, t->cell_count + 8,
+              sizeof *t->cells))
+        return false;
+    t->cell_count += 8;
+    t->cells[cell].child = first_child;
+    for (int i = 0; i < 8; i++) {
+        if (!fill_child(b, cell, first_child + (uint32_t)i, i, mid) ||
+            !push_cell(b, first_child + (uint32_t)i))
+            return false;
+    }
+    return true;
+}
+
+static bool process_cell(builder *b, uint32_t index)
+{
+    mci_octree *t = b->tree;
+    mci_cell *cell = &t->cells[index];
+    double mid[3];
+    cell->critical = cell_is_critical(t, cell);
+    if (cell->depth > t->max_depth)
+        t->max_depth = cell->depth;
+    if (cell->critical && cell->count > b->params.max_cell_faces &&
+        cell->depth < b->params.max_depth && split_points(cell, mid))
+        return split_cell(b, index, mid);
+    if (cell->critical)
+        t->critical_leaf_cells++;
+    return true;
+}
+
+static bool build_cells(builder *b)
+{
+    mci_octree *t = b->tree;
+    t->cells = mci_malloc_array(b->ctx, 64, sizeof *t->cells);
+    if (!t->cells)
+        return false;
+    b->cell_capacity = 64;
+    b->id_capacity = t->face_id_count;
+    memset(&t->cells[0], 0, sizeof t->cells[0]);
+    root_bounds(t, &t->cells[0]);
+    t->cells[0].count = (uint32_t)t->face_id_count;
+    t->cells[0].child = NO_CHILD;
+    t->cell_count = 1;
+    if (!push_cell(b, 0))
+        return false;
+    while (b->stack_len > 0) {
+        if (!process_cell(b, b->stack[--b->stack_len]))
+            return false;
+    }
+    return true;
+}
+
+mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+                             size_t leaf_count, const mci_octree_params *params,
+                             mci_octree *out, mcsg_error *err)
+{
+    builder b;
+    bool ok;
+    memset(out, 0, sizeof *out);
+    /* Face ids and cell face lists are 32-bit; the lists repeat faces, so leave room. */
+    if (total_faces(leaves, leaf_count) >= UINT32_MAX / 4)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many faces in the scene (%zu; at most %u)",
+                        total_faces(leaves, leaf_count), UINT32_MAX / 4 - 1);
+    memset(&b, 0, sizeof b);
+    out->leaves = leaves;
+    out->leaf_count = leaf_count;
+    b.ctx = ctx;
+    b.tree = out;
+    b.params.max_cell_faces = params ? params->max_cell_faces : DEFAULT_MAX_CELL_FACES;
+    b.params.max_depth = params ? params->max_depth : DEFAULT_MAX_DEPTH;
+    ok = index_faces(ctx, out) && build_cells(&b);
+    mci_free(ctx, b.stack);
+    if (!ok) {
+        mci_octree_free(ctx, out);
+        return mci_fail_nomem(err, "building the octree");
+    }
+    return MCSG_OK;
+}
+
+void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
+{
+    mci_free(ctx, tree->face_base);
+    mci_free(ctx, tree->face_leaf);
+    mci_free(ctx, tree->cells);
+    mci_free(ctx, tree->face_ids);
+    memset(tree, 0, sizeof *tree);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Candidate pairs                                                                     */
+
+static bool face_boxes_overlap(const mci_octree *t, uint32_t f, uint32_t g)
+{
+    for (int k = 0; k < 3; k++) {
+        double fmin = face_vertex(t, f, 0)[k], fmax = fmin, gmin = face_vertex(t, g, 0)[k],
+               gmax = gmin;
+        for (int v = 1; v < 3; v++) {
+            double x = face_vertex(t, f, v)[k], y = face_vertex(t, g, v)[k];
+            fmin = x < fmin ? x : fmin;
+            fmax = x > fmax ? x : fmax;
+            gmin = y < gmin ? y : gmin;
+            gmax = y > gmax ? y : gmax;
+        }
+        if (fmax < gmin || gmax < fmin)
+            return false;
+    }
+    return true;
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const mci_cell *cell,
+                               uint64_t **pairs, size_t *count, size_t *capacity)
+{
+    for (uint32_t i = 0; i < cell->count; i++) {
+        uint32_t f = t->face_ids[cell->first + i];
+        for (uint32_t j = i + 1; j < cell->count; j++) {
+            uint32_t g = t->face_ids[cell->first + j];
+            if (t->face_leaf[f] == t->face_leaf[g] || !face_boxes_overlap(t, f, g))
+                continue;
+            if (!grow(ctx, (void **)pairs, capacity, *count + 1, sizeof **pairs))
+                return false;
+            (*pairs)[(*count)++] = f < g ? (uint64_t)f << 32 | g : (uint64_t)g << 32 | f;
+        }
+    }
+    return true;
+}
+
+mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tree,
+                                       uint64_t **pairs, size_t *count, mcsg_error *err)
+{
+    size_t capacity = 0, unique = 0;
+    *pairs = NULL;
+    *count = 0;
+    for (size_t c = 0; c < tree->cell_count; c++) {
+        const mci_cell *cell = &tree->cells[c];
+        if (cell->child != NO_CHILD || !cell->critical)
+            continue;
+        if (!collect_cell_pairs(ctx, tree, cell, pairs, count, &capacity)) {
+            mci_free(ctx, *pairs);
+            *pairs = NULL;
+            *count = 0;
+            return mci_fail_nomem(err, "collecting candidate pairs");
+        }
+    }
+    /* A pair sharing several cells was collected once per cell: keep one. */
+    if (*count)
+        qsort(*pairs, *count, sizeof **pairs, compare_u64);
+    for (size_t i = 0; i < *count; i++) {
+        if (i == 0 || (*pairs)[i] != (*pairs)[i - 1])
+            (*pairs)[unique++] = (*pairs)[i];
+    }
+    *count = unique;
+    return MCSG_OK;
+}

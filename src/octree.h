@@ -1,0 +1,63 @@
+/*
+ * Adaptive octree over the faces of all CSG leaves (paper §3.1), built on the bounding
+ * box of the whole scene. A face belongs to every cell its triangle touches (closed
+ * sets), decided exactly. A cell is critical when it holds faces of two or more leaves;
+ * only critical cells with many faces are subdivided. Candidate pairs for the
+ * intersection stage are the pairs of faces of different leaves that share a critical
+ * cell and whose bounding boxes overlap, each reported once.
+ */
+#ifndef MESHCSG_OCTREE_H
+#define MESHCSG_OCTREE_H
+
+#include "internal.h"
+
+/* A cell's faces are face_ids[first .. first + count) (global face ids: faces of leaf i
+ * are numbered from face_base[i]). Leaf cells have child == UINT32_MAX; otherwise the
+ * eight children are cells child .. child + 7 (bit 0 of the index: upper half in x,
+ * bit 1: in y, bit 2: in z). */
+typedef struct mci_cell {
+    double lo[3], hi[3];
+    uint32_t first, count;
+    uint32_t child;
+    uint16_t depth;
+    uint8_t critical;
+} mci_cell;
+
+typedef struct mci_octree {
+    const mcsg_mesh *const *leaves;
+    size_t leaf_count;
+    uint32_t *face_base;   /* leaf_count + 1 entries: global id of each leaf's face 0 */
+    uint32_t *face_leaf;   /* owning leaf per global face id */
+    mci_cell *cells;
+    size_t cell_count;
+    uint32_t *face_ids;    /* the cells' face lists */
+    size_t face_id_count;
+    size_t critical_leaf_cells;
+    unsigned max_depth;
+} mci_octree;
+
+/* Tuning: a critical cell with more faces than this is subdivided, up to the depth. */
+typedef struct mci_octree_params {
+    uint32_t max_cell_faces;
+    unsigned max_depth;
+} mci_octree_params;
+
+/* Build the octree over the given leaves (which must outlive it). params may be NULL
+ * for defaults. Fails only on allocation failure or more than 2^32-1 faces in total. */
+mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+                             size_t leaf_count, const mci_octree_params *params,
+                             mci_octree *out, mcsg_error *err);
+void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
+
+/* Candidate pairs, each as (smaller global id << 32) | larger id, sorted, unique. The
+ * array is allocated with ctx; the caller frees it. */
+mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tree,
+                                       uint64_t **pairs, size_t *count, mcsg_error *err);
+
+/* Exact test: does the closed triangle a, b, c touch the closed box [lo, hi]? (The
+ * separating axis theorem with the box axes, the triangle normal and the nine edge x
+ * axis directions, each decided with exact predicates.) */
+bool mci_triangle_touches_box(const double *a, const double *b, const double *c,
+                              const double lo[3], const double hi[3]);
+
+#endif

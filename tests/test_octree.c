@@ -1,0 +1,349 @@
+/*
+ * Octree and candidate pairs: the exact triangle-box test against a rational clipping
+ * reference, the cell structure (children tile their parent exactly), completeness of
+ * the leaf cells' face lists (every face touching a leaf cell is listed: the property
+ * that makes candidate pairs complete), and the candidate pairs against brute force.
+ */
+#include "testlib.h"
+#include "octree.h"
+
+#include <gmp.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t rng = 0x9e3779b97f4a7c15ULL;
+static uint64_t next_random(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return rng;
+}
+
+static int random_int(int lo, int hi)
+{
+    return lo + (int)(next_random() % (uint64_t)(hi - lo + 1));
+}
+
+/* ---- reference: clip the triangle by the box's six closed half-spaces ---- */
+
+#define MAX_POLY 12
+
+typedef struct qpoly {
+    int n;
+    mpq_t p[MAX_POLY][3];
+} qpoly;
+
+static void qpoly_init(qpoly *q)
+{
+    q->n = 0;
+    for (int i = 0; i < MAX_POLY; i++)
+        for (int k = 0; k < 3; k++)
+            mpq_init(q->p[i][k]);
+}
+
+static void qpoly_clear(qpoly *q)
+{
+    for (int i = 0; i < MAX_POLY; i++)
+        for (int k = 0; k < 3; k++)
+            mpq_clear(q->p[i][k]);
+}
+
+/* Keep the part of `in` with sign * (x_k - bound) >= 0. */
+static void clip(const qpoly *in, qpoly *out, int k, double bound, int sign)
+{
+    mpq_t b, da, db, t;
+    mpq_inits(b, da, db, t, NULL);
+    mpq_set_d(b, bound);
+    out->n = 0;
+    for (int i = 0; i < in->n; i++) {
+        int j = (i + 1) % in->n;
+        mpq_sub(da, in->p[i][k], b);
+        mpq_sub(db, in->p[j][k], b);
+        int sa = mpq_sgn(da) * sign, sb = mpq_sgn(db) * sign;
+        if (sa >= 0) {
+            for (int c = 0; c < 3; c++)
+                mpq_set(out->p[out->n][c], in->p[i][c]);
+            out->n++;
+        }
+        if ((sa > 0 && sb < 0) || (sa < 0 && sb > 0)) {
+            /* crossing point a + t (b - a), t = da / (da - db) */
+            mpq_sub(t, da, db);
+            mpq_div(t, da, t);
+            for (int c = 0; c < 3; c++) {
+                mpq_sub(out->p[out->n][c], in->p[j][c], in->p[i][c]);
+                mpq_mul(out->p[out->n][c], out->p[out->n][c], t);
+                mpq_add(out->p[out->n][c], out->p[out->n][c], in->p[i][c]);
+            }
+            out->n++;
+        }
+    }
+    mpq_clears(b, da, db, t, NULL);
+}
+
+static bool reference_touches(const double *a, const double *b, const double *c,
+                              const double lo[3], const double hi[3])
+{
+    qpoly q[2];
+    int cur = 0;
+    const double *v[3] = {a, b, c};
+    qpoly_init(&q[0]);
+    qpoly_init(&q[1]);
+    q[0].n = 3;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            mpq_set_d(q[0].p[i][k], v[i][k]);
+    for (int k = 0; k < 3 && q[cur].n > 0; k++) {
+        clip(&q[cur], &q[1 - cur], k, lo[k], 1);
+        cur = 1 - cur;
+        clip(&q[cur], &q[1 - cur], k, hi[k], -1);
+        cur = 1 - cur;
+    }
+    bool touches = q[cur].n > 0;
+    qpoly_clear(&q[0]);
+    qpoly_clear(&q[1]);
+    return touches;
+}
+
+static double coordinate(int regime)
+{
+    if (regime == 0)
+        return random_int(-6, 6) / 2.0; /* many exact contacts */
+    return ((double)(next_random() >> 11) / 9007199254740992.0) * 8 - 4;
+}
+
+TEST(triangle_box_matches_rational_clipping)
+{
+    long touching = 0, total = 0;
+    for (int n = 0; n < 60000; n++) {
+        int regime = n % 2;
+        double v[3][3], lo[3], hi[3];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                v[i][k] = coordinate(regime);
+        for (int k = 0; k < 3; k++) {
+            double x = coordinate(regime), y = coordinate(regime);
+            lo[k] = x < y ? x : y;
+            hi[k] = x < y ? y : x;
+        }
+        bool want = reference_touches(v[0], v[1], v[2], lo, hi);
+        bool got = mci_triangle_touches_box(v[0], v[1], v[2], lo, hi);
+        touching += want;
+        total++;
+        CHECK_MSG(got == want, "case %d: got %d want %d: tri (%a %a %a) (%a %a %a) (%a %a %a)",
+                  n, got, want, v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0],
+                  v[2][1], v[2][2]);
+    }
+    printf("triangle-box: %ld of %ld touching\n", touching, total);
+    CHECK(touching > total / 10 && touching < total * 9 / 10);
+}
+
+/* ---- octree structure ---- */
+
+static bool face_listed(const mci_octree *t, const mci_cell *cell, uint32_t f)
+{
+    for (uint32_t i = 0; i < cell->count; i++)
+        if (t->face_ids[cell->first + i] == f)
+            return true;
+    return false;
+}
+
+static const double *vertex_of(const mci_octree *t, uint32_t f, int k)
+{
+    uint32_t leaf = t->face_leaf[f];
+    const mcsg_mesh *m = t->leaves[leaf];
+    return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)(f - t->face_base[leaf]) + (size_t)k];
+}
+
+static void check_structure(const mci_octree *t)
+{
+    for (size_t c = 0; c < t->cell_count; c++) {
+        const mci_cell *cell = &t->cells[c];
+        if (cell->child == UINT32_MAX)
+            continue;
+        for (int i = 0; i < 8; i++) {
+            const mci_cell *ch = &t->cells[cell->child + (uint32_t)i];
+            for (int k = 0; k < 3; k++) {
+                double mid = (i >> k) & 1 ? ch->lo[k] : ch->hi[k];
+                CHECK(((i >> k) & 1 ? ch->hi[k] == cell->hi[k] : ch->lo[k] == cell->lo[k]));
+                CHECK(cell->lo[k] < mid && mid < cell->hi[k]);
+                CHECK(mid == t->cells[cell->child + (uint32_t)(i ^ (1 << k))].lo[k] ||
+                      mid == t->cells[cell->child + (uint32_t)(i ^ (1 << k))].hi[k]);
+            }
+        }
+    }
+}
+
+/* Every face touching a leaf cell is listed in it, and only those. */
+static void check_completeness(const mci_octree *t)
+{
+    uint32_t faces = t->face_base[t->leaf_count];
+    for (size_t c = 0; c < t->cell_count; c++) {
+        const mci_cell *cell = &t->cells[c];
+        if (cell->child != UINT32_MAX)
+            continue;
+        for (uint32_t f = 0; f < faces; f++) {
+            bool touches = mci_triangle_touches_box(vertex_of(t, f, 0), vertex_of(t, f, 1),
+                                                    vertex_of(t, f, 2), cell->lo, cell->hi);
+            /* The root holds every face, touching or not, when it is a leaf itself. */
+            if (c == 0)
+                touches = true;
+            CHECK_MSG(face_listed(t, cell, f) == touches, "cell %zu face %u", c, f);
+        }
+    }
+}
+
+static bool boxes_overlap(const mci_octree *t, uint32_t f, uint32_t g)
+{
+    for (int k = 0; k < 3; k++) {
+        double fmin = INFINITY, fmax = -INFINITY, gmin = INFINITY, gmax = -INFINITY;
+        for (int v = 0; v < 3; v++) {
+            fmin = fmin < vertex_of(t, f, v)[k] ? fmin : vertex_of(t, f, v)[k];
+            fmax = fmax > vertex_of(t, f, v)[k] ? fmax : vertex_of(t, f, v)[k];
+            gmin = gmin < vertex_of(t, g, v)[k] ? gmin : vertex_of(t, g, v)[k];
+            gmax = gmax > vertex_of(t, g, v)[k] ? gmax : vertex_of(t, g, v)[k];
+        }
+        if (fmax < gmin || gmax < fmin)
+            return false;
+    }
+    return true;
+}
+
+static int compare_pairs(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Brute force: pairs of faces of different leaves in a common critical leaf cell. */
+static void check_pairs(const mci_octree *t)
+{
+    uint64_t *pairs, *expected = NULL;
+    size_t count, n = 0, cap = 0;
+    mcsg_error err;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mci_octree_candidate_pairs(&ctx, t, &pairs, &count, &err), &err);
+    for (size_t c = 0; c < t->cell_count; c++) {
+        const mci_cell *cell = &t->cells[c];
+        if (cell->child != UINT32_MAX)
+            continue;
+        for (uint32_t i = 0; i < cell->count; i++)
+            for (uint32_t j = 0; j < cell->count; j++) {
+                uint32_t f = t->face_ids[cell->first + i], g = t->face_ids[cell->first + j];
+                if (f >= g || t->face_leaf[f] == t->face_leaf[g] || !boxes_overlap(t, f, g))
+                    continue;
+                CHECK(cell->critical);
+                if (n == cap) {
+                    cap = cap ? 2 * cap : 1024;
+                    expected = realloc(expected, cap * sizeof *expected);
+                }
+                expected[n++] = (uint64_t)f << 32 | g;
+            }
+    }
+    if (n)
+        qsort(expected, n, sizeof *expected, compare_pairs);
+    size_t unique = 0;
+    for (size_t i = 0; i < n; i++)
+        if (i == 0 || expected[i] != expected[i - 1])
+            expected[unique++] = expected[i];
+    CHECK_EQ_SIZE(count, unique);
+    CHECK(count == unique && (count == 0 || memcmp(pairs, expected, count * sizeof *pairs) == 0));
+    free(expected);
+    mci_free(&ctx, pairs);
+}
+
+static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_faces,
+                        size_t min_pairs)
+{
+    mci_ctx ctx;
+    mci_octree tree;
+    mcsg_error err;
+    mci_octree_params params = {max_faces, 10};
+    uint64_t *pairs;
+    size_t count;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mci_octree_build(&ctx, leaves, n, &params, &tree, &err), &err);
+    check_structure(&tree);
+    check_completeness(&tree);
+    check_pairs(&tree);
+    CHECK_OK(mci_octree_candidate_pairs(&ctx, &tree, &pairs, &count, &err), &err);
+    CHECK_MSG(count >= min_pairs, "only %zu candidate pairs", count);
+    printf("  %zu cells, depth %u, %zu critical leaf cells, %zu face refs, %zu pairs\n",
+           tree.cell_count, tree.max_depth, tree.critical_leaf_cells, tree.face_id_count,
+           count);
+    mci_free(&ctx, pairs);
+    mci_octree_free(&ctx, &tree);
+}
+
+TEST(two_offset_spheres)
+{
+    mcsg_mesh a, b;
+    mcsg_resolution res = {24, 0, 0};
+    mcsg_error err;
+    double shift[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.25, 0, 0, 1, 0};
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &a, &err), &err);
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &b, &err), &err);
+    mcsg_mesh_transform(&b, shift);
+    const mcsg_mesh *leaves[2] = {&a, &b};
+    check_scene(leaves, 2, 8, 100);
+    mcsg_mesh_free(&a, NULL);
+    mcsg_mesh_free(&b, NULL);
+}
+
+TEST(coplanar_cubes_and_identical_spheres)
+{
+    mcsg_mesh c1, c2, s1;
+    mcsg_error err;
+    double size[3] = {2, 2, 2};
+    double shift[12] = {1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 1, 0}; /* shares the faces y, z */
+    mcsg_resolution res = {16, 0, 0};
+    CHECK_OK(mcsg_make_cube(size, 0, NULL, &c1, &err), &err);
+    CHECK_OK(mcsg_make_cube(size, 0, NULL, &c2, &err), &err);
+    mcsg_mesh_transform(&c2, shift);
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &s1, &err), &err);
+    const mcsg_mesh *cubes[2] = {&c1, &c2};
+    check_scene(cubes, 2, 2, 12);
+    const mcsg_mesh *spheres[3] = {&s1, &s1, &c1};
+    check_scene(spheres, 3, 4, 200);
+    mcsg_mesh_free(&c1, NULL);
+    mcsg_mesh_free(&c2, NULL);
+    mcsg_mesh_free(&s1, NULL);
+}
+
+TEST(build_survives_allocation_failure)
+{
+    mcsg_mesh a;
+    mcsg_resolution res = {12, 0, 0};
+    mcsg_error err;
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &a, &err), &err);
+    const mcsg_mesh *leaves[2] = {&a, &a};
+    for (long fail = 1;; fail++) {
+        test_allocator alloc = {0};
+        alloc.fail_at = fail;
+        mcsg_options opts = test_allocator_options(&alloc);
+        mci_ctx ctx;
+        mci_octree tree;
+        mci_octree_params params = {4, 6};
+        mcsg_status st;
+        mci_ctx_init(&ctx, &opts);
+        st = mci_octree_build(&ctx, leaves, 2, &params, &tree, &err);
+        if (st == MCSG_OK)
+            mci_octree_free(&ctx, &tree);
+        CHECK_EQ_SIZE(alloc.live, 0);
+        if (st == MCSG_OK && alloc.calls < fail)
+            break;
+        CHECK(st == MCSG_OK || st == MCSG_ERR_NOMEM);
+    }
+    mcsg_mesh_free(&a, NULL);
+}
+
+int main(void)
+{
+    RUN(triangle_box_matches_rational_clipping);
+    RUN(two_offset_spheres);
+    RUN(coplanar_cubes_and_identical_spheres);
+    RUN(build_survives_allocation_failure);
+    return test_summary();
+}
