@@ -214,6 +214,26 @@ static bool split_points(const mci_cell *cell, double mid[3])
     return true;
 }
 
+/* Most faces are small: a face whose bounding box lies inside the cell touches it, one
+ * whose box misses the cell does not; only faces straddling the cell's boundary need the
+ * exact separating-axis test. */
+static bool face_touches_cell(const mci_octree *t, uint32_t f, const mci_cell *cell)
+{
+    const double *v[3] = {face_vertex(t, f, 0), face_vertex(t, f, 1), face_vertex(t, f, 2)};
+    bool inside = true;
+    for (int k = 0; k < 3; k++) {
+        double min = v[0][k], max = v[0][k];
+        for (int i = 1; i < 3; i++) {
+            min = v[i][k] < min ? v[i][k] : min;
+            max = v[i][k] > max ? v[i][k] : max;
+        }
+        if (max < cell->lo[k] || min > cell->hi[k])
+            return false;
+        inside = inside && cell->lo[k] <= min && max <= cell->hi[k];
+    }
+    return inside || mci_triangle_touches_box(v[0], v[1], v[2], cell->lo, cell->hi);
+}
+
 /* Child `index` of `parent`: its box, and the parent's faces that touch it appended to
  * face_ids. */
 static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
@@ -233,8 +253,7 @@ static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
     c->count = 0;
     for (uint32_t i = 0; i < p->count; i++) {
         uint32_t f = t->face_ids[p->first + i];
-        if (!mci_triangle_touches_box(face_vertex(t, f, 0), face_vertex(t, f, 1),
-                                      face_vertex(t, f, 2), c->lo, c->hi))
+        if (!face_touches_cell(t, f, c))
             continue;
         if (!grow(b->ctx, (void **)&t->face_ids, &b->id_capacity, t->face_id_count + 1,
                   sizeof *t->face_ids))
