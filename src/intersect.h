@@ -1,0 +1,30 @@
+/*
+ * Exact plane-based triangle-triangle intersection (paper §4.1, after Moeller): no
+ * coordinate is ever constructed; the end points of an intersection segment are implicit
+ * points (an input vertex, or an edge line of one triangle meeting the other's plane).
+ */
+#ifndef MESHCSG_INTERSECT_H
+#define MESHCSG_INTERSECT_H
+
+#include "exact_kernel.h"
+
+typedef enum mci_tt_kind {
+    MCI_TT_DISJOINT = 0,
+    MCI_TT_POINT,    /* a single common point: end[0] (paper §4.2: recorded, no segment) */
+    MCI_TT_SEGMENT,  /* the segment end[0] -> end[1], ordered along n1 x n2, distinct */
+    MCI_TT_COPLANAR  /* same plane; `overlap` says whether the interiors overlap */
+} mci_tt_kind;
+
+typedef struct mci_tt_result {
+    mci_tt_kind kind;
+    bool overlap;
+    mci_point end[2];
+} mci_tt_result;
+
+/* Intersect the closed triangles t1 = (t1->a, t1->b, t1->c) and t2 (their planes, as
+ * built by mci_plane_init; both non-degenerate). Edge lines are defined by their two
+ * vertices in a canonical order (by address), so that the point where an edge crosses a
+ * plane has the same definition from both faces sharing that edge. */
+void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out);
+
+#endif

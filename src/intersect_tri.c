@@ -1,0 +1,149 @@
+/*
+ * Exact triangle-triangle intersection (see intersect.h). Steps, as in the paper §4.1:
+ * (1) signs of each triangle's vertices against the other's plane (early rejection);
+ * (2) Seg1 = t1 ∩ plane(t2) and Seg2 = t2 ∩ plane(t1), each a point or a segment whose
+ *     ends are vertices on the plane or edge-line/plane points (LPI);
+ * (3) the intersection is the overlap of Seg1 and Seg2 along the common line, found by
+ *     ordering their ends with the exact order predicate (paper Eq. 1).
+ * Coplanar triangles are tested for overlapping interiors with the edges' bounding
+ * planes (projected orientations): the interiors are disjoint exactly when some edge
+ * line of either triangle has the whole other triangle on its closed outer side.
+ */
+#include "intersect.h"
+
+#include <stdint.h>
+#include <string.h>
+
+static const double *corner(const mci_plane *t, int i)
+{
+    return i == 0 ? t->a : i == 1 ? t->b : t->c;
+}
+
+/* Side of each vertex of t against `plane`. */
+static void vertex_sides(const mci_plane *t, const mci_plane *plane, int side[3])
+{
+    for (int i = 0; i < 3; i++) {
+        mci_point p;
+        mci_point_explicit(&p, corner(t, i));
+        side[i] = mci_orient3d(&p, plane);
+    }
+}
+
+static bool all_strictly_one_side(const int side[3])
+{
+    return (side[0] > 0 && side[1] > 0 && side[2] > 0) ||
+           (side[0] < 0 && side[1] < 0 && side[2] < 0);
+}
+
+/* The edge line through u and v, defined in a canonical vertex order. */
+static void edge_crossing(mci_point *out, const double *u, const double *v,
+                          const mci_plane *plane)
+{
+    bool swap = (uintptr_t)u > (uintptr_t)v;
+    /* The sides differ strictly, so the line is not parallel to the plane. */
+    (void)mci_point_lpi(out, swap ? v : u, swap ? u : v, plane);
+}
+
+/* t ∩ plane as 1 or 2 points (t not coplanar with the plane, not strictly on a side). */
+static int plane_section(const mci_plane *t, const mci_plane *plane, const int side[3],
+                         mci_point out[2])
+{
+    int n = 0;
+    for (int i = 0; i < 3 && n < 2; i++) {
+        int j = (i + 1) % 3;
+        if (side[i] == 0)
+            mci_point_explicit(&out[n++], corner(t, i));
+        if (n < 2 && side[i] * side[j] < 0)
+            edge_crossing(&out[n++], corner(t, i), corner(t, j), plane);
+    }
+    return n;
+}
+
+/* Sort a section's ends along the line; a single point is its own segment. */
+static void order_section(mci_point s[2], int n, const mci_plane *p1, const mci_plane *p2)
+{
+    if (n == 1) {
+        s[1] = s[0];
+    } else if (mci_order_on_plane_line(&s[0], &s[1], p1, p2) > 0) {
+        mci_point t = s[0];
+        s[0] = s[1];
+        s[1] = t;
+    }
+}
+
+static void overlap_on_line(const mci_point s1[2], const mci_point s2[2],
+                            const mci_plane *p1, const mci_plane *p2, mci_tt_result *out)
+{
+    const mci_point *start, *end;
+    int order;
+    start = mci_order_on_plane_line(&s1[0], &s2[0], p1, p2) >= 0 ? &s1[0] : &s2[0];
+    end = mci_order_on_plane_line(&s1[1], &s2[1], p1, p2) <= 0 ? &s1[1] : &s2[1];
+    order = mci_order_on_plane_line(start, end, p1, p2);
+    if (order > 0) {
+        out->kind = MCI_TT_DISJOINT;
+        return;
+    }
+    out->end[0] = *start;
+    if (order == 0) {
+        out->kind = MCI_TT_POINT;
+        return;
+    }
+    out->kind = MCI_TT_SEGMENT;
+    out->end[1] = *end;
+}
+
+/* Whether some edge of `a` has all of `b` on its closed outer side, in the projection
+ * along `axis` where a's orientation has sign `a_sign`. */
+static bool edge_separates(const mci_plane *a, int a_sign, const mci_plane *b, int axis)
+{
+    mci_point ac[3], bc[3];
+    for (int i = 0; i < 3; i++) {
+        mci_point_explicit(&ac[i], corner(a, i));
+        mci_point_explicit(&bc[i], corner(b, i));
+    }
+    for (int e = 0; e < 3; e++) {
+        int outside = 0;
+        for (int i = 0; i < 3; i++)
+            outside += a_sign * mci_orient2d_projected(&ac[e], &ac[(e + 1) % 3], &bc[i], axis) <= 0;
+        if (outside == 3)
+            return true;
+    }
+    return false;
+}
+
+static bool coplanar_interiors_overlap(const mci_plane *t1, const mci_plane *t2)
+{
+    int sign1, sign2, axis = mci_plane_projection_axis(t1, &sign1);
+    mci_point c[3];
+    if (axis < 0)
+        return false;
+    for (int i = 0; i < 3; i++)
+        mci_point_explicit(&c[i], corner(t2, i));
+    sign2 = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
+    if (sign2 == 0)
+        return false;
+    return !edge_separates(t1, sign1, t2, axis) && !edge_separates(t2, sign2, t1, axis);
+}
+
+void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out)
+{
+    int side1[3], side2[3], n1, n2;
+    mci_point s1[2], s2[2];
+    memset(out, 0, sizeof *out);
+    vertex_sides(t1, t2, side1);
+    if (all_strictly_one_side(side1))
+        return;
+    vertex_sides(t2, t1, side2);
+    if (all_strictly_one_side(side2))
+        return;
+    if (side1[0] == 0 && side1[1] == 0 && side1[2] == 0) {
+        out->kind = MCI_TT_COPLANAR;
+        out->overlap = coplanar_interiors_overlap(t1, t2);
+        return;
+    }
+    n1 = plane_section(t1, t2, side1, s1);
+    n2 = plane_section(t2, t1, side2, s2);
+    order_section(s1, n1, t1, t2);
+    order_section(s2, n2, t1, t2);
+    overlap_on_line(s1, s2, t1, t2, out);
+}
