@@ -338,6 +338,40 @@ mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *nam
                                   const char *base_dir, const mcsg_options *opts,
                                   mcsg_tree **out, mcsg_error *err);
 
+/* ------------------------------------------------------------------------------------ */
+/* Intersection curves (the first stage of evaluation, exposed for inspection)           */
+
+/* Polylines as points and segments: segment i joins points segments[2i] and
+ * segments[2i+1]. Each exact intersection point appears once, however many faces produced
+ * it; its coordinates are approximated in double precision (for display: the exactly
+ * rounded output comes with evaluation). */
+typedef struct mcsg_curves {
+    double *points;
+    uint32_t *segments;
+    size_t point_count;
+    size_t segment_count;
+} mcsg_curves;
+
+typedef struct mcsg_intersect_stats {
+    size_t faces;              /* faces of all leaves */
+    size_t cells;              /* octree cells */
+    size_t critical_cells;     /* leaf cells holding faces of two or more leaves */
+    size_t candidate_pairs;    /* face pairs tested (each once) */
+    size_t intersecting_pairs; /* pairs that cross along a segment */
+    size_t point_contacts;     /* pairs touching at a single point */
+    size_t coplanar_pairs;     /* coplanar pairs with overlapping interiors */
+    double seconds_octree, seconds_pairs, seconds_intersect, seconds_merge;
+} mcsg_intersect_stats;
+
+/* Intersect the faces of different leaves of `tree` (the operations are ignored): octree
+ * over all leaves, candidate pairs, exact triangle-triangle intersection, exact merging
+ * of coincident points. *out receives the curves (release with mcsg_curves_free); stats
+ * may be NULL. */
+mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg_curves *out,
+                           mcsg_intersect_stats *stats, mcsg_error *err);
+
+void mcsg_curves_free(mcsg_curves *curves, const mcsg_options *opts);
+
 #ifdef __cplusplus
 }
 #endif

@@ -112,7 +112,7 @@ typedef struct builder {
     size_t stack_len, stack_capacity;
 } builder;
 
-static const double *face_vertex(const mci_octree *t, uint32_t face, int k)
+const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
 {
     const mcsg_mesh *m = t->leaves[t->face_leaf[face]];
     uint32_t local = face - t->face_base[t->face_leaf[face]];
@@ -182,7 +182,7 @@ static void root_bounds(const mci_octree *t, mci_cell *root)
     }
     for (uint32_t f = 0; f < t->face_id_count; f++) {
         for (int v = 0; v < 3; v++) {
-            const double *p = face_vertex(t, f, v);
+            const double *p = mci_octree_face_vertex(t, f, v);
             for (int k = 0; k < 3; k++) {
                 if ((f == 0 && v == 0) || p[k] < root->lo[k])
                     root->lo[k] = p[k];
@@ -219,7 +219,8 @@ static bool split_points(const mci_cell *cell, double mid[3])
  * exact separating-axis test. */
 static bool face_touches_cell(const mci_octree *t, uint32_t f, const mci_cell *cell)
 {
-    const double *v[3] = {face_vertex(t, f, 0), face_vertex(t, f, 1), face_vertex(t, f, 2)};
+    const double *v[3] = {mci_octree_face_vertex(t, f, 0), mci_octree_face_vertex(t, f, 1),
+                          mci_octree_face_vertex(t, f, 2)};
     bool inside = true;
     for (int k = 0; k < 3; k++) {
         double min = v[0][k], max = v[0][k];
@@ -267,18 +268,33 @@ static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
     return t->face_id_count < UINT32_MAX;
 }
 
-static bool split_cell(builder *b, uint32_t cell, const double mid[3])
+/* Split a cell; returns false only on allocation failure. When no child has fewer faces
+ * than the parent (many faces through one point, e.g. the centre of a cylinder's cap
+ * fan), splitting cannot help: the children are dropped and the cell stays a leaf. */
+static bool split_cell(builder *b, uint32_t cell, const double mid[3], bool *split)
 {
     mci_octree *t = b->tree;
-    uint32_t first_child = (uint32_t)t->cell_count;
+    uint32_t first_child = (uint32_t)t->cell_count, largest = 0;
+    size_t ids_before = t->face_id_count;
     if (!grow(b->ctx, (void **)&t->cells, &b->cell_capacity, t->cell_count + 8,
               sizeof *t->cells))
         return false;
     t->cell_count += 8;
+    for (int i = 0; i < 8; i++) {
+        if (!fill_child(b, cell, first_child + (uint32_t)i, i, mid))
+            return false;
+        if (t->cells[first_child + (uint32_t)i].count > largest)
+            largest = t->cells[first_child + (uint32_t)i].count;
+    }
+    *split = largest < t->cells[cell].count;
+    if (!*split) {
+        t->cell_count -= 8;
+        t->face_id_count = ids_before;
+        return true;
+    }
     t->cells[cell].child = first_child;
     for (int i = 0; i < 8; i++) {
-        if (!fill_child(b, cell, first_child + (uint32_t)i, i, mid) ||
-            !push_cell(b, first_child + (uint32_t)i))
+        if (!push_cell(b, first_child + (uint32_t)i))
             return false;
     }
     return true;
@@ -293,9 +309,14 @@ static bool process_cell(builder *b, uint32_t index)
     if (cell->depth > t->max_depth)
         t->max_depth = cell->depth;
     if (cell->critical && cell->count > b->params.max_cell_faces &&
-        cell->depth < b->params.max_depth && split_points(cell, mid))
-        return split_cell(b, index, mid);
-    if (cell->critical)
+        cell->depth < b->params.max_depth && split_points(cell, mid)) {
+        bool split;
+        if (!split_cell(b, index, mid, &split))
+            return false;
+        if (split)
+            return true;
+    }
+    if (t->cells[index].critical)
         t->critical_leaf_cells++;
     return true;
 }
@@ -364,10 +385,10 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
 static bool face_boxes_overlap(const mci_octree *t, uint32_t f, uint32_t g)
 {
     for (int k = 0; k < 3; k++) {
-        double fmin = face_vertex(t, f, 0)[k], fmax = fmin, gmin = face_vertex(t, g, 0)[k],
+        double fmin = mci_octree_face_vertex(t, f, 0)[k], fmax = fmin, gmin = mci_octree_face_vertex(t, g, 0)[k],
                gmax = gmin;
         for (int v = 1; v < 3; v++) {
-            double x = face_vertex(t, f, v)[k], y = face_vertex(t, g, v)[k];
+            double x = mci_octree_face_vertex(t, f, v)[k], y = mci_octree_face_vertex(t, g, v)[k];
             fmin = x < fmin ? x : fmin;
             fmax = x > fmax ? x : fmax;
             gmin = y < gmin ? y : gmin;

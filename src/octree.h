@@ -49,6 +49,9 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                              mci_octree *out, mcsg_error *err);
 void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
 
+/* Corner k (0..2) of a face given by its global id. */
+const double *mci_octree_face_vertex(const mci_octree *tree, uint32_t face, int k);
+
 /* Candidate pairs, each as (smaller global id << 32) | larger id, sorted, unique. The
  * array is allocated with ctx; the caller frees it. */
 mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tree,

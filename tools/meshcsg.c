@@ -4,6 +4,7 @@
  *   meshcsg check [-o FIXED] FILE...     validate meshes (or every leaf of a .scad file)
  *   meshcsg tree FILE.scad               print the parsed CSG tree
  *   meshcsg convert IN OUT [--format F]  convert between mesh formats
+ *   meshcsg intersect FILE.scad [-o C]   intersection curves of all leaves, as OBJ lines
  *   meshcsg demo [-n N]                  run the built-in ring scene through what exists
  *
  * Exit status: 0 on success (check: every mesh valid), 1 when a check finds a problem
@@ -374,6 +375,90 @@ static int cmd_convert(int argc, char **argv)
 }
 
 /* ---------------------------------------------------------------------------------- */
+/* intersect                                                                           */
+
+/* Curves as OBJ: one `v` per distinct point, one `l` per segment. */
+static int write_curves_obj(const char *path, const mcsg_curves *c)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "meshcsg: %s: cannot create\n", path);
+        return 0;
+    }
+    fprintf(f, "# meshcsg intersection curves: %zu points, %zu segments\n", c->point_count,
+            c->segment_count);
+    for (size_t i = 0; i < c->point_count; i++)
+        fprintf(f, "v %.17g %.17g %.17g\n", c->points[3 * i], c->points[3 * i + 1],
+                c->points[3 * i + 2]);
+    for (size_t i = 0; i < c->segment_count; i++)
+        fprintf(f, "l %u %u\n", c->segments[2 * i] + 1, c->segments[2 * i + 1] + 1);
+    return fclose(f) == 0;
+}
+
+/* Points where an odd number of segments meet: zero when every curve is closed. */
+static size_t odd_degree_points(const mcsg_curves *c)
+{
+    size_t odd = 0;
+    unsigned char *parity = calloc(c->point_count + 1, 1);
+    if (!parity)
+        return SIZE_MAX;
+    for (size_t i = 0; i < 2 * c->segment_count; i++)
+        parity[c->segments[i]] ^= 1;
+    for (size_t i = 0; i < c->point_count; i++)
+        odd += parity[i];
+    free(parity);
+    return odd;
+}
+
+static void print_intersect_stats(const mcsg_intersect_stats *s, const mcsg_curves *c)
+{
+    printf("faces %zu, octree cells %zu (critical leaf cells %zu)\n", s->faces, s->cells,
+           s->critical_cells);
+    printf("candidate pairs %zu, intersecting pairs %zu, single-point contacts %zu, "
+           "coplanar overlapping pairs %zu\n", s->candidate_pairs, s->intersecting_pairs,
+           s->point_contacts, s->coplanar_pairs);
+    printf("segments %zu, distinct points %zu, points of odd degree %zu\n",
+           c->segment_count, c->point_count, odd_degree_points(c));
+    printf("time: octree %.3f s, pairs %.3f s, intersect %.3f s, merge %.3f s\n",
+           s->seconds_octree, s->seconds_pairs, s->seconds_intersect, s->seconds_merge);
+}
+
+static int cmd_intersect(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    const char *in = NULL, *out = NULL;
+    mcsg_tree *tree;
+    mcsg_curves curves;
+    mcsg_intersect_stats stats;
+    mcsg_error err;
+    int ok;
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc)
+            out = argv[++i];
+        else
+            in = in ? NULL : argv[i];
+    }
+    if (!in) {
+        fprintf(stderr, "usage: meshcsg intersect FILE.scad [-o CURVES.obj]\n");
+        return EXIT_USAGE;
+    }
+    if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    if (mcsg_intersect(tree, &opts, &curves, &stats, &err) != MCSG_OK) {
+        fail_line(&err);
+        mcsg_tree_free(tree);
+        return EXIT_PROBLEM;
+    }
+    print_intersect_stats(&stats, &curves);
+    ok = !out || write_curves_obj(out, &curves);
+    mcsg_curves_free(&curves, &opts);
+    mcsg_tree_free(tree);
+    return ok ? 0 : EXIT_PROBLEM;
+}
+
+/* ---------------------------------------------------------------------------------- */
 /* demo                                                                                */
 
 static int demo_check_leaves(const mcsg_tree *tree, const mcsg_options *opts,
@@ -446,6 +531,7 @@ static void usage(FILE *out)
             "                                      -o writes the (re-oriented) mesh\n"
             "  meshcsg tree FILE.scad              print the parsed CSG tree\n"
             "  meshcsg convert IN OUT [--format F] convert between mesh formats\n"
+            "  meshcsg intersect FILE.scad [-o C.obj] intersection curves of the leaves\n"
             "  meshcsg demo [-n SPHERES]           build and validate the built-in scene\n"
             "exit status: 0 ok, 1 a problem was found or an operation failed, 2 usage error\n",
             MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
@@ -465,6 +551,8 @@ int main(int argc, char **argv)
         return cmd_convert(argc - 2, argv + 2);
     if (strcmp(argv[1], "demo") == 0)
         return cmd_demo(argc - 2, argv + 2);
+    if (strcmp(argv[1], "intersect") == 0)
+        return cmd_intersect(argc - 2, argv + 2);
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
         usage(stdout);
         return 0;
