@@ -189,14 +189,6 @@ static i128 i128_from_double(double x, int e0)
 #define NUM_SIGN(a) ((*(a) > 0) - (*(a) < 0))
 #define EVAL(name) i128_##name
 #include "exact_kernel_eval.inc"
-#undef NUM
-#undef NUM_FROM_DOUBLE
-#undef NUM_ADD
-#undef NUM_SUB
-#undef NUM_MUL
-#undef NUM_SET_INT
-#undef NUM_SIGN
-#undef EVAL
 
 #define NUM mci_big
 #define NUM_FROM_DOUBLE(r, x, e0) mci_big_from_double((r), (x), (e0))
@@ -207,14 +199,6 @@ static i128 i128_from_double(double x, int e0)
 #define NUM_SIGN(a) mci_big_sign(a)
 #define EVAL(name) big_##name
 #include "exact_kernel_eval.inc"
-#undef NUM
-#undef NUM_FROM_DOUBLE
-#undef NUM_ADD
-#undef NUM_SUB
-#undef NUM_MUL
-#undef NUM_SET_INT
-#undef NUM_SIGN
-#undef EVAL
 
 /* ---------------------------------------------------------------------------------- */
 /* Planes and points                                                                   */
