@@ -14,15 +14,12 @@
 static uint64_t rng = 0x243f6a8885a308d3ULL;
 static uint64_t next_random(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return test_xorshift(&rng);
 }
 
 static int random_int(int lo, int hi)
 {
-    return lo + (int)(next_random() % (uint64_t)(hi - lo + 1));
+    return test_random_int(&rng, lo, hi);
 }
 
 /* Containment from barycentric parameters (p = a + s(b-a) + t(c-a)). */

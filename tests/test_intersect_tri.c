@@ -16,10 +16,7 @@
 static uint64_t rng = 0xd1b54a32d192ed03ULL;
 static uint64_t next_random(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return test_xorshift(&rng);
 }
 
 typedef struct qvec {

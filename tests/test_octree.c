@@ -15,15 +15,12 @@
 static uint64_t rng = 0x9e3779b97f4a7c15ULL;
 static uint64_t next_random(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return test_xorshift(&rng);
 }
 
 static int random_int(int lo, int hi)
 {
-    return lo + (int)(next_random() % (uint64_t)(hi - lo + 1));
+    return test_random_int(&rng, lo, hi);
 }
 
 /* ---- reference: clip the triangle by the box's six closed half-spaces ---- */

@@ -264,10 +264,7 @@ static int ref_det3(const double p[9])
 static uint64_t rng_state = 0x9e3779b97f4a7c15ULL;
 static uint64_t next_random(void)
 {
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return rng_state;
+    return test_xorshift(&rng_state);
 }
 
 /* A random double from a mix of regimes: small integers, unit-range values, values

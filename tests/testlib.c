@@ -181,3 +181,16 @@ long test_allocation_failures(const char *what, test_alloc_run run, const void *
     test_fail(__FILE__, __LINE__, "%s: still failing after %ld allocations", what, most);
     return -1;
 }
+
+uint64_t test_xorshift(uint64_t *state)
+{
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    return *state;
+}
+
+int test_random_int(uint64_t *state, int lo, int hi)
+{
+    return lo + (int)(test_xorshift(state) % (uint64_t)(hi - lo + 1));
+}

@@ -91,6 +91,12 @@ const char *test_data(const char *name);
 /* Path of a scratch file in the build tree. Static buffer. */
 const char *test_tmp(const char *name);
 
+/* xorshift64 step on a caller-owned state (each test file keeps its own seed, so that
+ * its cases do not depend on what other code draws). */
+uint64_t test_xorshift(uint64_t *state);
+/* Uniform-ish integer in [lo, hi] from test_xorshift. */
+int test_random_int(uint64_t *state, int lo, int hi);
+
 /* Read a mesh from a string in the given format; aborts the test case on failure. */
 bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg_error *err);
 
