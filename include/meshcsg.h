@@ -44,7 +44,8 @@ typedef enum mcsg_status {
     MCSG_ERR_UNSUPPORTED,  /* well-formed input that uses a feature outside meshcsg */
     MCSG_ERR_INVALID_ARG,  /* the caller passed an invalid argument */
     MCSG_ERR_INVALID_MESH, /* a mesh is not usable (e.g. indices out of range) */
-    MCSG_ERR_LIMIT         /* the input exceeds a hard limit (e.g. 2^32-1 vertices) */
+    MCSG_ERR_LIMIT,        /* the input exceeds a hard limit (e.g. 2^32-1 vertices) */
+    MCSG_ERR_INTERNAL      /* an internal consistency check failed: a bug, please report */
 } mcsg_status;
 
 /* A short English description of a status code ("out of memory", ...). Never NULL. */

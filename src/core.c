@@ -249,6 +249,7 @@ const char *mcsg_status_string(mcsg_status status)
     case MCSG_ERR_INVALID_ARG: return "invalid argument";
     case MCSG_ERR_INVALID_MESH: return "invalid mesh";
     case MCSG_ERR_LIMIT: return "size limit exceeded";
+    case MCSG_ERR_INTERNAL: return "internal error";
     }
     return "unknown status";
 }

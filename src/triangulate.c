@@ -1,0 +1,527 @@
+/*
+ * Constrained triangulation of a face with exact predicates only.
+ *
+ *   1. Points are inserted one by one in Morton order of their approximate positions
+ *      (so consecutive points are close and walks are short). Each is located by the
+ *      remembering stochastic walk (Devillers, Pion, Teillaud, "Walking in a
+ *      triangulation", 2002), which terminates in any triangulation, Delaunay or not,
+ *      and splits the triangle (1 -> 3) or the edge (2 -> 4, or 1 -> 2 on the boundary)
+ *      it lies in.
+ *   2. Each constraint edge is recovered by edge flips (Sloan, "A fast algorithm for
+ *      generating constrained Delaunay triangulations", 1993, without the Delaunay
+ *      step): the edges it crosses are queued, and a queued edge whose quadrilateral is
+ *      strictly convex is flipped; the new diagonal is queued again if it still crosses.
+ *
+ * No incircle test is needed: the result only has to tile the face exactly, and the
+ * orientation test on implicit points (mci_orient2d_projected) is the only predicate.
+ * New edges never contain a point in their interior: an inserted point's edges lie
+ * inside the triangle it split, and a flipped diagonal inside a convex quadrilateral.
+ *
+ * Notation: triangle t has vertices v[0..2] counter-clockwise in the face's
+ * orientation; "edge i" is the edge opposite v[i], from v[i+1] to v[i+2]; n[i] is the
+ * triangle across edge i (NONE on the face's boundary).
+ */
+#include "triangulate.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define NONE UINT32_MAX
+
+typedef struct tri {
+    uint32_t v[3];
+    uint32_t n[3];
+    uint8_t fixed; /* bit i: edge i is a constraint */
+} tri;
+
+typedef struct queued_edge {
+    uint32_t u, w;  /* the edge's end points */
+    uint32_t t;     /* a triangle that had it when queued (checked before use) */
+} queued_edge;
+
+typedef struct cdt {
+    const mci_ctx *ctx;
+    const mci_cdt_input *in;
+    tri *t;
+    size_t count;
+    uint32_t *vt; /* a triangle incident to each inserted point */
+    uint64_t rng;
+    queued_edge *queue;
+    size_t queue_head, queue_len, queue_cap;
+} cdt;
+
+static int next3(int i)
+{
+    return i == 2 ? 0 : i + 1;
+}
+
+static int prev3(int i)
+{
+    return i == 0 ? 2 : i - 1;
+}
+
+static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
+{
+    const mci_point *pts = c->in->points;
+    return c->in->sign * mci_orient2d_projected(&pts[a], &pts[b], &pts[p], c->in->axis);
+}
+
+static int vertex_index(const tri *t, uint32_t v)
+{
+    return t->v[0] == v ? 0 : t->v[1] == v ? 1 : t->v[2] == v ? 2 : -1;
+}
+
+/* Index of the edge from u to w in t (directed), or -1. */
+static int edge_index(const tri *t, uint32_t u, uint32_t w)
+{
+    int i = vertex_index(t, u);
+    return i >= 0 && t->v[next3(i)] == w ? prev3(i) : -1;
+}
+
+/* edge_index for an edge that the adjacency invariant guarantees (the edge of a
+ * neighbour across a known edge); never -1, so that indexing stays in bounds. */
+static int known_edge(const tri *t, uint32_t u, uint32_t w)
+{
+    int i = edge_index(t, u, w);
+    return i < 0 ? 0 : i;
+}
+
+static uint32_t random_below(cdt *c, uint32_t n)
+{
+    c->rng ^= c->rng << 13;
+    c->rng ^= c->rng >> 7;
+    c->rng ^= c->rng << 17;
+    return (uint32_t)(c->rng % n);
+}
+
+static void set_vertices(cdt *c, uint32_t t, uint32_t a, uint32_t b, uint32_t d)
+{
+    c->t[t].v[0] = a;
+    c->t[t].v[1] = b;
+    c->t[t].v[2] = d;
+}
+
+/* Link each edge of each fresh triangle to the triangle holding the reversed edge, among
+ * the fresh ones and their outer neighbours (NONE entries allowed). Constraint flags of
+ * edges shared with outer triangles are taken from those. */
+static void stitch(cdt *c, const uint32_t *fresh, int nf, const uint32_t *outer, int no)
+{
+    for (int k = 0; k < nf; k++)
+        c->t[fresh[k]].fixed = 0;
+    for (int k = 0; k < nf; k++) {
+        tri *t = &c->t[fresh[k]];
+        for (int i = 0; i < 3; i++) {
+            uint32_t u = t->v[next3(i)], w = t->v[prev3(i)];
+            t->n[i] = NONE;
+            for (int m = 0; m < nf + no && t->n[i] == NONE; m++) {
+                uint32_t s = m < nf ? fresh[m] : outer[m - nf];
+                int j = s == NONE || s == fresh[k] ? -1 : edge_index(&c->t[s], w, u);
+                if (j < 0)
+                    continue;
+                t->n[i] = s;
+                c->t[s].n[j] = fresh[k];
+                if (m >= nf)
+                    t->fixed |= (uint8_t)(((c->t[s].fixed >> j) & 1) << i);
+            }
+        }
+    }
+}
+
+static void split_triangle(cdt *c, uint32_t t, uint32_t p)
+{
+    tri old = c->t[t];
+    uint32_t fresh[3] = {t, (uint32_t)c->count, (uint32_t)c->count + 1};
+    c->count += 2;
+    set_vertices(c, fresh[0], old.v[0], old.v[1], p);
+    set_vertices(c, fresh[1], old.v[1], old.v[2], p);
+    set_vertices(c, fresh[2], old.v[2], old.v[0], p);
+    stitch(c, fresh, 3, old.n, 3);
+    c->vt[old.v[0]] = c->vt[old.v[1]] = c->vt[p] = fresh[0];
+    c->vt[old.v[2]] = fresh[1];
+}
+
+/* p lies inside edge i of t: split t, and the triangle across if there is one. */
+static void split_edge(cdt *c, uint32_t t, int i, uint32_t p)
+{
+    tri ot = c->t[t];
+    uint32_t x = ot.v[i], u = ot.v[next3(i)], w = ot.v[prev3(i)], s = ot.n[i];
+    uint32_t fresh[4] = {t, (uint32_t)c->count++, s, NONE};
+    uint32_t outer[4] = {ot.n[next3(i)], ot.n[prev3(i)], NONE, NONE};
+    set_vertices(c, fresh[0], x, u, p);
+    set_vertices(c, fresh[1], x, p, w);
+    c->vt[x] = c->vt[u] = c->vt[p] = fresh[0];
+    c->vt[w] = fresh[1];
+    if (s != NONE) {
+        tri os = c->t[s];
+        int j = known_edge(&os, w, u);
+        uint32_t y = os.v[j];
+        fresh[3] = (uint32_t)c->count++;
+        outer[2] = os.n[next3(j)];
+        outer[3] = os.n[prev3(j)];
+        set_vertices(c, s, y, w, p);
+        set_vertices(c, fresh[3], y, p, u);
+        c->vt[y] = s;
+    }
+    stitch(c, fresh, s != NONE ? 4 : 2, outer, 4);
+}
+
+/* Find the triangle containing p by the remembering stochastic walk from `t`. On
+ * success *edge is -1 (p inside t) or the edge of t that p lies on. */
+static mcsg_status locate(cdt *c, uint32_t p, uint32_t t, uint32_t *found, int *edge,
+                          mcsg_error *err)
+{
+    uint32_t prev = NONE;
+    for (size_t steps = 0; steps <= 64 * c->count + 1024; steps++) {
+        const tri *tr = &c->t[t];
+        int start = (int)random_below(c, 3), side[3], zeros = 0, moved = 0;
+        for (int k = 0; k < 3 && !moved; k++) {
+            int i = (start + k) % 3;
+            side[i] = prev != NONE && tr->n[i] == prev
+                          ? 1 /* p was strictly beyond that edge as seen from prev */
+                          : orient(c, tr->v[next3(i)], tr->v[prev3(i)], p);
+            if (side[i] < 0) {
+                if (tr->n[i] == NONE)
+                    return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: a point lies "
+                                    "outside its face");
+                prev = t;
+                t = tr->n[i];
+                moved = 1;
+            }
+        }
+        if (moved)
+            continue;
+        *found = t;
+        *edge = -1;
+        for (int i = 0; i < 3; i++)
+            if (side[i] == 0)
+                zeros++, *edge = i;
+        if (zeros > 1)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: coincident points");
+        return MCSG_OK;
+    }
+    return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: point location did not end");
+}
+
+/* Interleave the bits of two 16-bit values. */
+static uint32_t morton(uint32_t x, uint32_t y)
+{
+    uint32_t r = 0;
+    for (int b = 0; b < 16; b++)
+        r |= ((x >> b) & 1u) << (2 * b) | ((y >> b) & 1u) << (2 * b + 1);
+    return r;
+}
+
+static int compare_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Quantised position of a point in the face's bounding box (only orders the insertion:
+ * any order gives a valid triangulation). */
+static uint32_t insertion_key(const mci_cdt_input *in, const double lo[2],
+                              const double span[2], uint32_t p)
+{
+    double x[3], q[2];
+    uint32_t cell[2];
+    mci_point_approx(&in->points[p], x);
+    q[0] = x[(in->axis + 1) % 3];
+    q[1] = x[(in->axis + 2) % 3];
+    for (int k = 0; k < 2; k++) {
+        double f = span[k] > 0 ? (q[k] - lo[k]) / span[k] : 0;
+        f = f > 0 ? (f < 1 ? f : 1) : 0; /* also maps NaN to 0 */
+        cell[k] = (uint32_t)(f * 65535.0);
+    }
+    return morton(cell[0], cell[1]);
+}
+
+static uint64_t *insertion_order(const mci_ctx *ctx, const mci_cdt_input *in)
+{
+    double lo[2] = {0, 0}, hi[2] = {0, 0}, span[2];
+    uint64_t *order = mci_malloc_array(ctx, in->insert_count ? in->insert_count : 1,
+                                       sizeof *order);
+    if (!order)
+        return NULL;
+    for (int i = 0; i < 3; i++) {
+        double x[3];
+        mci_point_approx(&in->points[i], x);
+        for (int k = 0; k < 2; k++) {
+            double q = x[(in->axis + 1 + k) % 3];
+            lo[k] = i == 0 || q < lo[k] ? q : lo[k];
+            hi[k] = i == 0 || q > hi[k] ? q : hi[k];
+        }
+    }
+    span[0] = hi[0] - lo[0];
+    span[1] = hi[1] - lo[1];
+    for (size_t i = 0; i < in->insert_count; i++)
+        order[i] = (uint64_t)insertion_key(in, lo, span, in->insert[i]) << 32 | i;
+    qsort(order, in->insert_count, sizeof *order, compare_u64);
+    return order;
+}
+
+static mcsg_status insert_points(cdt *c, mcsg_error *err)
+{
+    uint64_t *order = insertion_order(c->ctx, c->in);
+    uint32_t last = 0;
+    mcsg_status st = order ? MCSG_OK : mci_fail_nomem(err, "triangulating a face");
+    for (size_t k = 0; st == MCSG_OK && k < c->in->insert_count; k++) {
+        uint32_t p = c->in->insert[(uint32_t)order[k]], t = 0;
+        int edge = -1;
+        if (p >= c->in->point_count || c->vt[p] != NONE) {
+            st = mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad point id %u", p);
+            break;
+        }
+        st = locate(c, p, c->vt[last], &t, &edge, err);
+        if (st != MCSG_OK)
+            break;
+        if (edge < 0)
+            split_triangle(c, t, p);
+        else
+            split_edge(c, t, edge, p);
+        last = p;
+    }
+    mci_free(c->ctx, order);
+    return st;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Constraint recovery                                                                 */
+
+/* The triangle around u after t, turning counter-clockwise (ccw) or clockwise. */
+static uint32_t fan_step(const cdt *c, uint32_t t, uint32_t u, bool ccw)
+{
+    int iu = vertex_index(&c->t[t], u);
+    return c->t[t].n[ccw ? next3(iu) : prev3(iu)];
+}
+
+/* What find_around looks for in the triangle t = (u, q, r) around u. */
+typedef enum fan_goal { FAN_HAS_EDGE, FAN_SEES } fan_goal;
+
+static bool fan_match(const cdt *c, uint32_t t, uint32_t u, uint32_t w, fan_goal goal)
+{
+    const tri *tr = &c->t[t];
+    int iu = vertex_index(tr, u);
+    uint32_t q = tr->v[next3(iu)], r = tr->v[prev3(iu)];
+    if (q == w || r == w)
+        return true;
+    /* w strictly inside the angle q-u-r: the segment u w leaves through edge q r. */
+    return goal == FAN_SEES && orient(c, u, q, w) > 0 && orient(c, u, r, w) < 0;
+}
+
+/* A triangle around u that has the edge u-w, or (FAN_SEES) whose angle at u contains
+ * the direction to w; NONE if there is none. */
+static uint32_t find_around(const cdt *c, uint32_t u, uint32_t w, fan_goal goal)
+{
+    uint32_t start = c->vt[u], t = start;
+    do {
+        if (fan_match(c, t, u, w, goal))
+            return t;
+        t = fan_step(c, t, u, true);
+    } while (t != NONE && t != start);
+    if (t == start)
+        return NONE;
+    for (t = fan_step(c, start, u, false); t != NONE; t = fan_step(c, t, u, false))
+        if (fan_match(c, t, u, w, goal))
+            return t;
+    return NONE;
+}
+
+static bool push_edge(cdt *c, uint32_t u, uint32_t w, uint32_t t)
+{
+    if (c->queue_head + c->queue_len == c->queue_cap) {
+        if (c->queue_head > 0) {
+            memmove(c->queue, c->queue + c->queue_head, c->queue_len * sizeof *c->queue);
+            c->queue_head = 0;
+        } else {
+            size_t cap = c->queue_cap ? 2 * c->queue_cap : 64;
+            queued_edge *q = mci_realloc_array(c->ctx, c->queue, cap, sizeof *q);
+            if (!q)
+                return false;
+            c->queue = q;
+            c->queue_cap = cap;
+        }
+    }
+    c->queue[c->queue_head + c->queue_len++] = (queued_edge){u, w, t};
+    return true;
+}
+
+/* Edge index of u-w (either direction) in t, or -1. */
+static int undirected_edge(const tri *t, uint32_t u, uint32_t w)
+{
+    int i = edge_index(t, u, w);
+    return i >= 0 ? i : edge_index(t, w, u);
+}
+
+static void mark_fixed(cdt *c, uint32_t t, int i)
+{
+    uint32_t s = c->t[t].n[i];
+    c->t[t].fixed |= (uint8_t)(1u << i);
+    if (s != NONE) {
+        int j = known_edge(&c->t[s], c->t[t].v[prev3(i)], c->t[t].v[next3(i)]);
+        c->t[s].fixed |= (uint8_t)(1u << j);
+    }
+}
+
+/* Queue the edges that the segment a-b crosses, walking from a to b. */
+static mcsg_status queue_crossed_edges(cdt *c, uint32_t a, uint32_t b, uint32_t t,
+                                       mcsg_error *err)
+{
+    int i = vertex_index(&c->t[t], a);
+    /* In t = (a, q, r): q lies right of a->b, r left; the crossed edge is q-r. */
+    uint32_t q = c->t[t].v[next3(i)], r = c->t[t].v[prev3(i)];
+    for (;;) {
+        uint32_t s = c->t[t].n[i], z;
+        int j, side;
+        if (!push_edge(c, q, r, t))
+            return mci_fail_nomem(err, "triangulating a face");
+        if (s == NONE)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint leaves the face");
+        j = known_edge(&c->t[s], r, q);
+        z = c->t[s].v[j];
+        if (z == b)
+            return MCSG_OK;
+        side = orient(c, a, b, z);
+        if (side == 0)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: a point lies inside a "
+                            "constraint");
+        /* s = (z, r, q): the walk leaves through q-z (opposite r) or z-r (opposite q). */
+        if (side > 0)
+            r = z, i = next3(j);
+        else
+            q = z, i = prev3(j);
+        t = s;
+    }
+}
+
+static void flip(cdt *c, uint32_t t, int i)
+{
+    tri ot = c->t[t];
+    uint32_t s = ot.n[i];
+    tri os = c->t[s];
+    uint32_t x = ot.v[i], u = ot.v[next3(i)], w = ot.v[prev3(i)];
+    int j = known_edge(&os, w, u);
+    uint32_t y = os.v[j];
+    uint32_t fresh[2] = {t, s};
+    uint32_t outer[4] = {ot.n[next3(i)], ot.n[prev3(i)], os.n[next3(j)], os.n[prev3(j)]};
+    set_vertices(c, t, x, u, y);
+    set_vertices(c, s, y, w, x);
+    stitch(c, fresh, 2, outer, 4);
+    c->vt[x] = c->vt[u] = t;
+    c->vt[y] = c->vt[w] = s;
+}
+
+static bool segments_cross(const cdt *c, uint32_t a, uint32_t b, uint32_t x, uint32_t y)
+{
+    return orient(c, a, b, x) * orient(c, a, b, y) < 0 &&
+           orient(c, x, y, a) * orient(c, x, y, b) < 0;
+}
+
+/* Locate a queued edge again (flips may have moved it to other triangles). */
+static bool find_queued(const cdt *c, const queued_edge *e, uint32_t *t, int *i)
+{
+    *t = e->t;
+    if (*t < c->count && (*i = undirected_edge(&c->t[*t], e->u, e->w)) >= 0)
+        return true;
+    *t = find_around(c, e->u, e->w, FAN_HAS_EDGE);
+    return *t != NONE && (*i = undirected_edge(&c->t[*t], e->u, e->w)) >= 0;
+}
+
+/* Flip queued edges until none crosses a-b (Sloan's loop). */
+static mcsg_status flip_crossed_edges(cdt *c, uint32_t a, uint32_t b, mcsg_error *err)
+{
+    size_t budget = 64 * (c->queue_len + 16) * (c->queue_len + 16);
+    while (c->queue_len > 0) {
+        queued_edge e = c->queue[c->queue_head++];
+        uint32_t t, x, y;
+        int i;
+        c->queue_len--;
+        if (budget-- == 0 || !find_queued(c, &e, &t, &i) || c->t[t].n[i] == NONE)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint recovery failed");
+        x = c->t[t].v[i];
+        y = c->t[c->t[t].n[i]].v[known_edge(&c->t[c->t[t].n[i]], c->t[t].v[prev3(i)],
+                                             c->t[t].v[next3(i)])];
+        if (orient(c, x, y, e.u) * orient(c, x, y, e.w) < 0) {
+            flip(c, t, i);
+            if (x == a || x == b || y == a || y == b || !segments_cross(c, a, b, x, y))
+                continue;
+            e = (queued_edge){x, y, t};
+        }
+        if (!push_edge(c, e.u, e.w, e.t))
+            return mci_fail_nomem(err, "triangulating a face");
+    }
+    c->queue_head = 0;
+    return MCSG_OK;
+}
+
+static mcsg_status insert_constraint(cdt *c, uint32_t a, uint32_t b, mcsg_error *err)
+{
+    uint32_t t;
+    int i;
+    mcsg_status st;
+    if (a == b || a >= c->in->point_count || b >= c->in->point_count || c->vt[a] == NONE ||
+        c->vt[b] == NONE)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad constraint %u-%u", a, b);
+    t = find_around(c, a, b, FAN_SEES);
+    if (t == NONE)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint %u-%u not found",
+                        a, b);
+    if (undirected_edge(&c->t[t], a, b) < 0) {
+        st = queue_crossed_edges(c, a, b, t, err);
+        if (st == MCSG_OK)
+            st = flip_crossed_edges(c, a, b, err);
+        if (st != MCSG_OK)
+            return st;
+        t = find_around(c, a, b, FAN_HAS_EDGE);
+        if (t == NONE)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint not recovered");
+    }
+    i = undirected_edge(&c->t[t], a, b);
+    if (i < 0)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint not recovered");
+    mark_fixed(c, t, i);
+    return MCSG_OK;
+}
+
+static mcsg_status setup(cdt *c, const mci_ctx *ctx, const mci_cdt_input *in, mcsg_error *err)
+{
+    memset(c, 0, sizeof *c);
+    c->ctx = ctx;
+    c->in = in;
+    c->rng = 0x9e3779b97f4a7c15u;
+    if (in->point_count < 3 || in->insert_count > in->point_count)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad point counts");
+    c->t = mci_malloc_array(ctx, 1 + 2 * in->insert_count, sizeof *c->t);
+    c->vt = mci_malloc_array(ctx, in->point_count, sizeof *c->vt);
+    if (!c->t || !c->vt)
+        return mci_fail_nomem(err, "triangulating a face");
+    for (size_t i = 0; i < in->point_count; i++)
+        c->vt[i] = i < 3 ? 0 : NONE;
+    c->t[0] = (tri){{0, 1, 2}, {NONE, NONE, NONE}, 0};
+    c->count = 1;
+    return MCSG_OK;
+}
+
+mcsg_status mci_triangulate(const mci_ctx *ctx, const mci_cdt_input *in, mci_cdt_output *out,
+                            mcsg_error *err)
+{
+    cdt c;
+    mcsg_status st = setup(&c, ctx, in, err);
+    if (st == MCSG_OK)
+        st = insert_points(&c, err);
+    for (size_t k = 0; st == MCSG_OK && k < in->edge_count; k++)
+        st = insert_constraint(&c, in->edges[2 * k], in->edges[2 * k + 1], err);
+    out->tris = NULL;
+    out->tri_count = 0;
+    if (st == MCSG_OK) {
+        out->tris = mci_malloc_array(ctx, c.count, 3 * sizeof *out->tris);
+        if (!out->tris)
+            st = mci_fail_nomem(err, "triangulating a face");
+        for (size_t k = 0; st == MCSG_OK && k < c.count; k++)
+            memcpy(out->tris + 3 * k, c.t[k].v, sizeof c.t[k].v);
+        out->tri_count = st == MCSG_OK ? c.count : 0;
+    }
+    mci_free(ctx, c.t);
+    mci_free(ctx, c.vt);
+    mci_free(ctx, c.queue);
+    return st;
+}
