@@ -343,8 +343,10 @@ mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *nam
 /* Intersection curves (the first stage of evaluation, exposed for inspection)           */
 
 /* Polylines as points and segments: segment i joins points segments[2i] and
- * segments[2i+1]. Each exact intersection point appears once, however many faces produced
- * it; its coordinates are approximated in double precision (for display: the exactly
+ * segments[2i+1]. The segments are the pieces of the curves where faces of different
+ * leaves cross, and the edges of coplanar faces of other leaves clipped to each face, all
+ * split at every point where they meet (triple points included). Each exact point
+ * appears once, however many faces produced it; its coordinates are approximated in double precision (for display: the exactly
  * rounded output comes with evaluation). */
 typedef struct mcsg_curves {
     double *points;
@@ -361,7 +363,8 @@ typedef struct mcsg_intersect_stats {
     size_t intersecting_pairs; /* pairs that cross along a segment */
     size_t point_contacts;     /* pairs touching at a single point */
     size_t coplanar_pairs;     /* coplanar pairs with overlapping interiors */
-    double seconds_octree, seconds_pairs, seconds_intersect, seconds_merge;
+    size_t arranged_faces;     /* faces cut by curves or holding points on their edges */
+    double seconds_octree, seconds_pairs, seconds_intersect, seconds_arrange, seconds_merge;
 } mcsg_intersect_stats;
 
 /* Intersect the faces of different leaves of `tree` (the operations are ignored): octree

@@ -308,6 +308,30 @@ void mci_point_approx(const mci_point *p, double out[3])
         out[k] = p->v[0][k] + p->y[k].v / p->w.v;
 }
 
+void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
+{
+    double wl = p->w.v - p->w.e, wh = p->w.v + p->w.e;
+    for (int k = 0; k < 3; k++) {
+        double base = p->v[0][k], yl, yh, ql, qh, slack;
+        lo[k] = hi[k] = base;
+        if (p->kind == MCI_POINT_EXPLICIT)
+            continue;
+        yl = p->y[k].v - p->y[k].e;
+        yh = p->y[k].v + p->y[k].e;
+        /* Interval quotient for W > 0; the slack covers the rounding of these few
+         * operations (relative) and underflow (absolute). */
+        ql = yl >= 0 ? yl / wh : yl / wl;
+        qh = yh >= 0 ? yh / wl : yh / wh;
+        slack = 0x1p-48 * (fabs(base) + fmax(fabs(ql), fabs(qh))) + 0x1p-1060;
+        lo[k] = base + ql - slack;
+        hi[k] = base + qh + slack;
+        if (!(wl > 0) || !(lo[k] <= hi[k])) {
+            lo[k] = -INFINITY;
+            hi[k] = INFINITY;
+        }
+    }
+}
+
 /* Offset of p from `origin`, scaled by p's W: (base - origin) W + Y. */
 static void fv_offset(const mci_point *p, const double *origin, mci_fv out[3])
 {

@@ -127,6 +127,10 @@ mci_containment mci_point_in_triangle(const mci_point *p, const mci_plane *trian
  * output only after rounding decisions elsewhere, and for display). */
 void mci_point_approx(const mci_point *p, double out[3]);
 
+/* A box certainly containing the point (possibly infinite when the cached W is too
+ * uncertain). For culling only: decisions stay with the predicates. */
+void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);
+
 /* Each predicate above is the combination of two stages, exposed for tests (which check
  * the exact stage on every case, not only where the filter gives up) and benchmarks
  * (which measure how often the filter decides):

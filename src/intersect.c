@@ -1,21 +1,28 @@
 /*
- * The intersection stage over a whole scene (paper §3.2, §4): octree, candidate pairs,
- * exact triangle-triangle intersection of each pair once, and exact merging of
- * coincident points (sorting by the exact lexicographic order, so that one geometric
- * point becomes one vertex whatever faces and definitions produced it).
+ * The intersection stage over a whole scene (see scene.h): octree (paper §3.1),
+ * candidate pairs (§3.2), exact triangle-triangle intersection of each pair once
+ * (§4.1), per-face records turned into arrangements (§4.2), points on a face's edge
+ * given to the face across that edge (so both tessellations have them: no T-junctions),
+ * and one number per distinct point over the whole scene (exact identity, not welding
+ * by distance).
  */
 #include "intersect.h"
-#include "octree.h"
+#include "scene.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-typedef struct scene_curves {
-    const mci_ctx *ctx;
-    mci_point *points; /* segment ends before merging: 2 per segment */
-    size_t point_count, point_capacity;
-    mcsg_intersect_stats stats;
-} scene_curves;
+typedef struct pair_hit {
+    uint32_t f, g;
+    uint8_t kind; /* mci_tt_kind */
+    mci_point end[2];
+} pair_hit;
+
+typedef struct hit_list {
+    pair_hit *v;
+    size_t count, capacity;
+} hit_list;
 
 static double seconds_now(void)
 {
@@ -24,105 +31,533 @@ static double seconds_now(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-static bool push_segment(scene_curves *c, const mci_point *a, const mci_point *b)
+const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
 {
-    if (c->point_count + 2 > c->point_capacity) {
-        size_t cap = c->point_capacity ? 2 * c->point_capacity : 1024;
-        mci_point *grown = mci_realloc_array(c->ctx, c->points, cap, sizeof *grown);
+    return mci_octree_face_vertex(&scene->octree, f, k);
+}
+
+static void face_plane(const mci_scene *s, uint32_t f, mci_plane *plane)
+{
+    mci_plane_init(plane, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
+                   mci_scene_corner(s, f, 2));
+}
+
+static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
+                     const mci_tt_result *r)
+{
+    if (h->count == h->capacity) {
+        size_t cap = h->capacity ? 2 * h->capacity : 1024;
+        pair_hit *grown = mci_realloc_array(ctx, h->v, cap, sizeof *grown);
         if (!grown)
             return false;
-        c->points = grown;
-        c->point_capacity = cap;
+        h->v = grown;
+        h->capacity = cap;
     }
-    c->points[c->point_count++] = *a;
-    c->points[c->point_count++] = *b;
+    h->v[h->count].f = f;
+    h->v[h->count].g = g;
+    h->v[h->count].kind = (uint8_t)r->kind;
+    h->v[h->count].end[0] = r->end[0];
+    h->v[h->count++].end[1] = r->end[1];
     return true;
 }
 
-static void face_plane(const mci_octree *t, uint32_t f, mci_plane *plane)
-{
-    mci_plane_init(plane, mci_octree_face_vertex(t, f, 0), mci_octree_face_vertex(t, f, 1),
-                   mci_octree_face_vertex(t, f, 2));
-}
-
-static bool intersect_pairs(scene_curves *c, const mci_octree *t, const uint64_t *pairs,
-                            size_t count)
+/* Every coplanar pair is kept, touching or not: faces that only share an edge still
+ * exchange the points on it. */
+static bool intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
+                            size_t count, hit_list *hits)
 {
     for (size_t i = 0; i < count; i++) {
+        uint32_t f = (uint32_t)(pairs[i] >> 32), g = (uint32_t)pairs[i];
         mci_plane p1, p2;
         mci_tt_result r;
-        face_plane(t, (uint32_t)(pairs[i] >> 32), &p1);
-        face_plane(t, (uint32_t)pairs[i], &p2);
+        face_plane(s, f, &p1);
+        face_plane(s, g, &p2);
         mci_triangle_intersection(&p1, &p2, &r);
-        if (r.kind == MCI_TT_SEGMENT) {
-            c->stats.intersecting_pairs++;
-            if (!push_segment(c, &r.end[0], &r.end[1]))
-                return false;
-        }
-        c->stats.point_contacts += r.kind == MCI_TT_POINT;
-        c->stats.coplanar_pairs += r.kind == MCI_TT_COPLANAR && r.overlap;
+        s->stats.intersecting_pairs += r.kind == MCI_TT_SEGMENT;
+        s->stats.point_contacts += r.kind == MCI_TT_POINT;
+        s->stats.coplanar_pairs += r.kind == MCI_TT_COPLANAR && r.overlap;
+        if (r.kind != MCI_TT_DISJOINT && !push_hit(ctx, hits, f, g, &r))
+            return false;
     }
     return true;
 }
 
-/* Merge sort of point indices by the exact lexicographic order (C11 has no qsort with
- * a context argument). */
-static void sort_by_position(const mci_point *points, uint32_t *idx, uint32_t *tmp, size_t n)
+/* ---------------------------------------------------------------------------------- */
+/* Face adjacency                                                                      */
+
+typedef struct edge_key {
+    uint64_t key; /* (canonical start << 32) | canonical end */
+    uint32_t slot; /* 3 * face + edge */
+} edge_key;
+
+static int compare_edge_keys(const void *x, const void *y)
 {
-    for (size_t width = 1; width < n; width *= 2) {
-        for (size_t lo = 0; lo < n; lo += 2 * width) {
-            size_t mid = lo + width < n ? lo + width : n;
-            size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
-            size_t i = lo, j = mid, k = lo;
-            while (i < mid && j < hi)
-                tmp[k++] = mci_compare_lex(&points[idx[j]], &points[idx[i]]) < 0 ? idx[j++]
-                                                                                : idx[i++];
-            while (i < mid)
-                tmp[k++] = idx[i++];
-            while (j < hi)
-                tmp[k++] = idx[j++];
+    const edge_key *a = x, *b = y;
+    if (a->key != b->key)
+        return (a->key > b->key) - (a->key < b->key);
+    return (a->slot > b->slot) - (a->slot < b->slot);
+}
+
+typedef struct vertex_ref {
+    double x[3];
+    uint32_t index;
+} vertex_ref;
+
+static int compare_vertex_refs(const void *p, const void *q)
+{
+    const vertex_ref *a = p, *b = q;
+    for (int k = 0; k < 3; k++)
+        if (a->x[k] != b->x[k])
+            return a->x[k] < b->x[k] ? -1 : 1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+/* canon[v]: the first vertex with the same coordinates (meshes need not share them). */
+static uint32_t *canonical_vertices(const mci_ctx *ctx, const mcsg_mesh *m)
+{
+    vertex_ref *refs = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *refs);
+    uint32_t *canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *canon);
+    if (!refs || !canon) {
+        mci_free(ctx, refs);
+        mci_free(ctx, canon);
+        return NULL;
+    }
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        memcpy(refs[v].x, m->vertices + 3 * v, sizeof refs[v].x);
+        refs[v].index = (uint32_t)v;
+    }
+    if (m->vertex_count > 0)
+        qsort(refs, m->vertex_count, sizeof *refs, compare_vertex_refs);
+    for (size_t i = 0, first = 0; i < m->vertex_count; i++) {
+        if (refs[i].x[0] != refs[first].x[0] || refs[i].x[1] != refs[first].x[1] ||
+            refs[i].x[2] != refs[first].x[2])
+            first = i;
+        canon[refs[i].index] = refs[first].index;
+    }
+    mci_free(ctx, refs);
+    return canon;
+}
+
+static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf)
+{
+    const mcsg_mesh *m = s->octree.leaves[leaf];
+    uint32_t base = s->octree.face_base[leaf], *canon = canonical_vertices(ctx, m);
+    edge_key *keys = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *keys);
+    size_t n = 3 * m->triangle_count;
+    if (!canon || !keys) {
+        mci_free(ctx, canon);
+        mci_free(ctx, keys);
+        return false;
+    }
+    for (size_t e = 0; e < n; e++) {
+        uint64_t u = canon[m->triangles[e]], w = canon[m->triangles[e % 3 == 2 ? e - 2 : e + 1]];
+        keys[e] = (edge_key){u << 32 | w, (uint32_t)e};
+    }
+    if (n > 0)
+        qsort(keys, n, sizeof *keys, compare_edge_keys);
+    for (size_t e = 0; e < n; e++) {
+        uint64_t u = canon[m->triangles[e]], w = canon[m->triangles[e % 3 == 2 ? e - 2 : e + 1]];
+        edge_key want = {w << 32 | u, 0};
+        const edge_key *hit = NULL;
+        size_t lo = 0, hi = n;
+        while (lo < hi) { /* first key >= want */
+            size_t mid = lo + (hi - lo) / 2;
+            if (compare_edge_keys(&keys[mid], &want) < 0)
+                lo = mid + 1;
+            else
+                hi = mid;
         }
-        memcpy(idx, tmp, n * sizeof *idx);
+        if (lo < n && keys[lo].key == want.key)
+            hit = &keys[lo];
+        s->neighbour[3 * (size_t)base + e] = hit ? base + hit->slot / 3 : MCI_NONE;
+    }
+    mci_free(ctx, canon);
+    mci_free(ctx, keys);
+    return true;
+}
+
+static bool build_neighbours(const mci_ctx *ctx, mci_scene *s)
+{
+    s->neighbour = mci_malloc_array(ctx, 3 * s->face_count + 1, sizeof *s->neighbour);
+    if (!s->neighbour)
+        return false;
+    for (size_t leaf = 0; leaf < s->octree.leaf_count; leaf++)
+        if (!leaf_neighbours(ctx, s, leaf))
+            return false;
+    return true;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Arrangements                                                                        */
+
+/* hit_start[f] .. hit_start[f + 1]: indices of the hits face f takes part in. */
+static bool index_hits(const mci_ctx *ctx, const mci_scene *s, const hit_list *hits,
+                       uint32_t **start_out, uint32_t **list_out)
+{
+    uint32_t *start = mci_calloc_array(ctx, s->face_count + 2, sizeof *start);
+    uint32_t *list = mci_malloc_array(ctx, 2 * hits->count + 1, sizeof *list);
+    if (!start || !list) {
+        mci_free(ctx, start);
+        mci_free(ctx, list);
+        return false;
+    }
+    for (size_t h = 0; h < hits->count; h++) {
+        start[hits->v[h].f + 2]++;
+        start[hits->v[h].g + 2]++;
+    }
+    for (size_t f = 2; f < s->face_count + 2; f++)
+        start[f] += start[f - 1];
+    for (size_t h = 0; h < hits->count; h++) {
+        list[start[hits->v[h].f + 1]++] = (uint32_t)h;
+        list[start[hits->v[h].g + 1]++] = (uint32_t)h;
+    }
+    *start_out = start;
+    *list_out = list;
+    return true;
+}
+
+/* Whether the surface bends at edge i of face f (the face across is not coplanar; an
+ * open edge counts as a crease). */
+static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t f, int i)
+{
+    uint32_t nb = s->neighbour[3 * (size_t)f + i];
+    mci_point far;
+    if (nb == MCI_NONE)
+        return true;
+    for (int k = 0; k < 3; k++) {
+        const double *v = mci_scene_corner(s, nb, k);
+        if (v == plane->a || v == plane->b || v == plane->c)
+            continue;
+        mci_point_explicit(&far, v);
+        if (mci_orient3d(&far, plane) != 0)
+            return true;
+    }
+    return false;
+}
+
+static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
+                    const pair_hit *h)
+{
+    uint32_t other = h->f == arr->face ? h->g : h->f;
+    mci_plane plane;
+    bool crease[3];
+    face_plane(s, other, &plane);
+    switch (h->kind) {
+    case MCI_TT_SEGMENT:
+        return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, &plane);
+    case MCI_TT_POINT:
+        return mci_arr_add_point(ctx, arr, &h->end[0]);
+    default:
+        for (int i = 0; i < 3; i++)
+            crease[i] = edge_is_crease(s, &plane, other, i);
+        return mci_arr_add_coplanar(ctx, arr, other, &plane, crease);
     }
 }
 
-/* Number the distinct points; out->segments refer to them. */
-static bool merge_points(scene_curves *c, mcsg_curves *out)
+static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t f,
+                                const hit_list *hits, const uint32_t *ids, size_t n,
+                                mci_face_arr *arr, mcsg_error *err)
 {
-    size_t n = c->point_count, unique = 0;
-    uint32_t *idx = mci_malloc_array(c->ctx, n, sizeof *idx);
-    uint32_t *tmp = mci_malloc_array(c->ctx, n, sizeof *tmp);
-    uint32_t *id = mci_malloc_array(c->ctx, n, sizeof *id);
-    bool ok = idx && tmp && id;
-    for (size_t i = 0; ok && i < n; i++)
-        idx[i] = (uint32_t)i;
-    if (ok)
-        sort_by_position(c->points, idx, tmp, n);
-    for (size_t i = 0; ok && i < n; i++) {
-        if (i > 0 && !mci_points_equal(&c->points[idx[i]], &c->points[idx[i - 1]]))
-            unique++;
-        id[idx[i]] = (uint32_t)unique;
+    size_t coplanar = 0;
+    mcsg_status st;
+    for (size_t i = 0; i < n; i++)
+        coplanar += hits->v[ids[i]].kind == MCI_TT_COPLANAR;
+    st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
+                      mci_scene_corner(s, f, 2), coplanar, err);
+    for (size_t i = 0; st == MCSG_OK && i < n; i++)
+        if (!add_hit(ctx, s, arr, &hits->v[ids[i]]))
+            st = mci_fail_nomem(err, "arranging faces");
+    return st == MCSG_OK ? mci_arr_merge(ctx, arr, err) : st;
+}
+
+/* Faces that are untouched themselves but receive a point on an edge. */
+static void mark_receivers(const mci_scene *s, bool *needs)
+{
+    for (size_t k = 0; k < s->arr_count; k++) {
+        const mci_face_arr *arr = &s->arrs[k];
+        for (size_t p = 3; p < arr->point_count; p++) {
+            uint32_t nb;
+            if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
+                continue;
+            nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
+            if (nb != MCI_NONE && s->arr_of[nb] == MCI_NONE)
+                needs[nb] = true;
+        }
     }
-    unique += n > 0;
-    out->points = ok ? mci_malloc_array(c->ctx, unique, 3 * sizeof(double)) : NULL;
-    out->segments = ok ? mci_malloc_array(c->ctx, n, sizeof(uint32_t)) : NULL;
-    ok = ok && out->points && out->segments;
-    for (size_t i = 0; ok && i < n; i++) {
-        out->segments[i] = id[i];
-        mci_point_approx(&c->points[i], out->points + 3 * (size_t)id[i]);
+}
+
+/* Rebuild arrs in face order with new (empty) arrangements for the marked faces. */
+static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *needs,
+                                 mcsg_error *err)
+{
+    size_t extra = 0, k = 0, out = 0;
+    mci_face_arr *all;
+    mcsg_status st = MCSG_OK;
+    for (size_t f = 0; f < s->face_count; f++)
+        extra += needs[f];
+    if (extra == 0)
+        return MCSG_OK;
+    all = mci_calloc_array(ctx, s->arr_count + extra, sizeof *all);
+    if (!all)
+        return mci_fail_nomem(err, "arranging faces");
+    for (uint32_t f = 0; f < s->face_count; f++) {
+        if (s->arr_of[f] != MCI_NONE) {
+            all[out] = s->arrs[k++];
+        } else if (needs[f] && st == MCSG_OK) {
+            st = mci_arr_init(ctx, &all[out], f, mci_scene_corner(s, f, 0),
+                              mci_scene_corner(s, f, 1), mci_scene_corner(s, f, 2), 0, err);
+        } else {
+            continue;
+        }
+        s->arr_of[f] = (uint32_t)out++;
     }
-    if (!ok) {
-        mci_free(c->ctx, out->points);
-        mci_free(c->ctx, out->segments);
-        out->points = NULL;
-        out->segments = NULL;
+    mci_free(ctx, s->arrs);
+    s->arrs = all;
+    s->arr_count = out;
+    return st;
+}
+
+static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    bool *needs = mci_calloc_array(ctx, s->face_count + 1, sizeof *needs);
+    size_t count;
+    mcsg_status st;
+    if (!needs)
+        return mci_fail_nomem(err, "arranging faces");
+    mark_receivers(s, needs);
+    st = add_receivers(ctx, s, needs, err);
+    mci_free(ctx, needs);
+    count = s->arr_count;
+    for (size_t k = 0; st == MCSG_OK && k < count; k++) {
+        const mci_face_arr *arr = &s->arrs[k];
+        for (size_t p = 3; p < arr->point_count && !arr->dirty; p++) {
+            uint32_t nb;
+            if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
+                continue;
+            nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
+            if (nb != MCI_NONE &&
+                !mci_arr_add_point(ctx, &s->arrs[s->arr_of[nb]], &arr->points[p]))
+                st = mci_fail_nomem(err, "arranging faces");
+        }
     }
-    out->point_count = ok ? unique : 0;
-    out->segment_count = ok ? n / 2 : 0;
-    mci_free(c->ctx, idx);
-    mci_free(c->ctx, tmp);
-    mci_free(c->ctx, id);
-    return ok;
+    return st;
+}
+
+static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
+                                      mcsg_error *err)
+{
+    uint32_t *start = NULL, *list = NULL;
+    mcsg_status st = MCSG_OK;
+    s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
+    if (!s->arr_of || !index_hits(ctx, s, hits, &start, &list))
+        return mci_fail_nomem(err, "arranging faces");
+    for (uint32_t f = 0; f < s->face_count; f++)
+        s->arr_count += start[f + 1] > start[f];
+    s->arrs = mci_calloc_array(ctx, s->arr_count + 1, sizeof *s->arrs);
+    if (!s->arrs)
+        st = mci_fail_nomem(err, "arranging faces");
+    for (uint32_t f = 0, k = 0; f < s->face_count; f++) {
+        s->arr_of[f] = MCI_NONE;
+        if (start[f + 1] == start[f] || st != MCSG_OK)
+            continue;
+        s->arr_of[f] = k;
+        st = arrange_face(ctx, s, f, hits, list + start[f], start[f + 1] - start[f],
+                          &s->arrs[k++], err);
+    }
+    mci_free(ctx, start);
+    mci_free(ctx, list);
+    if (st == MCSG_OK)
+        st = share_edge_points(ctx, s, err);
+    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++)
+        st = mci_arr_split(ctx, &s->arrs[k], err);
+    return st;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* The whole stage                                                                     */
+
+static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    uint64_t *pairs = NULL;
+    size_t count = 0;
+    hit_list hits = {NULL, 0, 0};
+    double t0 = seconds_now(), t1, t2;
+    mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);
+    if (st != MCSG_OK)
+        return st;
+    t1 = seconds_now();
+    s->stats.candidate_pairs = count;
+    if (!intersect_pairs(ctx, s, pairs, count, &hits))
+        st = mci_fail_nomem(err, "intersecting faces");
+    mci_free(ctx, pairs);
+    t2 = seconds_now();
+    if (st == MCSG_OK && !build_neighbours(ctx, s))
+        st = mci_fail_nomem(err, "finding neighbouring faces");
+    if (st == MCSG_OK)
+        st = build_arrangements(ctx, s, &hits, err);
+    mci_free(ctx, hits.v);
+    s->stats.seconds_pairs = t1 - t0;
+    s->stats.seconds_intersect = t2 - t1;
+    s->stats.seconds_arrange = seconds_now() - t2;
+    s->stats.arranged_faces = s->arr_count;
+    return st;
+}
+
+mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+                            size_t leaf_count, mci_scene *scene, mcsg_error *err)
+{
+    double t0 = seconds_now();
+    mcsg_status st;
+    memset(scene, 0, sizeof *scene);
+    st = mci_octree_build(ctx, leaves, leaf_count, NULL, &scene->octree, err);
+    if (st != MCSG_OK)
+        return st;
+    scene->stats.seconds_octree = seconds_now() - t0;
+    scene->face_count = scene->octree.face_base[scene->octree.leaf_count];
+    scene->stats.faces = scene->face_count;
+    scene->stats.cells = scene->octree.cell_count;
+    scene->stats.critical_cells = scene->octree.critical_leaf_cells;
+    st = intersect_scene(ctx, scene, err);
+    if (st != MCSG_OK)
+        mci_scene_free(ctx, scene);
+    return st;
+}
+
+void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
+{
+    for (size_t k = 0; scene->arrs && k < scene->arr_count; k++)
+        mci_arr_free(ctx, &scene->arrs[k]);
+    mci_free(ctx, scene->arrs);
+    mci_free(ctx, scene->arr_of);
+    mci_free(ctx, scene->neighbour);
+    mci_free(ctx, scene->gid_start);
+    mci_free(ctx, scene->gid);
+    mci_octree_free(ctx, &scene->octree);
+    memset(scene, 0, sizeof *scene);
+}
+
+mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    size_t total = 0, id = 0;
+    const mci_point **table;
+    uint32_t *order, *tmp;
+    double t0 = seconds_now();
+    for (size_t k = 0; k < s->arr_count; k++)
+        total += s->arrs[k].point_count;
+    if (total >= UINT32_MAX)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total);
+    s->gid_start = mci_malloc_array(ctx, s->arr_count + 1, sizeof *s->gid_start);
+    s->gid = mci_malloc_array(ctx, total + 1, sizeof *s->gid);
+    table = mci_malloc_array(ctx, total + 1, sizeof *table);
+    order = mci_malloc_array(ctx, total + 1, sizeof *order);
+    tmp = mci_malloc_array(ctx, total + 1, sizeof *tmp);
+    if (s->gid_start && s->gid && table && order && tmp) {
+        for (size_t k = 0, slot = 0; k < s->arr_count; k++) {
+            s->gid_start[k] = (uint32_t)slot;
+            for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {
+                table[slot] = &s->arrs[k].points[p];
+                order[slot] = (uint32_t)slot;
+            }
+        }
+        s->gid_start[s->arr_count] = (uint32_t)total;
+        mci_sort_point_ids(table, order, tmp, total);
+        for (size_t i = 0; i < total; i++) {
+            id += i > 0 && !mci_points_equal(table[order[i]], table[order[i - 1]]);
+            s->gid[order[i]] = (uint32_t)id;
+        }
+        s->point_count = total ? id + 1 : 0;
+    }
+    bool ok = s->gid_start && s->gid && table && order && tmp;
+    mci_free(ctx, table);
+    mci_free(ctx, order);
+    mci_free(ctx, tmp);
+    s->stats.seconds_merge = seconds_now() - t0;
+    return ok ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Public entry: the curves                                                            */
+
+static int compare_u64(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* Every elementary edge of every arrangement, once (both faces along a curve have it). */
+static uint64_t *curve_edges(const mci_ctx *ctx, const mci_scene *s, size_t *count)
+{
+    size_t n = 0, out = 0;
+    uint64_t *keys;
+    for (size_t k = 0; k < s->arr_count; k++)
+        n += s->arrs[k].edge_count;
+    keys = mci_malloc_array(ctx, n + 1, sizeof *keys);
+    if (!keys)
+        return NULL;
+    for (size_t k = 0, i = 0; k < s->arr_count; k++) {
+        const uint32_t *gid = s->gid + s->gid_start[k];
+        for (size_t e = 0; e < s->arrs[k].edge_count; e++) {
+            uint64_t a = gid[s->arrs[k].edges[e].a], b = gid[s->arrs[k].edges[e].b];
+            keys[i++] = a < b ? a << 32 | b : b << 32 | a;
+        }
+    }
+    if (n > 0)
+        qsort(keys, n, sizeof *keys, compare_u64);
+    for (size_t i = 0; i < n; i++)
+        if (out == 0 || keys[i] != keys[out - 1])
+            keys[out++] = keys[i];
+    *count = out;
+    return keys;
+}
+
+/* Renumber the points the curves use, densely (corners off the curves are left out). */
+static size_t compact_points(const mci_scene *s, const uint64_t *keys, size_t count,
+                             uint32_t *new_id)
+{
+    size_t used = 0;
+    for (size_t i = 0; i < s->point_count; i++)
+        new_id[i] = MCI_NONE;
+    for (size_t i = 0; i < 2 * count; i++) {
+        uint32_t g = (uint32_t)(i % 2 ? keys[i / 2] : keys[i / 2] >> 32);
+        if (new_id[g] == MCI_NONE)
+            new_id[g] = (uint32_t)used++;
+    }
+    return used;
+}
+
+static mcsg_status export_curves(const mci_ctx *ctx, const mci_scene *s, mcsg_curves *out,
+                                 mcsg_error *err)
+{
+    size_t count = 0, used = 0;
+    uint64_t *keys = curve_edges(ctx, s, &count);
+    uint32_t *new_id = mci_malloc_array(ctx, s->point_count + 1, sizeof *new_id);
+    if (keys && new_id)
+        used = compact_points(s, keys, count, new_id);
+    out->points = mci_malloc_array(ctx, used + 1, 3 * sizeof(double));
+    out->segments = mci_malloc_array(ctx, 2 * count + 1, sizeof(uint32_t));
+    if (!keys || !new_id || !out->points || !out->segments) {
+        mci_free(ctx, keys);
+        mci_free(ctx, new_id);
+        mci_free(ctx, out->points);
+        mci_free(ctx, out->segments);
+        memset(out, 0, sizeof *out);
+        return mci_fail_nomem(err, "collecting the curves");
+    }
+    for (size_t k = 0; k < s->arr_count; k++)
+        for (size_t p = 0; p < s->arrs[k].point_count; p++) {
+            uint32_t id = new_id[s->gid[s->gid_start[k] + p]];
+            if (id != MCI_NONE)
+                mci_point_approx(&s->arrs[k].points[p], out->points + 3 * (size_t)id);
+        }
+    for (size_t i = 0; i < count; i++) {
+        out->segments[2 * i] = new_id[keys[i] >> 32];
+        out->segments[2 * i + 1] = new_id[(uint32_t)keys[i]];
+    }
+    out->point_count = used;
+    out->segment_count = count;
+    mci_free(ctx, keys);
+    mci_free(ctx, new_id);
+    return MCSG_OK;
 }
 
 static size_t collect_leaves(const mcsg_tree *tree, const mcsg_mesh **leaves)
@@ -136,60 +571,30 @@ static size_t collect_leaves(const mcsg_tree *tree, const mcsg_mesh **leaves)
     return n;
 }
 
-static mcsg_status run_stages(scene_curves *c, const mci_octree *t, mcsg_curves *out,
-                              mcsg_error *err)
-{
-    uint64_t *pairs = NULL;
-    size_t count = 0;
-    double t0 = seconds_now(), t1, t2;
-    mcsg_status st = mci_octree_candidate_pairs(c->ctx, t, &pairs, &count, err);
-    if (st != MCSG_OK)
-        return st;
-    t1 = seconds_now();
-    c->stats.candidate_pairs = count;
-    if (!intersect_pairs(c, t, pairs, count) || (t2 = seconds_now(), !merge_points(c, out))) {
-        mci_free(c->ctx, pairs);
-        return mci_fail_nomem(err, "intersecting faces");
-    }
-    c->stats.seconds_pairs = t1 - t0;
-    c->stats.seconds_intersect = t2 - t1;
-    c->stats.seconds_merge = seconds_now() - t2;
-    mci_free(c->ctx, pairs);
-    return MCSG_OK;
-}
-
 mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg_curves *out,
                            mcsg_intersect_stats *stats, mcsg_error *err)
 {
     mci_ctx ctx;
-    scene_curves c;
-    mci_octree octree;
+    mci_scene scene;
     const mcsg_mesh **leaves;
     mcsg_status st;
-    double t0;
     mci_ctx_init(&ctx, opts);
     memset(out, 0, sizeof *out);
-    memset(&c, 0, sizeof c);
-    c.ctx = &ctx;
+    memset(&scene, 0, sizeof scene);
     if (!tree)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_intersect: NULL tree");
     leaves = mci_malloc_array(&ctx, mcsg_tree_node_count(tree) + 1, sizeof *leaves);
     if (!leaves)
         return mci_fail_nomem(err, "intersecting faces");
-    t0 = seconds_now();
-    st = mci_octree_build(&ctx, leaves, collect_leaves(tree, leaves), NULL, &octree, err);
-    if (st == MCSG_OK) {
-        c.stats.seconds_octree = seconds_now() - t0;
-        c.stats.faces = octree.face_base[octree.leaf_count];
-        c.stats.cells = octree.cell_count;
-        c.stats.critical_cells = octree.critical_leaf_cells;
-        st = run_stages(&c, &octree, out, err);
-        mci_octree_free(&ctx, &octree);
-    }
-    mci_free(&ctx, c.points);
-    mci_free(&ctx, leaves);
+    st = mci_scene_build(&ctx, leaves, collect_leaves(tree, leaves), &scene, err);
+    if (st == MCSG_OK)
+        st = mci_scene_number_points(&ctx, &scene, err);
+    if (st == MCSG_OK)
+        st = export_curves(&ctx, &scene, out, err);
     if (stats)
-        *stats = c.stats;
+        *stats = scene.stats;
+    mci_scene_free(&ctx, &scene);
+    mci_free(&ctx, leaves);
     return st;
 }
 

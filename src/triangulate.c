@@ -255,7 +255,8 @@ static uint64_t *insertion_order(const mci_ctx *ctx, const mci_cdt_input *in)
     span[1] = hi[1] - lo[1];
     for (size_t i = 0; i < in->insert_count; i++)
         order[i] = (uint64_t)insertion_key(in, lo, span, in->insert[i]) << 32 | i;
-    qsort(order, in->insert_count, sizeof *order, compare_u64);
+    if (in->insert_count > 0)
+        qsort(order, in->insert_count, sizeof *order, compare_u64);
     return order;
 }
 

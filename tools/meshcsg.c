@@ -417,10 +417,11 @@ static void print_intersect_stats(const mcsg_intersect_stats *s, const mcsg_curv
     printf("candidate pairs %zu, intersecting pairs %zu, single-point contacts %zu, "
            "coplanar overlapping pairs %zu\n", s->candidate_pairs, s->intersecting_pairs,
            s->point_contacts, s->coplanar_pairs);
-    printf("segments %zu, distinct points %zu, points of odd degree %zu\n",
-           c->segment_count, c->point_count, odd_degree_points(c));
-    printf("time: octree %.3f s, pairs %.3f s, intersect %.3f s, merge %.3f s\n",
-           s->seconds_octree, s->seconds_pairs, s->seconds_intersect, s->seconds_merge);
+    printf("arranged faces %zu, segments %zu, distinct points %zu, points of odd degree %zu\n",
+           s->arranged_faces, c->segment_count, c->point_count, odd_degree_points(c));
+    printf("time: octree %.3f s, pairs %.3f s, intersect %.3f s, arrange %.3f s, "
+           "merge %.3f s\n", s->seconds_octree, s->seconds_pairs, s->seconds_intersect,
+           s->seconds_arrange, s->seconds_merge);
 }
 
 static int cmd_intersect(int argc, char **argv)

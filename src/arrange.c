@@ -1,0 +1,701 @@
+/*
+ * Per-face arrangement (paper §4.2, §5.4; design brief §3), exact throughout:
+ *
+ *   inputs     crossing segments (this face ∩ another leaf's face), single contact
+ *              points, coplanar faces of other leaves (their edges clipped to this
+ *              face), points on this face's edges found by its neighbours;
+ *   merge      coincident points become one (exact lexicographic sort + equality),
+ *              each point classified as corner / on edge i / inside;
+ *   split      every segment is cut at each point lying inside it and at each proper
+ *              crossing with another segment; a crossing is a new implicit point
+ *              (TPI of this face's plane and the two segments' planes, or the LPI of a
+ *              coplanar edge line with the other segment's plane), so triple points of
+ *              three leaves come out exactly;
+ *   triangulate  any subset of the elementary edges (triangulate.c).
+ *
+ * Every segment's line is the intersection of this face's plane with a second plane:
+ * the other face's plane for a crossing, and for a coplanar edge u-v the plane through
+ * u, v and an auxiliary vertex `aux` = u moved along the projection axis (so off this
+ * face's plane: the plane contains the edge and is transversal to the face). The
+ * auxiliary vertices are stored in the arrangement so that points may refer to them.
+ *
+ * Candidate pairs for splitting come from a sweep over certified bounding boxes
+ * (mci_point_bounds), so a face crossed by thousands of segments is not quadratic
+ * unless their boxes overlap.
+ */
+#include "arrange.h"
+#include "triangulate.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double *corner(const mci_face_arr *arr, int i)
+{
+    return i == 0 ? arr->plane.a : i == 1 ? arr->plane.b : arr->plane.c;
+}
+
+/* A vertex off the face's plane: x moved along the projection axis. */
+static const double *add_aux(mci_face_arr *arr, const double *x)
+{
+    double *r;
+    if (arr->aux_count == arr->aux_capacity)
+        return NULL;
+    r = arr->aux[arr->aux_count++];
+    memcpy(r, x, 3 * sizeof *r);
+    r[arr->axis] = x[arr->axis] + 1.0 != x[arr->axis] ? x[arr->axis] + 1.0
+                                                      : x[arr->axis] / 2; /* |x| >= 2^53 */
+    return r;
+}
+
+mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
+                         const double *a, const double *b, const double *c,
+                         size_t max_coplanar, mcsg_error *err)
+{
+    memset(arr, 0, sizeof *arr);
+    arr->face = face;
+    mci_plane_init(&arr->plane, a, b, c);
+    arr->axis = mci_plane_projection_axis(&arr->plane, &arr->sign);
+    if (arr->axis < 0)
+        return mci_fail(err, MCSG_ERR_INVALID_MESH, "face %u is degenerate", face);
+    arr->aux_capacity = 3 + 3 * max_coplanar;
+    arr->aux = mci_malloc_array(ctx, arr->aux_capacity, sizeof *arr->aux);
+    if (!arr->aux)
+        return mci_fail_nomem(err, "arranging a face");
+    for (int i = 0; i < 3; i++) {
+        mci_point p;
+        mci_point_explicit(&p, corner(arr, i));
+        add_aux(arr, corner(arr, i)); /* aux[i]: for the face's edge i */
+        if (!mci_arr_add_point(ctx, arr, &p)) {
+            mci_arr_free(ctx, arr);
+            return mci_fail_nomem(err, "arranging a face");
+        }
+    }
+    return MCSG_OK;
+}
+
+void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
+{
+    mci_free(ctx, arr->points);
+    mci_free(ctx, arr->where);
+    mci_free(ctx, arr->segments);
+    mci_free(ctx, arr->edges);
+    mci_free(ctx, arr->aux);
+    mci_free(ctx, arr->tris);
+    memset(arr, 0, sizeof *arr);
+}
+
+static bool grow(const mci_ctx *ctx, void **data, size_t *capacity, size_t need, size_t size)
+{
+    size_t cap = *capacity ? *capacity : 8;
+    void *grown;
+    if (need <= *capacity)
+        return true;
+    while (cap < need)
+        cap *= 2;
+    grown = mci_realloc_array(ctx, *data, cap, size);
+    if (!grown)
+        return false;
+    *data = grown;
+    *capacity = cap;
+    return true;
+}
+
+bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    if (!grow(ctx, (void **)&arr->points, &arr->point_capacity, arr->point_count + 1,
+              sizeof *arr->points))
+        return false;
+    arr->points[arr->point_count++] = *p;
+    arr->dirty = true;
+    return true;
+}
+
+static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
+                        const mci_point *b, const mci_arr_segment *s)
+{
+    uint32_t ia = (uint32_t)arr->point_count;
+    if (!mci_arr_add_point(ctx, arr, a) || !mci_arr_add_point(ctx, arr, b) ||
+        !grow(ctx, (void **)&arr->segments, &arr->segment_capacity, arr->segment_count + 1,
+              sizeof *arr->segments))
+        return false;
+    arr->segments[arr->segment_count] = *s;
+    arr->segments[arr->segment_count].a = ia;
+    arr->segments[arr->segment_count++].b = ia + 1;
+    return true;
+}
+
+bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
+                          const mci_point *b, uint32_t other, const mci_plane *other_plane)
+{
+    mci_arr_segment s = {0, 0, other, 0, {other_plane->a, other_plane->b, other_plane->c}};
+    return add_segment(ctx, arr, a, b, &s);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Coplanar faces: clip each of their edges to this face                               */
+
+static int side_of_edge(const mci_face_arr *arr, int e, const mci_point *p)
+{
+    mci_point c0, c1;
+    mci_point_explicit(&c0, corner(arr, e));
+    mci_point_explicit(&c1, corner(arr, (e + 1) % 3));
+    return arr->sign * mci_orient2d_projected(&c0, &c1, p, arr->axis);
+}
+
+/* The part of the line u->v inside the face is [*start, *end]: each face edge the
+ * segment crosses moves one of them (entering or leaving). */
+typedef struct clip_state {
+    mci_point cut[3];
+    const mci_point *start, *end;
+    bool empty, on_boundary;
+} clip_state;
+
+static void clip_by_edge(mci_face_arr *arr, int e, const mci_point *pu, const mci_point *pv,
+                         clip_state *c)
+{
+    int su = side_of_edge(arr, e, pu), sv = side_of_edge(arr, e, pv);
+    const double *u = pu->v[0], *v = pv->v[0];
+    const mci_point *enter = NULL, *leave = NULL;
+    if (su == 0 && sv == 0) {
+        c->on_boundary = true;
+        return;
+    }
+    if (su < 0 && sv < 0) {
+        c->empty = true;
+        return;
+    }
+    if (su * sv < 0) {
+        mci_plane edge_plane;
+        mci_plane_init(&edge_plane, corner(arr, e), corner(arr, (e + 1) % 3), arr->aux[e]);
+        (void)mci_point_lpi(&c->cut[e], u, v, &edge_plane); /* strict sides: exists */
+        *(su < 0 ? &enter : &leave) = &c->cut[e];
+    } else if (su == 0 && sv < 0) {
+        leave = pu;
+    } else if (su < 0 && sv == 0) {
+        enter = pv;
+    }
+    if (enter && mci_order_on_edge_line(enter, c->start, u, v) > 0)
+        c->start = enter;
+    if (leave && mci_order_on_edge_line(leave, c->end, u, v) < 0)
+        c->end = leave;
+}
+
+static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
+                               const double *u, const double *v, bool crease)
+{
+    mci_point pu, pv;
+    clip_state c;
+    int order;
+    mci_point_explicit(&pu, u);
+    mci_point_explicit(&pv, v);
+    memset(&c, 0, sizeof c);
+    c.start = &pu;
+    c.end = &pv;
+    for (int e = 0; e < 3 && !c.empty; e++)
+        clip_by_edge(arr, e, &pu, &pv, &c);
+    if (c.empty || (order = mci_order_on_edge_line(c.start, c.end, u, v)) > 0)
+        return true;
+    if (order == 0)
+        return mci_arr_add_point(ctx, arr, c.start);
+    if (c.on_boundary || !crease)
+        return mci_arr_add_point(ctx, arr, c.start) && mci_arr_add_point(ctx, arr, c.end);
+    {
+        const double *aux = add_aux(arr, u);
+        mci_arr_segment s = {0, 0, other, 1, {u, v, aux}};
+        return aux && add_segment(ctx, arr, c.start, c.end, &s);
+    }
+}
+
+bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
+                          const mci_plane *other_plane, const bool crease[3])
+{
+    const double *v[3] = {other_plane->a, other_plane->b, other_plane->c};
+    for (int i = 0; i < 3; i++)
+        if (!clip_coplanar_edge(ctx, arr, other, v[i], v[(i + 1) % 3], crease[i]))
+            return false;
+    return true;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Exact merging                                                                       */
+
+void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n)
+{
+    for (size_t width = 1; width < n; width *= 2) {
+        for (size_t lo = 0; lo < n; lo += 2 * width) {
+            size_t mid = lo + width < n ? lo + width : n;
+            size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
+            size_t i = lo, j = mid, k = lo;
+            while (i < mid && j < hi)
+                tmp[k++] = mci_compare_lex(table[ids[j]], table[ids[i]]) < 0 ? ids[j++] : ids[i++];
+            while (i < mid)
+                tmp[k++] = ids[i++];
+            while (j < hi)
+                tmp[k++] = ids[j++];
+        }
+        memcpy(ids, tmp, n * sizeof *ids);
+    }
+}
+
+/* A table of pointers to the face's points, for mci_sort_point_ids. */
+static const mci_point **point_table(const mci_ctx *ctx, const mci_face_arr *arr)
+{
+    const mci_point **table = mci_malloc_array(ctx, arr->point_count + 1, sizeof *table);
+    for (size_t i = 0; table && i < arr->point_count; i++)
+        table[i] = &arr->points[i];
+    return table;
+}
+
+/* New id of every point after merging (corners keep 0..2, the rest follow in sorted
+ * order). Returns the number of distinct points. */
+static size_t merge_ids(const mci_face_arr *arr, const uint32_t *sorted, uint32_t *remap)
+{
+    size_t n = arr->point_count, next = 3;
+    for (size_t i = 0; i < n;) {
+        size_t j = i + 1;
+        uint32_t id = UINT32_MAX;
+        while (j < n && mci_points_equal(&arr->points[sorted[j]], &arr->points[sorted[i]]))
+            j++;
+        for (size_t k = i; k < j; k++)
+            if (sorted[k] < 3)
+                id = sorted[k];
+        if (id == UINT32_MAX)
+            id = (uint32_t)next++;
+        for (size_t k = i; k < j; k++)
+            remap[sorted[k]] = id;
+        i = j;
+    }
+    return next;
+}
+
+static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
+{
+    uint8_t *where = mci_realloc_array(ctx, arr->where, arr->point_count, 1);
+    if (!where)
+        return mci_fail_nomem(err, "arranging a face");
+    arr->where = where;
+    for (size_t i = 0; i < arr->point_count; i++) {
+        int which;
+        mci_containment c = i < 3 ? MCI_ON_VERTEX
+                                  : mci_point_in_triangle(&arr->points[i], &arr->plane, &which);
+        if (i < 3)
+            where[i] = (uint8_t)(MCI_AT_CORNER + i);
+        else if (c == MCI_INSIDE)
+            where[i] = MCI_AT_INSIDE;
+        else if (c == MCI_ON_EDGE)
+            where[i] = (uint8_t)(MCI_AT_EDGE + which);
+        else
+            return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a point is %s",
+                            arr->face, c == MCI_OUTSIDE ? "off the face" : "a corner twice");
+    }
+    return MCSG_OK;
+}
+
+/* Merge, and return the id map (old -> new) through *remap_out if wanted. */
+static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t **remap_out,
+                                mcsg_error *err)
+{
+    size_t n = arr->point_count, kept = 0;
+    const mci_point **table = point_table(ctx, arr);
+    uint32_t *idx = mci_malloc_array(ctx, n, sizeof *idx);
+    uint32_t *tmp = mci_malloc_array(ctx, n, sizeof *tmp);
+    uint32_t *remap = mci_malloc_array(ctx, n, sizeof *remap);
+    mci_point *merged = mci_malloc_array(ctx, n, sizeof *merged);
+    mcsg_status st = table && idx && tmp && remap && merged ? MCSG_OK
+                                                  : mci_fail_nomem(err, "arranging a face");
+    if (st == MCSG_OK) {
+        size_t out = 0;
+        for (size_t i = 0; i < n; i++)
+            idx[i] = (uint32_t)i;
+        mci_sort_point_ids(table, idx, tmp, n);
+        kept = merge_ids(arr, idx, remap);
+        for (size_t i = 0; i < n; i++)
+            merged[remap[i]] = arr->points[i];
+        for (size_t s = 0; s < arr->segment_count; s++) {
+            mci_arr_segment seg = arr->segments[s];
+            seg.a = remap[seg.a];
+            seg.b = remap[seg.b];
+            if (seg.a != seg.b)
+                arr->segments[out++] = seg;
+        }
+        arr->segment_count = out;
+        mci_free(ctx, arr->points);
+        arr->points = merged;
+        arr->point_count = arr->point_capacity = kept;
+        merged = NULL;
+        st = classify_points(ctx, arr, err);
+        arr->dirty = false;
+    }
+    if (remap_out && st == MCSG_OK)
+        *remap_out = remap;
+    else
+        mci_free(ctx, remap);
+    mci_free(ctx, table);
+    mci_free(ctx, idx);
+    mci_free(ctx, tmp);
+    mci_free(ctx, merged);
+    return st;
+}
+
+mcsg_status mci_arr_merge(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
+{
+    return merge_points(ctx, arr, NULL, err);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Splitting                                                                           */
+
+/* Orientation of three points of the face in its own orientation (0 for repeated ids,
+ * which also spares the exact stage a certain zero). */
+static int orient_ids(const mci_face_arr *arr, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (a == b || b == c || a == c)
+        return 0;
+    return arr->sign * mci_orient2d_projected(&arr->points[a], &arr->points[b],
+                                              &arr->points[c], arr->axis);
+}
+
+/* A sweep item: a segment or a lone point, with a certified box in the projection. */
+typedef struct sweep_item {
+    double lo[2], hi[2];
+    uint32_t id;
+    bool is_point;
+} sweep_item;
+
+typedef struct splitter {
+    const mci_ctx *ctx;
+    mci_face_arr *arr;
+    uint32_t (*cuts)[2]; /* (segment, point) */
+    size_t cut_count, cut_capacity;
+    bool ok;
+} splitter;
+
+static void cut(splitter *sp, uint32_t s, uint32_t p)
+{
+    if (!sp->ok || !grow(sp->ctx, (void **)&sp->cuts, &sp->cut_capacity, sp->cut_count + 1,
+                         sizeof *sp->cuts)) {
+        sp->ok = false;
+        return;
+    }
+    sp->cuts[sp->cut_count][0] = s;
+    sp->cuts[sp->cut_count++][1] = p;
+}
+
+/* Cut segment s at p if p, known to lie on its line, is strictly between its ends. */
+static void cut_if_inside(splitter *sp, uint32_t s, uint32_t p)
+{
+    const mci_arr_segment *seg = &sp->arr->segments[s];
+    const mci_point *pts = sp->arr->points;
+    if (p != seg->a && p != seg->b &&
+        mci_compare_lex(&pts[seg->a], &pts[p]) * mci_compare_lex(&pts[p], &pts[seg->b]) > 0)
+        cut(sp, s, p);
+}
+
+/* The crossing point of two segments that cross properly. */
+static bool crossing_point(const mci_face_arr *arr, const mci_arr_segment *s,
+                           const mci_arr_segment *t, mci_point *out)
+{
+    mci_plane ps, pt;
+    if (t->coplanar && !s->coplanar) {
+        const mci_arr_segment *swap = s;
+        s = t;
+        t = swap;
+    }
+    mci_plane_init(&pt, t->l[0], t->l[1], t->l[2]);
+    if (s->coplanar)
+        return mci_point_lpi(out, s->l[0], s->l[1], &pt);
+    mci_plane_init(&ps, s->l[0], s->l[1], s->l[2]);
+    return mci_point_tpi(out, &arr->plane, &ps, &pt);
+}
+
+static void relate_segments(splitter *sp, uint32_t s, uint32_t t)
+{
+    mci_face_arr *arr = sp->arr;
+    mci_arr_segment S = arr->segments[s], T = arr->segments[t];
+    int oc = orient_ids(arr, S.a, S.b, T.a), od = orient_ids(arr, S.a, S.b, T.b), oa, ob;
+    if (oc == 0 && od == 0) { /* collinear: each cuts the other at its ends */
+        cut_if_inside(sp, s, T.a);
+        cut_if_inside(sp, s, T.b);
+        cut_if_inside(sp, t, S.a);
+        cut_if_inside(sp, t, S.b);
+        return;
+    }
+    oa = orient_ids(arr, T.a, T.b, S.a);
+    ob = orient_ids(arr, T.a, T.b, S.b);
+    if (oc * od < 0 && oa * ob < 0) {
+        mci_point x;
+        uint32_t id = (uint32_t)arr->point_count;
+        if (!crossing_point(arr, &S, &T, &x) || !mci_arr_add_point(sp->ctx, arr, &x)) {
+            sp->ok = false;
+            return;
+        }
+        cut(sp, s, id);
+        cut(sp, t, id);
+        return;
+    }
+    if (oc == 0)
+        cut_if_inside(sp, s, T.a);
+    if (od == 0)
+        cut_if_inside(sp, s, T.b);
+    if (oa == 0)
+        cut_if_inside(sp, t, S.a);
+    if (ob == 0)
+        cut_if_inside(sp, t, S.b);
+}
+
+static void relate_point(splitter *sp, uint32_t p, uint32_t s)
+{
+    const mci_arr_segment *seg = &sp->arr->segments[s];
+    if (orient_ids(sp->arr, seg->a, seg->b, p) == 0)
+        cut_if_inside(sp, s, p);
+}
+
+static void item_bounds(const mci_face_arr *arr, const double face_lo[2],
+                        const double face_hi[2], const mci_point *p, sweep_item *it,
+                        bool first)
+{
+    double lo[3], hi[3];
+    mci_point_bounds(p, lo, hi);
+    for (int k = 0; k < 2; k++) {
+        int axis = (arr->axis + 1 + k) % 3;
+        double l = fmax(lo[axis], face_lo[k]), h = fmin(hi[axis], face_hi[k]);
+        it->lo[k] = first || l < it->lo[k] ? l : it->lo[k];
+        it->hi[k] = first || h > it->hi[k] ? h : it->hi[k];
+    }
+}
+
+static int compare_items(const void *x, const void *y)
+{
+    const sweep_item *a = x, *b = y;
+    if (a->lo[0] != b->lo[0])
+        return a->lo[0] < b->lo[0] ? -1 : 1;
+    /* Deterministic order for equal keys. */
+    if (a->is_point != b->is_point)
+        return a->is_point ? 1 : -1;
+    return (a->id > b->id) - (a->id < b->id);
+}
+
+/* Segments, and the points that are no segment's end (those are seen through their
+ * segments). */
+static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size_t *count)
+{
+    double face_lo[2], face_hi[2];
+    size_t n = 0;
+    bool *is_end = mci_calloc_array(ctx, arr->point_count, sizeof *is_end);
+    sweep_item *items = mci_malloc_array(ctx, arr->segment_count + arr->point_count,
+                                         sizeof *items);
+    if (!is_end || !items) {
+        mci_free(ctx, is_end);
+        mci_free(ctx, items);
+        return NULL;
+    }
+    for (int k = 0; k < 2; k++) {
+        int axis = (arr->axis + 1 + k) % 3;
+        face_lo[k] = fmin(fmin(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
+        face_hi[k] = fmax(fmax(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
+    }
+    for (size_t s = 0; s < arr->segment_count; s++, n++) {
+        const mci_arr_segment *seg = &arr->segments[s];
+        items[n].id = (uint32_t)s;
+        items[n].is_point = false;
+        item_bounds(arr, face_lo, face_hi, &arr->points[seg->a], &items[n], true);
+        item_bounds(arr, face_lo, face_hi, &arr->points[seg->b], &items[n], false);
+        is_end[seg->a] = is_end[seg->b] = true;
+    }
+    for (size_t p = 0; p < arr->point_count; p++) {
+        if (is_end[p])
+            continue;
+        items[n].id = (uint32_t)p;
+        items[n].is_point = true;
+        item_bounds(arr, face_lo, face_hi, &arr->points[p], &items[n], true);
+        n++;
+    }
+    mci_free(ctx, is_end);
+    if (n > 0)
+        qsort(items, n, sizeof *items, compare_items);
+    *count = n;
+    return items;
+}
+
+/* Relate every two items whose boxes overlap. */
+static bool sweep(splitter *sp)
+{
+    size_t n;
+    sweep_item *items = sweep_items(sp->ctx, sp->arr, &n);
+    if (!items)
+        return false;
+    for (size_t i = 0; i < n && sp->ok; i++) {
+        for (size_t j = i + 1; j < n && items[j].lo[0] <= items[i].hi[0] && sp->ok; j++) {
+            const sweep_item *a = &items[i], *b = &items[j];
+            if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || (a->is_point && b->is_point))
+                continue;
+            if (!a->is_point && !b->is_point)
+                relate_segments(sp, a->id, b->id);
+            else
+                relate_point(sp, a->is_point ? a->id : b->id, a->is_point ? b->id : a->id);
+        }
+    }
+    mci_free(sp->ctx, items);
+    return sp->ok;
+}
+
+static int compare_cuts(const void *x, const void *y)
+{
+    const uint32_t *a = x, *b = y;
+    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+static int compare_edges(const void *x, const void *y)
+{
+    const mci_arr_edge *a = x, *b = y;
+    if (a->a != b->a)
+        return (a->a > b->a) - (a->a < b->a);
+    if (a->b != b->b)
+        return (a->b > b->b) - (a->b < b->b);
+    if (a->other != b->other)
+        return (a->other > b->other) - (a->other < b->other);
+    return (a->coplanar > b->coplanar) - (a->coplanar < b->coplanar);
+}
+
+/* The elementary edges of segment s: its ends and cuts (ids[0..n)) in order along it. */
+static void emit_pieces(mci_face_arr *arr, const mci_point *const *table,
+                        const mci_arr_segment *s, uint32_t *ids, uint32_t *tmp, size_t n)
+{
+    mci_sort_point_ids(table, ids, tmp, n);
+    for (size_t k = 0; k + 1 < n; k++) {
+        mci_arr_edge *e = &arr->edges[arr->edge_count];
+        uint32_t u = ids[k], w = ids[k + 1];
+        if (u == w)
+            continue;
+        e->a = u < w ? u : w;
+        e->b = u < w ? w : u;
+        e->other = s->other;
+        e->coplanar = s->coplanar;
+        arr->edge_count++;
+    }
+}
+
+static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[2],
+                        size_t cut_count)
+{
+    size_t max_pieces = arr->segment_count + cut_count, c = 0, out = 0;
+    uint32_t *ids = mci_malloc_array(ctx, 2 + cut_count, sizeof *ids);
+    uint32_t *tmp = mci_malloc_array(ctx, 2 + cut_count, sizeof *tmp);
+    const mci_point **table = point_table(ctx, arr);
+    mci_free(ctx, arr->edges);
+    arr->edge_count = 0;
+    arr->edges = mci_malloc_array(ctx, max_pieces ? max_pieces : 1, sizeof *arr->edges);
+    if (!ids || !tmp || !table || !arr->edges) {
+        mci_free(ctx, ids);
+        mci_free(ctx, tmp);
+        mci_free(ctx, table);
+        return false;
+    }
+    if (cut_count > 0)
+        qsort(cuts, cut_count, sizeof *cuts, compare_cuts);
+    for (uint32_t s = 0; s < arr->segment_count; s++) {
+        size_t n = 0;
+        ids[n++] = arr->segments[s].a;
+        ids[n++] = arr->segments[s].b;
+        for (; c < cut_count && cuts[c][0] == s; c++)
+            ids[n++] = cuts[c][1];
+        emit_pieces(arr, table, &arr->segments[s], ids, tmp, n);
+    }
+    if (arr->edge_count > 0)
+        qsort(arr->edges, arr->edge_count, sizeof *arr->edges, compare_edges);
+    for (size_t e = 0; e < arr->edge_count; e++)
+        if (out == 0 || compare_edges(&arr->edges[e], &arr->edges[out - 1]) != 0)
+            arr->edges[out++] = arr->edges[e];
+    arr->edge_count = out;
+    mci_free(ctx, ids);
+    mci_free(ctx, tmp);
+    mci_free(ctx, table);
+    return true;
+}
+
+mcsg_status mci_arr_split(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
+{
+    splitter sp = {ctx, arr, NULL, 0, 0, true};
+    uint32_t *remap = NULL;
+    mcsg_status st = MCSG_OK;
+    size_t before;
+    if (arr->dirty && (st = merge_points(ctx, arr, NULL, err)) != MCSG_OK)
+        return st;
+    before = arr->point_count;
+    if (!sweep(&sp))
+        st = mci_fail_nomem(err, "arranging a face");
+    /* Crossing points may coincide with each other or with earlier points. */
+    if (st == MCSG_OK && arr->point_count > before)
+        st = merge_points(ctx, arr, &remap, err);
+    for (size_t k = 0; st == MCSG_OK && remap && k < sp.cut_count; k++)
+        sp.cuts[k][1] = remap[sp.cuts[k][1]];
+    if (st == MCSG_OK && !build_edges(ctx, arr, sp.cuts, sp.cut_count))
+        st = mci_fail_nomem(err, "arranging a face");
+    mci_free(ctx, remap);
+    mci_free(ctx, sp.cuts);
+    return st;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Triangulation                                                                       */
+
+static size_t chosen_points(const mci_face_arr *arr, const bool *use, bool *mark,
+                            uint32_t *insert)
+{
+    size_t n = 0;
+    for (size_t e = 0; e < arr->edge_count; e++)
+        if (!use || use[e])
+            mark[arr->edges[e].a] = mark[arr->edges[e].b] = true;
+    for (size_t p = 3; p < arr->point_count; p++)
+        if (!use || mark[p] || (arr->where[p] >= MCI_AT_EDGE && arr->where[p] < MCI_AT_INSIDE))
+            insert[n++] = (uint32_t)p;
+    return n;
+}
+
+static size_t chosen_edges(const mci_face_arr *arr, const bool *use, uint32_t *pairs)
+{
+    size_t n = 0;
+    for (size_t e = 0; e < arr->edge_count; e++) {
+        const mci_arr_edge *edge = &arr->edges[e];
+        if ((use && !use[e]) ||
+            (n > 0 && pairs[2 * n - 2] == edge->a && pairs[2 * n - 1] == edge->b))
+            continue;
+        pairs[2 * n] = edge->a;
+        pairs[2 * n + 1] = edge->b;
+        n++;
+    }
+    return n;
+}
+
+mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const bool *use,
+                                mcsg_error *err)
+{
+    bool *mark = mci_calloc_array(ctx, arr->point_count, sizeof *mark);
+    uint32_t *insert = mci_malloc_array(ctx, arr->point_count, sizeof *insert);
+    uint32_t *pairs = mci_malloc_array(ctx, 2 * arr->edge_count + 1, sizeof *pairs);
+    mcsg_status st = MCSG_OK;
+    if (arr->dirty)
+        st = mci_fail(err, MCSG_ERR_INTERNAL, "face %u triangulated before splitting", arr->face);
+    mci_free(ctx, arr->tris);
+    arr->tris = NULL;
+    arr->tri_count = 0;
+    if (st == MCSG_OK && (!mark || !insert || !pairs)) {
+        st = mci_fail_nomem(err, "triangulating a face");
+    } else if (st == MCSG_OK) {
+        mci_cdt_input in = {arr->points, arr->point_count, arr->axis, arr->sign, insert, 0,
+                            pairs, 0};
+        mci_cdt_output out;
+        in.insert_count = chosen_points(arr, use, mark, insert);
+        in.edge_count = chosen_edges(arr, use, pairs);
+        st = mci_triangulate(ctx, &in, &out, err);
+        if (st == MCSG_OK) {
+            arr->tris = out.tris;
+            arr->tri_count = out.tri_count;
+        }
+    }
+    mci_free(ctx, mark);
+    mci_free(ctx, insert);
+    mci_free(ctx, pairs);
+    return st;
+}

@@ -1,0 +1,97 @@
+/*
+ * The arrangement of one face: everything the intersection stage found on it (crossing
+ * segments, single contact points, coplanar faces of other leaves, points on its edges
+ * shared by its neighbours), merged exactly, split into non-crossing elementary edges,
+ * and triangulated for any chosen subset of them. See arrange.c.
+ */
+#ifndef MESHCSG_ARRANGE_H
+#define MESHCSG_ARRANGE_H
+
+#include "exact_kernel.h"
+#include "internal.h"
+
+/* Where a point of a face lies. */
+enum {
+    MCI_AT_CORNER = 0, /* + corner index 0..2 */
+    MCI_AT_EDGE = 3,   /* + edge index 0..2 (edge i from corner i to corner i + 1) */
+    MCI_AT_INSIDE = 6
+};
+
+/* A piece of constraint between two points of the face, with its source: the segment
+ * where face `other` (global id) crosses this face, or (coplanar) part of an edge of the
+ * coplanar face `other`. Several edges may join the same two points (one per source). */
+typedef struct mci_arr_edge {
+    uint32_t a, b; /* point ids, a < b */
+    uint32_t other;
+    uint8_t coplanar;
+} mci_arr_edge;
+
+/* An input segment before splitting: its line is this face's plane ∩ the plane through
+ * l[0], l[1], l[2] (the other face's plane; for a coplanar edge u-v: u, v and an
+ * auxiliary vertex off the face's plane). */
+typedef struct mci_arr_segment {
+    uint32_t a, b;
+    uint32_t other;
+    uint8_t coplanar;
+    const double *l[3];
+} mci_arr_segment;
+
+typedef struct mci_face_arr {
+    uint32_t face;       /* global face id */
+    mci_plane plane;     /* the face's plane; corners plane.a, .b, .c */
+    int axis, sign;      /* projection (mci_plane_projection_axis) */
+    mci_point *points;   /* [0..2] are the corners */
+    uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge */
+    size_t point_count, point_capacity;
+    mci_arr_segment *segments;
+    size_t segment_count, segment_capacity;
+    mci_arr_edge *edges; /* after mci_arr_split: sorted by (a, b, other) */
+    size_t edge_count;
+    double (*aux)[3];    /* auxiliary vertices (stable: points refer to them) */
+    size_t aux_count, aux_capacity;
+    uint32_t *tris;      /* after mci_arr_triangulate: 3 point ids per triangle */
+    size_t tri_count;
+    bool dirty;          /* points were added since the last merge */
+} mci_face_arr;
+
+/* Start the arrangement of face `face` with corners a, b, c (non-degenerate).
+ * `max_coplanar` bounds the number of mci_arr_add_coplanar calls (it sizes the
+ * auxiliary vertex store, whose addresses must not move). */
+mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
+                         const double *a, const double *b, const double *c,
+                         size_t max_coplanar, mcsg_error *err);
+void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
+
+/* Inputs. Points must lie on the face (closed triangle). */
+bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
+bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
+                          const mci_point *b, uint32_t other, const mci_plane *other_plane);
+/* The coplanar face `other` (corners of other_plane): its edges are clipped to this
+ * face. The part inside of a crease edge (crease[i] for the edge from corner i to
+ * corner i + 1: the other surface bends there) becomes a coplanar segment; other edges
+ * lie inside a flat region of the other surface, bound no region, and give only their
+ * end points. */
+bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
+                          const mci_plane *other_plane, const bool crease[3]);
+
+/* Merge coincident points exactly (corners keep ids 0..2) and classify each point
+ * (where[]). May be called again after more points were added. Fails with
+ * MCSG_ERR_INTERNAL if a point is off the face. */
+mcsg_status mci_arr_merge(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err);
+
+/* Split the segments at every point on them and at their crossings (new points are
+ * triple points: three planes, or an edge line and two planes), giving `edges`. Merges
+ * first if points were added since the last merge. */
+mcsg_status mci_arr_split(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err);
+
+/* Triangulate the face with the edges e for which use[e] is true (all if use is NULL):
+ * the points inserted are those on the face's boundary, the end points of the used
+ * edges, and (when use is NULL) every other point too. */
+mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const bool *use,
+                                mcsg_error *err);
+
+/* Sort ids by the exact lexicographic order of the points table[id] (stable merge sort;
+ * tmp has n entries). */
+void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n);
+
+#endif
