@@ -77,6 +77,7 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
 {
     mci_free(ctx, arr->points);
+    mci_free(ctx, arr->lines);
     mci_free(ctx, arr->where);
     mci_free(ctx, arr->segments);
     mci_free(ctx, arr->edges);
@@ -101,21 +102,49 @@ static bool grow(const mci_ctx *ctx, void **data, size_t *capacity, size_t need,
     return true;
 }
 
-bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+/* Add a point known to lie on `line` (0: none known). */
+static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
+                         uint64_t line)
 {
+    size_t capacity = arr->point_capacity;
     if (!grow(ctx, (void **)&arr->points, &arr->point_capacity, arr->point_count + 1,
               sizeof *arr->points))
         return false;
+    if (capacity != arr->point_capacity) {
+        mci_point_lines *grown = mci_realloc_array(ctx, arr->lines, arr->point_capacity,
+                                                   sizeof *grown);
+        if (!grown) {
+            arr->point_capacity = capacity; /* points grew; lines did not: stay consistent */
+            return false;
+        }
+        arr->lines = grown;
+    }
+    arr->lines[arr->point_count].count = line != 0;
+    arr->lines[arr->point_count].id[0] = line;
     arr->points[arr->point_count++] = *p;
     arr->dirty = true;
     return true;
+}
+
+bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    return add_point_on(ctx, arr, p, 0);
+}
+
+static void add_line(mci_point_lines *l, uint64_t line)
+{
+    for (int i = 0; i < l->count; i++)
+        if (l->id[i] == line)
+            return;
+    if (line != 0 && l->count < 3)
+        l->id[l->count++] = line;
 }
 
 static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
                         const mci_point *b, const mci_arr_segment *s)
 {
     uint32_t ia = (uint32_t)arr->point_count;
-    if (!mci_arr_add_point(ctx, arr, a) || !mci_arr_add_point(ctx, arr, b) ||
+    if (!add_point_on(ctx, arr, a, s->line) || !add_point_on(ctx, arr, b, s->line) ||
         !grow(ctx, (void **)&arr->segments, &arr->segment_capacity, arr->segment_count + 1,
               sizeof *arr->segments))
         return false;
@@ -125,10 +154,16 @@ static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *
     return true;
 }
 
+/* Line ids: a crossing's line is this face's plane ∩ the other plane, named by the
+ * plane's id (+1, so that 0 means none); a coplanar edge's line is named by the edge. */
+#define COPLANAR_LINE (1ull << 40)
+
 bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
-                          const mci_point *b, uint32_t other, const mci_plane *other_plane)
+                          const mci_point *b, uint32_t other, const mci_plane *other_plane,
+                          uint32_t plane_id, uint32_t group, bool on_edge)
 {
-    mci_arr_segment s = {0, 0, other, 0, {other_plane->a, other_plane->b, other_plane->c}};
+    mci_arr_segment s = {0, 0, other, 0, {other_plane->a, other_plane->b, other_plane->c},
+                         (uint64_t)plane_id + 1, group, on_edge};
     return add_segment(ctx, arr, a, b, &s);
 }
 
@@ -182,7 +217,8 @@ static void clip_by_edge(mci_face_arr *arr, int e, const mci_point *pu, const mc
 }
 
 static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
-                               const double *u, const double *v, bool crease)
+                               uint32_t group, int edge, const double *u, const double *v,
+                               bool crease)
 {
     mci_point pu, pv;
     clip_state c;
@@ -202,17 +238,18 @@ static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t o
         return mci_arr_add_point(ctx, arr, c.start) && mci_arr_add_point(ctx, arr, c.end);
     {
         const double *aux = add_aux(arr, u);
-        mci_arr_segment s = {0, 0, other, 1, {u, v, aux}};
+        mci_arr_segment s = {0, 0, other, 1, {u, v, aux},
+                             COPLANAR_LINE + 3 * (uint64_t)other + (uint64_t)edge, group, 1};
         return aux && add_segment(ctx, arr, c.start, c.end, &s);
     }
 }
 
 bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
-                          const mci_plane *other_plane, const bool crease[3])
+                          const mci_plane *other_plane, const bool crease[3], uint32_t group)
 {
     const double *v[3] = {other_plane->a, other_plane->b, other_plane->c};
     for (int i = 0; i < 3; i++)
-        if (!clip_coplanar_edge(ctx, arr, other, v[i], v[(i + 1) % 3], crease[i]))
+        if (!clip_coplanar_edge(ctx, arr, other, group, i, v[i], v[(i + 1) % 3], crease[i]))
             return false;
     return true;
 }
@@ -269,25 +306,54 @@ static size_t merge_ids(const mci_face_arr *arr, const uint32_t *sorted, uint32_
     return next;
 }
 
+/* Whether p lies on the line of face edge e by its very definition (an end point of
+ * the edge, or an LPI on the edge's line): the predicate would be an exact zero, which
+ * only the slow exact stage can confirm. */
+static bool defined_on_edge(const mci_face_arr *arr, int e, const mci_point *p)
+{
+    const double *u = corner(arr, e), *w = corner(arr, (e + 1) % 3);
+    if (p->kind == MCI_POINT_EXPLICIT)
+        return p->v[0] == u || p->v[0] == w;
+    return p->kind == MCI_POINT_LPI &&
+           ((p->v[0] == u && p->v[1] == w) || (p->v[0] == w && p->v[1] == u));
+}
+
+/* MCI_AT_* of a point of the face, or UINT8_MAX if it is off the face. */
+static uint8_t locate_in_face(const mci_face_arr *arr, const mci_point *p)
+{
+    int side[3], zeros = 0;
+    for (int e = 0; e < 3; e++) {
+        side[e] = defined_on_edge(arr, e, p) ? 0 : side_of_edge(arr, e, p);
+        if (side[e] < 0)
+            return UINT8_MAX;
+        zeros += side[e] == 0;
+    }
+    if (zeros == 0)
+        return MCI_AT_INSIDE;
+    for (int e = 0; e < 3; e++) {
+        if (zeros == 1 && side[e] == 0)
+            return (uint8_t)(MCI_AT_EDGE + e);
+        if (zeros == 2 && side[e] == 0 && side[(e + 2) % 3] == 0)
+            return (uint8_t)(MCI_AT_CORNER + e); /* edges e - 1 and e meet at corner e */
+    }
+    return UINT8_MAX;
+}
+
 static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
 {
     uint8_t *where = mci_realloc_array(ctx, arr->where, arr->point_count, 1);
     if (!where)
         return mci_fail_nomem(err, "arranging a face");
     arr->where = where;
+    arr->where_count = arr->point_count;
     for (size_t i = 0; i < arr->point_count; i++) {
-        int which;
-        mci_containment c = i < 3 ? MCI_ON_VERTEX
-                                  : mci_point_in_triangle(&arr->points[i], &arr->plane, &which);
-        if (i < 3)
-            where[i] = (uint8_t)(MCI_AT_CORNER + i);
-        else if (c == MCI_INSIDE)
-            where[i] = MCI_AT_INSIDE;
-        else if (c == MCI_ON_EDGE)
-            where[i] = (uint8_t)(MCI_AT_EDGE + which);
-        else
-            return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a point is %s",
-                            arr->face, c == MCI_OUTSIDE ? "off the face" : "a corner twice");
+        where[i] = i < 3 ? (uint8_t)(MCI_AT_CORNER + i) : locate_in_face(arr, &arr->points[i]);
+        if (i >= 3 && where[i] < MCI_AT_EDGE)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a corner "
+                            "appears twice", arr->face);
+        if (where[i] == UINT8_MAX)
+            return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a point is off "
+                            "the face", arr->face);
     }
     return MCSG_OK;
 }
@@ -302,7 +368,8 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     uint32_t *tmp = mci_malloc_array(ctx, n, sizeof *tmp);
     uint32_t *remap = mci_malloc_array(ctx, n, sizeof *remap);
     mci_point *merged = mci_malloc_array(ctx, n, sizeof *merged);
-    mcsg_status st = table && idx && tmp && remap && merged ? MCSG_OK
+    mci_point_lines *merged_lines = mci_malloc_array(ctx, n, sizeof *merged_lines);
+    mcsg_status st = table && idx && tmp && remap && merged && merged_lines ? MCSG_OK
                                                   : mci_fail_nomem(err, "arranging a face");
     if (st == MCSG_OK) {
         size_t out = 0;
@@ -310,8 +377,13 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
             idx[i] = (uint32_t)i;
         mci_sort_point_ids(table, idx, tmp, n);
         kept = merge_ids(arr, idx, remap);
-        for (size_t i = 0; i < n; i++)
+        for (size_t i = 0; i < kept; i++)
+            merged_lines[i].count = 0;
+        for (size_t i = 0; i < n; i++) {
             merged[remap[i]] = arr->points[i];
+            for (int l = 0; l < arr->lines[i].count; l++)
+                add_line(&merged_lines[remap[i]], arr->lines[i].id[l]);
+        }
         for (size_t s = 0; s < arr->segment_count; s++) {
             mci_arr_segment seg = arr->segments[s];
             seg.a = remap[seg.a];
@@ -321,9 +393,12 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         }
         arr->segment_count = out;
         mci_free(ctx, arr->points);
+        mci_free(ctx, arr->lines);
         arr->points = merged;
+        arr->lines = merged_lines;
         arr->point_count = arr->point_capacity = kept;
         merged = NULL;
+        merged_lines = NULL;
         st = classify_points(ctx, arr, err);
         arr->dirty = false;
     }
@@ -335,6 +410,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     mci_free(ctx, idx);
     mci_free(ctx, tmp);
     mci_free(ctx, merged);
+    mci_free(ctx, merged_lines);
     return st;
 }
 
@@ -346,11 +422,43 @@ mcsg_status mci_arr_merge(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err
 /* ---------------------------------------------------------------------------------- */
 /* Splitting                                                                           */
 
-/* Orientation of three points of the face in its own orientation (0 for repeated ids,
- * which also spares the exact stage a certain zero). */
+/* The face edges a classified point lies on (corner i is on edges i and i - 1). */
+static uint8_t edge_mask_of(const mci_face_arr *arr, uint32_t p)
+{
+    uint8_t where = p < arr->where_count ? arr->where[p] : MCI_AT_INSIDE;
+    if (where < MCI_AT_EDGE)
+        return (uint8_t)(1u << where | 1u << (where + 2) % 3);
+    return where < MCI_AT_INSIDE ? (uint8_t)(1u << (where - MCI_AT_EDGE)) : 0;
+}
+
+static bool shares_line(const mci_point_lines *l, uint64_t line)
+{
+    for (int i = 0; i < l->count; i++)
+        if (l->id[i] == line)
+            return true;
+    return false;
+}
+
+/* Collinear by construction: a repeated point, one face edge or one known line through
+ * all three. */
+static bool known_collinear(const void *user, uint32_t a, uint32_t b, uint32_t c)
+{
+    const mci_face_arr *arr = user;
+    const mci_point_lines *la = &arr->lines[a];
+    if (a == b || b == c || a == c)
+        return true;
+    if (edge_mask_of(arr, a) & edge_mask_of(arr, b) & edge_mask_of(arr, c))
+        return true;
+    for (int i = 0; i < la->count; i++)
+        if (shares_line(&arr->lines[b], la->id[i]) && shares_line(&arr->lines[c], la->id[i]))
+            return true;
+    return false;
+}
+
+/* Orientation of three points of the face in its own orientation. */
 static int orient_ids(const mci_face_arr *arr, uint32_t a, uint32_t b, uint32_t c)
 {
-    if (a == b || b == c || a == c)
+    if (known_collinear(arr, a, b, c))
         return 0;
     return arr->sign * mci_orient2d_projected(&arr->points[a], &arr->points[b],
                                               &arr->points[c], arr->axis);
@@ -388,8 +496,33 @@ static void cut_if_inside(splitter *sp, uint32_t s, uint32_t p)
     const mci_arr_segment *seg = &sp->arr->segments[s];
     const mci_point *pts = sp->arr->points;
     if (p != seg->a && p != seg->b &&
-        mci_compare_lex(&pts[seg->a], &pts[p]) * mci_compare_lex(&pts[p], &pts[seg->b]) > 0)
+        mci_compare_lex(&pts[seg->a], &pts[p]) * mci_compare_lex(&pts[p], &pts[seg->b]) > 0) {
         cut(sp, s, p);
+        add_line(&sp->arr->lines[p], seg->line);
+    }
+}
+
+static bool plane_before(const mci_plane *p, const mci_plane *q)
+{
+    const double *a[3] = {p->a, p->b, p->c}, *b[3] = {q->a, q->b, q->c};
+    for (int i = 0; i < 3; i++)
+        if (a[i] != b[i])
+            return (uintptr_t)a[i] < (uintptr_t)b[i];
+    return false;
+}
+
+/* The TPI of three planes given in a canonical order (by their vertices' addresses), so
+ * that the three faces of a triple point define it identically: their arrangements'
+ * copies are then recognised as one point by definition, without arithmetic. */
+static bool canonical_tpi(mci_point *out, const mci_plane *p1, const mci_plane *p2,
+                          const mci_plane *p3)
+{
+    const mci_plane *q[3] = {p1, p2, p3}, *t;
+    for (int m = 0; m < 2; m++)
+        for (int k = 0; k < 2 - m; k++)
+            if (plane_before(q[k + 1], q[k]))
+                t = q[k], q[k] = q[k + 1], q[k + 1] = t;
+    return mci_point_tpi(out, q[0], q[1], q[2]);
 }
 
 /* The crossing point of two segments that cross properly. */
@@ -406,14 +539,16 @@ static bool crossing_point(const mci_face_arr *arr, const mci_arr_segment *s,
     if (s->coplanar)
         return mci_point_lpi(out, s->l[0], s->l[1], &pt);
     mci_plane_init(&ps, s->l[0], s->l[1], s->l[2]);
-    return mci_point_tpi(out, &arr->plane, &ps, &pt);
+    return canonical_tpi(out, &arr->plane, &ps, &pt);
 }
 
 static void relate_segments(splitter *sp, uint32_t s, uint32_t t)
 {
     mci_face_arr *arr = sp->arr;
     mci_arr_segment S = arr->segments[s], T = arr->segments[t];
-    int oc = orient_ids(arr, S.a, S.b, T.a), od = orient_ids(arr, S.a, S.b, T.b), oa, ob;
+    bool same_line = S.line == T.line;
+    int oc = same_line ? 0 : orient_ids(arr, S.a, S.b, T.a);
+    int od = same_line ? 0 : orient_ids(arr, S.a, S.b, T.b), oa, ob;
     if (oc == 0 && od == 0) { /* collinear: each cuts the other at its ends */
         cut_if_inside(sp, s, T.a);
         cut_if_inside(sp, s, T.b);
@@ -426,10 +561,11 @@ static void relate_segments(splitter *sp, uint32_t s, uint32_t t)
     if (oc * od < 0 && oa * ob < 0) {
         mci_point x;
         uint32_t id = (uint32_t)arr->point_count;
-        if (!crossing_point(arr, &S, &T, &x) || !mci_arr_add_point(sp->ctx, arr, &x)) {
+        if (!crossing_point(arr, &S, &T, &x) || !add_point_on(sp->ctx, arr, &x, S.line)) {
             sp->ok = false;
             return;
         }
+        add_line(&arr->lines[id], T.line);
         cut(sp, s, id);
         cut(sp, t, id);
         return;
@@ -463,6 +599,14 @@ static void item_bounds(const mci_face_arr *arr, const double face_lo[2],
         it->lo[k] = first || l < it->lo[k] ? l : it->lo[k];
         it->hi[k] = first || h > it->hi[k] ? h : it->hi[k];
     }
+}
+
+/* Segments of one leaf, neither along an edge of its face: they meet only at shared
+ * end points (see mci_arr_add_crossing). */
+static bool one_surface(const mci_face_arr *arr, uint32_t s, uint32_t t)
+{
+    const mci_arr_segment *S = &arr->segments[s], *T = &arr->segments[t];
+    return S->group == T->group && !S->on_edge && !T->on_edge;
 }
 
 static int compare_items(const void *x, const void *y)
@@ -530,8 +674,10 @@ static bool sweep(splitter *sp)
             const sweep_item *a = &items[i], *b = &items[j];
             if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || (a->is_point && b->is_point))
                 continue;
-            if (!a->is_point && !b->is_point)
+            if (!a->is_point && !b->is_point && !one_surface(sp->arr, a->id, b->id))
                 relate_segments(sp, a->id, b->id);
+            else if (!a->is_point && !b->is_point)
+                continue;
             else
                 relate_point(sp, a->is_point ? a->id : b->id, a->is_point ? b->id : a->id);
         }
@@ -648,7 +794,7 @@ static size_t chosen_points(const mci_face_arr *arr, const bool *use, bool *mark
         if (!use || use[e])
             mark[arr->edges[e].a] = mark[arr->edges[e].b] = true;
     for (size_t p = 3; p < arr->point_count; p++)
-        if (!use || mark[p] || (arr->where[p] >= MCI_AT_EDGE && arr->where[p] < MCI_AT_INSIDE))
+        if (!use || mark[p] || edge_mask_of(arr, (uint32_t)p) != 0)
             insert[n++] = (uint32_t)p;
     return n;
 }
@@ -684,7 +830,7 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
         st = mci_fail_nomem(err, "triangulating a face");
     } else if (st == MCSG_OK) {
         mci_cdt_input in = {arr->points, arr->point_count, arr->axis, arr->sign, insert, 0,
-                            pairs, 0};
+                            pairs, 0, known_collinear, arr};
         mci_cdt_output out;
         in.insert_count = chosen_points(arr, use, mark, insert);
         in.edge_count = chosen_edges(arr, use, pairs);

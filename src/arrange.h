@@ -34,14 +34,26 @@ typedef struct mci_arr_segment {
     uint32_t other;
     uint8_t coplanar;
     const double *l[3];
+    uint64_t line; /* segments with equal `line` lie on one line (see mci_arr_add_crossing) */
+    uint32_t group;  /* the leaf of `other` */
+    uint8_t on_edge; /* lies along an edge of `other` (always for coplanar edges) */
 } mci_arr_segment;
+
+/* Lines a point is known to lie on, by construction (at most 3 kept: the list only
+ * saves predicate evaluations, so dropping one is harmless). */
+typedef struct mci_point_lines {
+    uint64_t id[3];
+    uint8_t count;
+} mci_point_lines;
 
 typedef struct mci_face_arr {
     uint32_t face;       /* global face id */
     mci_plane plane;     /* the face's plane; corners plane.a, .b, .c */
     int axis, sign;      /* projection (mci_plane_projection_axis) */
     mci_point *points;   /* [0..2] are the corners */
+    mci_point_lines *lines; /* per point */
     uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge */
+    size_t where_count;  /* points classified in where[] */
     size_t point_count, point_capacity;
     mci_arr_segment *segments;
     size_t segment_count, segment_capacity;
@@ -64,15 +76,22 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Inputs. Points must lie on the face (closed triangle). */
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
+/* The segment a-b where face `other` crosses. `plane_id` names other's plane: faces of
+ * one flat region of a leaf may share it (their segments then lie on one line, which
+ * spares exact zero tests); distinct planes must have distinct ids below 2^32.
+ * `group` is other's leaf and `on_edge` says whether the segment lies along an edge of
+ * other: two segments of one leaf that do not lie along edges cannot cross or overlap
+ * (a leaf does not intersect itself), so they are not compared at all. */
 bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
-                          const mci_point *b, uint32_t other, const mci_plane *other_plane);
+                          const mci_point *b, uint32_t other, const mci_plane *other_plane,
+                          uint32_t plane_id, uint32_t group, bool on_edge);
 /* The coplanar face `other` (corners of other_plane): its edges are clipped to this
  * face. The part inside of a crease edge (crease[i] for the edge from corner i to
  * corner i + 1: the other surface bends there) becomes a coplanar segment; other edges
  * lie inside a flat region of the other surface, bound no region, and give only their
  * end points. */
 bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
-                          const mci_plane *other_plane, const bool crease[3]);
+                          const mci_plane *other_plane, const bool crease[3], uint32_t group);
 
 /* Merge coincident points exactly (corners keep ids 0..2) and classify each point
  * (where[]). May be called again after more points were added. Fails with

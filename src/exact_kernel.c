@@ -336,7 +336,9 @@ void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
 static void fv_offset(const mci_point *p, const double *origin, mci_fv out[3])
 {
     for (int k = 0; k < 3; k++) {
-        if (p->v[0] == origin)
+        if (p->kind == MCI_POINT_EXPLICIT) /* W = 1, Y = 0 */
+            out[k] = fv_diff(p->v[0][k], origin[k]);
+        else if (p->v[0] == origin)
             out[k] = p->y[k];
         else
             out[k] = fv_add(fv_mul(fv_diff(p->v[0][k], origin[k]), p->w), p->y[k]);
@@ -396,6 +398,8 @@ static bool same_definition(const mci_point *a, const mci_point *b)
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
 {
     int s;
+    if (a->kind == MCI_POINT_EXPLICIT && b->kind == MCI_POINT_EXPLICIT)
+        return (a->v[0][axis] > b->v[0][axis]) - (a->v[0][axis] < b->v[0][axis]);
     if (same_definition(a, b))
         return 0;
     s = mci_compare_coord_filtered(a, b, axis);
@@ -443,10 +447,42 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
     return big_orient2d(points, axis, s.e0);
 }
 
+/* A coordinate as centre +- radius, from the certified box of the point. */
+static mci_fv coordinate_interval(const double lo[3], const double hi[3], int k)
+{
+    double c = lo[k] / 2 + hi[k] / 2;
+    /* |c - lo|, |hi - c| <= (hi - lo) / 2 up to the rounding of c and of the halving. */
+    return (mci_fv){c, fmax(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070};
+}
+
+/* Second filter for points close together but defined far away (consecutive points of
+ * a curve, say): the homogeneous determinant's bound grows with the distances to the
+ * defining vertices, while differences of certified coordinate intervals stay small. */
+static int orient2d_intervals(const mci_point *p, const mci_point *q, const mci_point *r,
+                              int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    double lo[3][3], hi[3][3];
+    const mci_point *pts[3] = {p, q, r};
+    mci_fv c[3][2], d[2][2];
+    for (int k = 0; k < 3; k++) {
+        mci_point_bounds(pts[k], lo[k], hi[k]);
+        c[k][0] = coordinate_interval(lo[k], hi[k], i);
+        c[k][1] = coordinate_interval(lo[k], hi[k], j);
+    }
+    for (int k = 0; k < 2; k++) {
+        d[0][k] = fv_sub(c[1][k], c[0][k]);
+        d[1][k] = fv_sub(c[2][k], c[0][k]);
+    }
+    return fv_sign(fv_sub(fv_mul(d[0][0], d[1][1]), fv_mul(d[0][1], d[1][0])));
+}
+
 int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
                            int axis)
 {
     int s = mci_orient2d_projected_filtered(p, q, r, axis);
+    if (s == MCI_UNCERTAIN)
+        s = orient2d_intervals(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 
@@ -476,8 +512,7 @@ static int line_direction_sign(const mci_plane *p1, const mci_plane *p2, int axi
 /* Along a line, the order of two of its points is their order in any coordinate in
  * which the direction is nonzero, times the sign of that component. The largest
  * approximate component is tried first: it is nonzero unless the planes are parallel. */
-int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_plane *p1,
-                            const mci_plane *p2)
+int mci_plane_line_axis(const mci_plane *p1, const mci_plane *p2, int *sign)
 {
     double magnitude[3];
     int order[3] = {0, 1, 2};
@@ -493,11 +528,18 @@ int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_pl
         }
     }
     for (int m = 0; m < 3; m++) {
-        int s = line_direction_sign(p1, p2, order[m]);
-        if (s != 0)
-            return s * mci_compare_coord(a, b, order[m]);
+        *sign = line_direction_sign(p1, p2, order[m]);
+        if (*sign != 0)
+            return order[m];
     }
-    return 0;
+    return -1;
+}
+
+int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_plane *p1,
+                            const mci_plane *p2)
+{
+    int sign, axis = mci_plane_line_axis(p1, p2, &sign);
+    return axis < 0 ? 0 : sign * mci_compare_coord(a, b, axis);
 }
 
 int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double *l0,

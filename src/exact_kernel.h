@@ -97,6 +97,12 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
 int mci_order_on_plane_line(const mci_point *a, const mci_point *b, const mci_plane *p1,
                             const mci_plane *p2);
 
+/* An axis along which the line of two non-parallel planes moves (the direction
+ * n1 x n2 has a nonzero component there, decided exactly), with that component's sign
+ * in *sign; -1 for parallel planes. Order along the line is then
+ * sign * mci_compare_coord(a, b, axis): callers ordering many points compute it once. */
+int mci_plane_line_axis(const mci_plane *p1, const mci_plane *p2, int *sign);
+
 /* Order of two points lying on the line through input vertices l0 != l1, along
  * l1 - l0: sign((a - b) . (l1 - l0)). */
 int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double *l0,

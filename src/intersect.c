@@ -16,6 +16,7 @@
 typedef struct pair_hit {
     uint32_t f, g;
     uint8_t kind; /* mci_tt_kind */
+    bool along_edge[2]; /* of f, of g */
     mci_point end[2];
 } pair_hit;
 
@@ -56,8 +57,39 @@ static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
     h->v[h->count].f = f;
     h->v[h->count].g = g;
     h->v[h->count].kind = (uint8_t)r->kind;
+    h->v[h->count].along_edge[0] = r->along_edge[0];
+    h->v[h->count].along_edge[1] = r->along_edge[1];
     h->v[h->count].end[0] = r->end[0];
     h->v[h->count++].end[1] = r->end[1];
+    return true;
+}
+
+/* Planes of the faces that appear in candidate pairs, computed once each. */
+typedef struct plane_cache {
+    uint32_t *slot; /* per face: index in planes, or MCI_NONE */
+    mci_plane *planes;
+} plane_cache;
+
+static bool cache_planes(const mci_ctx *ctx, const mci_scene *s, const uint64_t *pairs,
+                         size_t count, plane_cache *c)
+{
+    size_t used = 0;
+    c->slot = mci_malloc_array(ctx, s->face_count + 1, sizeof *c->slot);
+    if (!c->slot)
+        return false;
+    for (size_t f = 0; f < s->face_count; f++)
+        c->slot[f] = MCI_NONE;
+    for (size_t i = 0; i < 2 * count; i++) {
+        uint32_t f = (uint32_t)(i % 2 ? pairs[i / 2] : pairs[i / 2] >> 32);
+        if (c->slot[f] == MCI_NONE)
+            c->slot[f] = (uint32_t)used++;
+    }
+    c->planes = mci_malloc_array(ctx, used + 1, sizeof *c->planes);
+    if (!c->planes)
+        return false;
+    for (uint32_t f = 0; f < s->face_count; f++)
+        if (c->slot[f] != MCI_NONE)
+            face_plane(s, f, &c->planes[c->slot[f]]);
     return true;
 }
 
@@ -66,125 +98,153 @@ static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
 static bool intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
                             size_t count, hit_list *hits)
 {
-    for (size_t i = 0; i < count; i++) {
+    plane_cache cache = {NULL, NULL};
+    bool ok = cache_planes(ctx, s, pairs, count, &cache);
+    for (size_t i = 0; ok && i < count; i++) {
         uint32_t f = (uint32_t)(pairs[i] >> 32), g = (uint32_t)pairs[i];
-        mci_plane p1, p2;
         mci_tt_result r;
-        face_plane(s, f, &p1);
-        face_plane(s, g, &p2);
-        mci_triangle_intersection(&p1, &p2, &r);
+        mci_triangle_intersection(&cache.planes[cache.slot[f]], &cache.planes[cache.slot[g]],
+                                  &r);
         s->stats.intersecting_pairs += r.kind == MCI_TT_SEGMENT;
         s->stats.point_contacts += r.kind == MCI_TT_POINT;
         s->stats.coplanar_pairs += r.kind == MCI_TT_COPLANAR && r.overlap;
         if (r.kind != MCI_TT_DISJOINT && !push_hit(ctx, hits, f, g, &r))
-            return false;
+            ok = false;
     }
-    return true;
+    mci_free(ctx, cache.slot);
+    mci_free(ctx, cache.planes);
+    return ok;
 }
 
 /* ---------------------------------------------------------------------------------- */
-/* Face adjacency                                                                      */
+/* Face adjacency (for the faces that take part in hits only: linear time)             */
 
-typedef struct edge_key {
-    uint64_t key; /* (canonical start << 32) | canonical end */
-    uint32_t slot; /* 3 * face + edge */
-} edge_key;
+typedef struct leaf_adjacency {
+    uint32_t *canon;      /* per vertex: the first vertex with the same coordinates */
+    uint32_t *start;      /* vertex -> incident faces (CSR over canonical vertices) */
+    uint32_t *faces;
+} leaf_adjacency;
 
-static int compare_edge_keys(const void *x, const void *y)
+static uint64_t coordinate_hash(const double *x)
 {
-    const edge_key *a = x, *b = y;
-    if (a->key != b->key)
-        return (a->key > b->key) - (a->key < b->key);
-    return (a->slot > b->slot) - (a->slot < b->slot);
+    uint64_t h = 0x9e3779b97f4a7c15u;
+    for (int k = 0; k < 3; k++) {
+        double v = x[k] == 0 ? 0.0 : x[k]; /* -0 and +0 are one coordinate */
+        uint64_t bits;
+        memcpy(&bits, &v, sizeof bits);
+        h = (h ^ bits) * 0xff51afd7ed558ccdu;
+        h ^= h >> 29;
+    }
+    return h;
 }
 
-typedef struct vertex_ref {
-    double x[3];
-    uint32_t index;
-} vertex_ref;
-
-static int compare_vertex_refs(const void *p, const void *q)
+static bool same_coordinates(const double *a, const double *b)
 {
-    const vertex_ref *a = p, *b = q;
-    for (int k = 0; k < 3; k++)
-        if (a->x[k] != b->x[k])
-            return a->x[k] < b->x[k] ? -1 : 1;
-    return (a->index > b->index) - (a->index < b->index);
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
 }
 
-/* canon[v]: the first vertex with the same coordinates (meshes need not share them). */
-static uint32_t *canonical_vertices(const mci_ctx *ctx, const mcsg_mesh *m)
+/* Meshes need not share vertices between faces (STL never does): vertices with equal
+ * coordinates are identified, through a hash table. */
+static bool canonical_vertices(const mci_ctx *ctx, const mcsg_mesh *m, uint32_t *canon)
 {
-    vertex_ref *refs = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *refs);
-    uint32_t *canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *canon);
-    if (!refs || !canon) {
-        mci_free(ctx, refs);
-        mci_free(ctx, canon);
-        return NULL;
+    size_t size = 16;
+    uint32_t *table;
+    while (size < 2 * m->vertex_count)
+        size *= 2;
+    table = mci_malloc_array(ctx, size, sizeof *table);
+    if (!table)
+        return false;
+    for (size_t i = 0; i < size; i++)
+        table[i] = MCI_NONE;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        const double *x = m->vertices + 3 * (size_t)v;
+        size_t at = coordinate_hash(x) & (size - 1);
+        while (table[at] != MCI_NONE && !same_coordinates(m->vertices + 3 * (size_t)table[at], x))
+            at = (at + 1) & (size - 1);
+        if (table[at] == MCI_NONE)
+            table[at] = v;
+        canon[v] = table[at];
     }
-    for (size_t v = 0; v < m->vertex_count; v++) {
-        memcpy(refs[v].x, m->vertices + 3 * v, sizeof refs[v].x);
-        refs[v].index = (uint32_t)v;
-    }
-    if (m->vertex_count > 0)
-        qsort(refs, m->vertex_count, sizeof *refs, compare_vertex_refs);
-    for (size_t i = 0, first = 0; i < m->vertex_count; i++) {
-        if (refs[i].x[0] != refs[first].x[0] || refs[i].x[1] != refs[first].x[1] ||
-            refs[i].x[2] != refs[first].x[2])
-            first = i;
-        canon[refs[i].index] = refs[first].index;
-    }
-    mci_free(ctx, refs);
-    return canon;
+    mci_free(ctx, table);
+    return true;
 }
 
-static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf)
+static bool build_adjacency(const mci_ctx *ctx, const mcsg_mesh *m, leaf_adjacency *a)
+{
+    size_t n = m->triangle_count;
+    a->canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *a->canon);
+    a->start = mci_calloc_array(ctx, m->vertex_count + 2, sizeof *a->start);
+    a->faces = mci_malloc_array(ctx, 3 * n + 1, sizeof *a->faces);
+    if (!a->canon || !a->start || !a->faces || !canonical_vertices(ctx, m, a->canon))
+        return false;
+    for (size_t c = 0; c < 3 * n; c++)
+        a->start[a->canon[m->triangles[c]] + 2]++;
+    for (size_t v = 2; v < m->vertex_count + 2; v++)
+        a->start[v] += a->start[v - 1];
+    for (size_t c = 0; c < 3 * n; c++)
+        a->faces[a->start[a->canon[m->triangles[c]] + 1]++] = (uint32_t)(c / 3);
+    return true;
+}
+
+static void free_adjacency(const mci_ctx *ctx, leaf_adjacency *a)
+{
+    mci_free(ctx, a->canon);
+    mci_free(ctx, a->start);
+    mci_free(ctx, a->faces);
+}
+
+/* The face having the directed edge w -> u (canonical vertices), or MCI_NONE. */
+static uint32_t face_with_edge(const mcsg_mesh *m, const leaf_adjacency *a, uint32_t w,
+                               uint32_t u)
+{
+    for (uint32_t k = a->start[w]; k < a->start[w + 1]; k++) {
+        const uint32_t *t = m->triangles + 3 * (size_t)a->faces[k];
+        for (int i = 0; i < 3; i++)
+            if (a->canon[t[i]] == w && a->canon[t[(i + 1) % 3]] == u)
+                return a->faces[k];
+    }
+    return MCI_NONE;
+}
+
+static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const bool *wanted)
 {
     const mcsg_mesh *m = s->octree.leaves[leaf];
-    uint32_t base = s->octree.face_base[leaf], *canon = canonical_vertices(ctx, m);
-    edge_key *keys = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *keys);
-    size_t n = 3 * m->triangle_count;
-    if (!canon || !keys) {
-        mci_free(ctx, canon);
-        mci_free(ctx, keys);
-        return false;
-    }
-    for (size_t e = 0; e < n; e++) {
-        uint64_t u = canon[m->triangles[e]], w = canon[m->triangles[e % 3 == 2 ? e - 2 : e + 1]];
-        keys[e] = (edge_key){u << 32 | w, (uint32_t)e};
-    }
-    if (n > 0)
-        qsort(keys, n, sizeof *keys, compare_edge_keys);
-    for (size_t e = 0; e < n; e++) {
-        uint64_t u = canon[m->triangles[e]], w = canon[m->triangles[e % 3 == 2 ? e - 2 : e + 1]];
-        edge_key want = {w << 32 | u, 0};
-        const edge_key *hit = NULL;
-        size_t lo = 0, hi = n;
-        while (lo < hi) { /* first key >= want */
-            size_t mid = lo + (hi - lo) / 2;
-            if (compare_edge_keys(&keys[mid], &want) < 0)
-                lo = mid + 1;
-            else
-                hi = mid;
+    uint32_t base = s->octree.face_base[leaf];
+    leaf_adjacency a = {NULL, NULL, NULL};
+    bool any = false, ok;
+    for (uint32_t f = 0; f < m->triangle_count && !any; f++)
+        any = wanted[base + f];
+    if (!any)
+        return true;
+    ok = build_adjacency(ctx, m, &a);
+    for (uint32_t f = 0; ok && f < m->triangle_count; f++) {
+        const uint32_t *t = m->triangles + 3 * (size_t)f;
+        if (!wanted[base + f])
+            continue;
+        for (int i = 0; i < 3; i++) {
+            uint32_t nb = face_with_edge(m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]]);
+            s->neighbour[3 * (size_t)(base + f) + i] = nb == MCI_NONE ? MCI_NONE : base + nb;
         }
-        if (lo < n && keys[lo].key == want.key)
-            hit = &keys[lo];
-        s->neighbour[3 * (size_t)base + e] = hit ? base + hit->slot / 3 : MCI_NONE;
     }
-    mci_free(ctx, canon);
-    mci_free(ctx, keys);
-    return true;
+    free_adjacency(ctx, &a);
+    return ok;
 }
 
-static bool build_neighbours(const mci_ctx *ctx, mci_scene *s)
+/* Neighbours of every face that takes part in a hit (the others are never asked). */
+static bool build_neighbours(const mci_ctx *ctx, mci_scene *s, const hit_list *hits)
 {
+    bool *wanted = mci_calloc_array(ctx, s->face_count + 1, sizeof *wanted);
+    bool ok = wanted != NULL;
     s->neighbour = mci_malloc_array(ctx, 3 * s->face_count + 1, sizeof *s->neighbour);
-    if (!s->neighbour)
-        return false;
-    for (size_t leaf = 0; leaf < s->octree.leaf_count; leaf++)
-        if (!leaf_neighbours(ctx, s, leaf))
-            return false;
-    return true;
+    ok = ok && s->neighbour;
+    for (size_t h = 0; ok && h < hits->count; h++)
+        wanted[hits->v[h].f] = wanted[hits->v[h].g] = true;
+    for (size_t i = 0; ok && i < 3 * s->face_count; i++)
+        s->neighbour[i] = MCI_NONE;
+    for (size_t leaf = 0; ok && leaf < s->octree.leaf_count; leaf++)
+        ok = leaf_neighbours(ctx, s, leaf, wanted);
+    mci_free(ctx, wanted);
+    return ok;
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -235,8 +295,51 @@ static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t 
     return false;
 }
 
+static uint32_t find_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+/* plane_rep[f]: one face of f's flat region among the faces that take part in hits
+ * (neighbours across flat edges are joined): crossing segments from faces with one
+ * representative lie on one line of the face they cross. */
+static uint32_t *plane_representatives(const mci_ctx *ctx, const mci_scene *s,
+                                       const hit_list *hits)
+{
+    uint32_t *parent = mci_malloc_array(ctx, s->face_count + 1, sizeof *parent);
+    bool *in_hits = mci_calloc_array(ctx, s->face_count + 1, sizeof *in_hits);
+    if (!parent || !in_hits) {
+        mci_free(ctx, parent);
+        mci_free(ctx, in_hits);
+        return NULL;
+    }
+    for (uint32_t f = 0; f < s->face_count; f++)
+        parent[f] = f;
+    for (size_t h = 0; h < hits->count; h++)
+        in_hits[hits->v[h].f] = in_hits[hits->v[h].g] = true;
+    for (uint32_t f = 0; f < s->face_count; f++) {
+        mci_plane plane;
+        if (!in_hits[f])
+            continue;
+        face_plane(s, f, &plane);
+        for (int i = 0; i < 3; i++) {
+            uint32_t nb = s->neighbour[3 * (size_t)f + i];
+            if (nb != MCI_NONE && nb > f && in_hits[nb] && !edge_is_crease(s, &plane, f, i))
+                parent[find_root(parent, nb)] = find_root(parent, f);
+        }
+    }
+    for (uint32_t f = 0; f < s->face_count; f++)
+        parent[f] = find_root(parent, f);
+    mci_free(ctx, in_hits);
+    return parent;
+}
+
 static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
-                    const pair_hit *h)
+                    const pair_hit *h, const uint32_t *plane_rep)
 {
     uint32_t other = h->f == arr->face ? h->g : h->f;
     mci_plane plane;
@@ -244,19 +347,21 @@ static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
     face_plane(s, other, &plane);
     switch (h->kind) {
     case MCI_TT_SEGMENT:
-        return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, &plane);
+        return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, &plane,
+                                    plane_rep[other], s->octree.face_leaf[other],
+                                    h->along_edge[h->f == arr->face ? 1 : 0]);
     case MCI_TT_POINT:
         return mci_arr_add_point(ctx, arr, &h->end[0]);
     default:
         for (int i = 0; i < 3; i++)
             crease[i] = edge_is_crease(s, &plane, other, i);
-        return mci_arr_add_coplanar(ctx, arr, other, &plane, crease);
+        return mci_arr_add_coplanar(ctx, arr, other, &plane, crease, s->octree.face_leaf[other]);
     }
 }
 
 static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t f,
                                 const hit_list *hits, const uint32_t *ids, size_t n,
-                                mci_face_arr *arr, mcsg_error *err)
+                                const uint32_t *plane_rep, mci_face_arr *arr, mcsg_error *err)
 {
     size_t coplanar = 0;
     mcsg_status st;
@@ -265,7 +370,7 @@ static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t
     st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
                       mci_scene_corner(s, f, 2), coplanar, err);
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
-        if (!add_hit(ctx, s, arr, &hits->v[ids[i]]))
+        if (!add_hit(ctx, s, arr, &hits->v[ids[i]], plane_rep))
             st = mci_fail_nomem(err, "arranging faces");
     return st == MCSG_OK ? mci_arr_merge(ctx, arr, err) : st;
 }
@@ -346,11 +451,13 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
                                       mcsg_error *err)
 {
-    uint32_t *start = NULL, *list = NULL;
+    uint32_t *start = NULL, *list = NULL, *plane_rep = plane_representatives(ctx, s, hits);
     mcsg_status st = MCSG_OK;
     s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
-    if (!s->arr_of || !index_hits(ctx, s, hits, &start, &list))
+    if (!plane_rep || !s->arr_of || !index_hits(ctx, s, hits, &start, &list)) {
+        mci_free(ctx, plane_rep);
         return mci_fail_nomem(err, "arranging faces");
+    }
     for (uint32_t f = 0; f < s->face_count; f++)
         s->arr_count += start[f + 1] > start[f];
     s->arrs = mci_calloc_array(ctx, s->arr_count + 1, sizeof *s->arrs);
@@ -362,8 +469,9 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hi
             continue;
         s->arr_of[f] = k;
         st = arrange_face(ctx, s, f, hits, list + start[f], start[f + 1] - start[f],
-                          &s->arrs[k++], err);
+                          plane_rep, &s->arrs[k++], err);
     }
+    mci_free(ctx, plane_rep);
     mci_free(ctx, start);
     mci_free(ctx, list);
     if (st == MCSG_OK)
@@ -391,7 +499,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
         st = mci_fail_nomem(err, "intersecting faces");
     mci_free(ctx, pairs);
     t2 = seconds_now();
-    if (st == MCSG_OK && !build_neighbours(ctx, s))
+    if (st == MCSG_OK && !build_neighbours(ctx, s, &hits))
         st = mci_fail_nomem(err, "finding neighbouring faces");
     if (st == MCSG_OK)
         st = build_arrangements(ctx, s, &hits, err);
@@ -436,41 +544,151 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
     memset(scene, 0, sizeof *scene);
 }
 
+/* Numbering in three steps, each deterministic:
+ *   1. copies with the same definition (kind and defining vertices) are one point:
+ *      found by hashing, no arithmetic (most shared points are defined identically by
+ *      the faces that share them: canonical edge order, canonical TPI plane order);
+ *   2. distinct definitions of one point (e.g. a crossing exactly at a vertex) are
+ *      found among points whose certified boxes overlap, by a sweep along x, and
+ *      joined after an exact equality test;
+ *   3. numbers follow the first occurrence in (face, local index) order. */
+typedef struct numbering {
+    const mci_point **table; /* by slot */
+    uint32_t *parent;        /* union-find over slots */
+    size_t total;
+} numbering;
+
+static uint64_t definition_hash(const mci_point *p)
+{
+    uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)p->kind;
+    int n = p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 5 : 9;
+    for (int i = 0; i < n; i++) {
+        h ^= (uint64_t)(uintptr_t)p->v[i];
+        h *= 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
+static bool same_definition(const mci_point *a, const mci_point *b)
+{
+    int n = a->kind == MCI_POINT_EXPLICIT ? 1 : a->kind == MCI_POINT_LPI ? 5 : 9;
+    return a->kind == b->kind && memcmp(a->v, b->v, (size_t)n * sizeof a->v[0]) == 0;
+}
+
+static uint32_t root_of(uint32_t *parent, uint32_t x)
+{
+    return find_root(parent, x);
+}
+
+/* Join with the smaller slot as root, so that roots are first occurrences. */
+static void join(uint32_t *parent, uint32_t a, uint32_t b)
+{
+    a = root_of(parent, a);
+    b = root_of(parent, b);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+static bool join_same_definitions(const mci_ctx *ctx, numbering *nb)
+{
+    size_t size = 16;
+    uint32_t *bucket;
+    while (size < 2 * nb->total)
+        size *= 2;
+    bucket = mci_malloc_array(ctx, size, sizeof *bucket);
+    if (!bucket)
+        return false;
+    for (size_t i = 0; i < size; i++)
+        bucket[i] = MCI_NONE;
+    for (uint32_t slot = 0; slot < nb->total; slot++) {
+        size_t at = definition_hash(nb->table[slot]) & (size - 1);
+        while (bucket[at] != MCI_NONE && !same_definition(nb->table[bucket[at]], nb->table[slot]))
+            at = (at + 1) & (size - 1);
+        if (bucket[at] == MCI_NONE)
+            bucket[at] = slot;
+        else
+            join(nb->parent, bucket[at], slot);
+    }
+    mci_free(ctx, bucket);
+    return true;
+}
+
+typedef struct boxed_slot {
+    double lo[3], hi[3];
+    uint32_t slot;
+} boxed_slot;
+
+static int compare_boxed(const void *x, const void *y)
+{
+    const boxed_slot *a = x, *b = y;
+    if (a->lo[0] != b->lo[0])
+        return a->lo[0] < b->lo[0] ? -1 : 1;
+    return (a->slot > b->slot) - (a->slot < b->slot);
+}
+
+static bool join_equal_points(const mci_ctx *ctx, numbering *nb)
+{
+    size_t n = 0;
+    boxed_slot *items = mci_malloc_array(ctx, nb->total + 1, sizeof *items);
+    if (!items)
+        return false;
+    for (uint32_t slot = 0; slot < nb->total; slot++) {
+        if (nb->parent[slot] != slot)
+            continue; /* a copy of an earlier definition */
+        mci_point_bounds(nb->table[slot], items[n].lo, items[n].hi);
+        items[n++].slot = slot;
+    }
+    if (n > 0)
+        qsort(items, n, sizeof *items, compare_boxed);
+    for (size_t i = 0; i < n; i++) {
+        for (size_t j = i + 1; j < n && items[j].lo[0] <= items[i].hi[0]; j++) {
+            const boxed_slot *a = &items[i], *b = &items[j];
+            if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
+                b->lo[2] > a->hi[2])
+                continue;
+            if (mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                join(nb->parent, a->slot, b->slot);
+        }
+    }
+    mci_free(ctx, items);
+    return true;
+}
+
 mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
-    size_t total = 0, id = 0;
-    const mci_point **table;
-    uint32_t *order, *tmp;
+    numbering nb = {NULL, NULL, 0};
+    size_t id = 0;
+    bool ok;
     double t0 = seconds_now();
     for (size_t k = 0; k < s->arr_count; k++)
-        total += s->arrs[k].point_count;
-    if (total >= UINT32_MAX)
-        return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total);
+        nb.total += s->arrs[k].point_count;
+    if (nb.total >= UINT32_MAX)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", nb.total);
     s->gid_start = mci_malloc_array(ctx, s->arr_count + 1, sizeof *s->gid_start);
-    s->gid = mci_malloc_array(ctx, total + 1, sizeof *s->gid);
-    table = mci_malloc_array(ctx, total + 1, sizeof *table);
-    order = mci_malloc_array(ctx, total + 1, sizeof *order);
-    tmp = mci_malloc_array(ctx, total + 1, sizeof *tmp);
-    if (s->gid_start && s->gid && table && order && tmp) {
-        for (size_t k = 0, slot = 0; k < s->arr_count; k++) {
-            s->gid_start[k] = (uint32_t)slot;
-            for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {
-                table[slot] = &s->arrs[k].points[p];
-                order[slot] = (uint32_t)slot;
-            }
+    s->gid = mci_malloc_array(ctx, nb.total + 1, sizeof *s->gid);
+    nb.table = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.table);
+    nb.parent = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.parent);
+    ok = s->gid_start && s->gid && nb.table && nb.parent;
+    for (size_t k = 0, slot = 0; ok && k < s->arr_count; k++) {
+        s->gid_start[k] = (uint32_t)slot;
+        for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {
+            nb.table[slot] = &s->arrs[k].points[p];
+            nb.parent[slot] = (uint32_t)slot;
         }
-        s->gid_start[s->arr_count] = (uint32_t)total;
-        mci_sort_point_ids(table, order, tmp, total);
-        for (size_t i = 0; i < total; i++) {
-            id += i > 0 && !mci_points_equal(table[order[i]], table[order[i - 1]]);
-            s->gid[order[i]] = (uint32_t)id;
-        }
-        s->point_count = total ? id + 1 : 0;
     }
-    bool ok = s->gid_start && s->gid && table && order && tmp;
-    mci_free(ctx, table);
-    mci_free(ctx, order);
-    mci_free(ctx, tmp);
+    if (ok)
+        s->gid_start[s->arr_count] = (uint32_t)nb.total;
+    ok = ok && join_same_definitions(ctx, &nb) && join_equal_points(ctx, &nb);
+    for (uint32_t slot = 0; ok && slot < nb.total; slot++) {
+        uint32_t root = root_of(nb.parent, slot);
+        s->gid[slot] = root == slot ? (uint32_t)id++ : s->gid[root];
+    }
+    s->point_count = ok ? id : 0;
+    mci_free(ctx, nb.table);
+    mci_free(ctx, nb.parent);
     s->stats.seconds_merge = seconds_now() - t0;
     return ok ? MCSG_OK : mci_fail_nomem(err, "numbering points");
 }

@@ -18,6 +18,9 @@ typedef enum mci_tt_kind {
 typedef struct mci_tt_result {
     mci_tt_kind kind;
     bool overlap;
+    /* SEGMENT: whether it lies along an edge of t1 (two of t1's corners are on t2's
+     * plane), and of t2. */
+    bool along_edge[2];
     mci_point end[2];
 } mci_tt_result;
 

@@ -59,12 +59,22 @@ static int plane_section(const mci_plane *t, const mci_plane *plane, const int s
     return n;
 }
 
+/* The common line of the two planes, as an axis and direction sign (computed once). */
+typedef struct line_order {
+    int axis, sign;
+} line_order;
+
+static int order_on_line(const mci_point *a, const mci_point *b, const line_order *l)
+{
+    return l->sign * mci_compare_coord(a, b, l->axis);
+}
+
 /* Sort a section's ends along the line; a single point is its own segment. */
-static void order_section(mci_point s[2], int n, const mci_plane *p1, const mci_plane *p2)
+static void order_section(mci_point s[2], int n, const line_order *l)
 {
     if (n == 1) {
         s[1] = s[0];
-    } else if (mci_order_on_plane_line(&s[0], &s[1], p1, p2) > 0) {
+    } else if (order_on_line(&s[0], &s[1], l) > 0) {
         mci_point t = s[0];
         s[0] = s[1];
         s[1] = t;
@@ -72,13 +82,13 @@ static void order_section(mci_point s[2], int n, const mci_plane *p1, const mci_
 }
 
 static void overlap_on_line(const mci_point s1[2], const mci_point s2[2],
-                            const mci_plane *p1, const mci_plane *p2, mci_tt_result *out)
+                            const line_order *l, mci_tt_result *out)
 {
     const mci_point *start, *end;
     int order;
-    start = mci_order_on_plane_line(&s1[0], &s2[0], p1, p2) >= 0 ? &s1[0] : &s2[0];
-    end = mci_order_on_plane_line(&s1[1], &s2[1], p1, p2) <= 0 ? &s1[1] : &s2[1];
-    order = mci_order_on_plane_line(start, end, p1, p2);
+    start = order_on_line(&s1[0], &s2[0], l) >= 0 ? &s1[0] : &s2[0];
+    end = order_on_line(&s1[1], &s2[1], l) <= 0 ? &s1[1] : &s2[1];
+    order = order_on_line(start, end, l);
     if (order > 0) {
         out->kind = MCI_TT_DISJOINT;
         return;
@@ -129,6 +139,7 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
 {
     int side1[3], side2[3], n1, n2;
     mci_point s1[2], s2[2];
+    line_order line;
     memset(out, 0, sizeof *out);
     vertex_sides(t1, t2, side1);
     if (all_strictly_one_side(side1))
@@ -141,9 +152,15 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
         out->overlap = coplanar_interiors_overlap(t1, t2);
         return;
     }
+    out->along_edge[0] = (side1[0] == 0) + (side1[1] == 0) + (side1[2] == 0) == 2;
+    out->along_edge[1] = (side2[0] == 0) + (side2[1] == 0) + (side2[2] == 0) == 2;
     n1 = plane_section(t1, t2, side1, s1);
     n2 = plane_section(t2, t1, side2, s2);
-    order_section(s1, n1, t1, t2);
-    order_section(s2, n2, t1, t2);
-    overlap_on_line(s1, s2, t1, t2, out);
+    /* Not coplanar and both meet the other's plane: the planes are not parallel. */
+    line.axis = mci_plane_line_axis(t1, t2, &line.sign);
+    if (line.axis < 0)
+        return; /* not reached: parallel planes put t1 strictly on one side */
+    order_section(s1, n1, &line);
+    order_section(s2, n2, &line);
+    overlap_on_line(s1, s2, &line, out);
 }

@@ -11,6 +11,7 @@
 #include "exact.h"
 #include "exact_kernel.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -110,6 +111,7 @@ typedef struct builder {
     size_t cell_capacity, id_capacity;
     uint32_t *stack;
     size_t stack_len, stack_capacity;
+    double *face_box; /* per face: min x, y, z, max x, y, z */
 } builder;
 
 const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
@@ -214,25 +216,100 @@ static bool split_points(const mci_cell *cell, double mid[3])
     return true;
 }
 
-/* Most faces are small: a face whose bounding box lies inside the cell touches it, one
- * whose box misses the cell does not; only faces straddling the cell's boundary need the
- * exact separating-axis test. */
-static bool face_touches_cell(const mci_octree *t, uint32_t f, const mci_cell *cell)
+/* Whether the triangle's plane provably misses the box: the box corners extreme along
+ * the normal, evaluated in doubles, are both strictly on one side by more than a bound
+ * on the rounding error (differences, the cross product and the dot product each add at
+ * most a few units of 2^-53 relative to the sums of absolute terms; 1e-14 covers them
+ * tenfold, 1e-300 covers underflow). When it cannot prove it, the face is kept. */
+static bool plane_misses_box(const double *a, const double *b, const double *c,
+                             const double lo[3], const double hi[3])
 {
-    const double *v[3] = {mci_octree_face_vertex(t, f, 0), mci_octree_face_vertex(t, f, 1),
-                          mci_octree_face_vertex(t, f, 2)};
+    double d1[3], d2[3], lowest = 0, highest = 0, bound = 0;
+    for (int k = 0; k < 3; k++) {
+        d1[k] = b[k] - a[k];
+        d2[k] = c[k] - a[k];
+    }
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        double n = d1[i] * d2[j] - d1[j] * d2[i];
+        double n_abs = fabs(d1[i] * d2[j]) + fabs(d1[j] * d2[i]);
+        double to_lo = lo[k] - a[k], to_hi = hi[k] - a[k];
+        lowest += n * (n > 0 ? to_lo : to_hi);
+        highest += n * (n > 0 ? to_hi : to_lo);
+        bound += n_abs * fmax(fabs(to_lo), fabs(to_hi));
+    }
+    bound = bound * 1e-14 + 1e-300;
+    return lowest > bound || highest < -bound;
+}
+
+/* The same for the axis (q - p) x e_k: in the projection along k, f(x) = (q - p) x
+ * (x - p) spans [min(0, f(r)), max(0, f(r))] over the triangle; the box's range of f
+ * comes from its extreme corners. */
+static bool edge_axis_misses_box(const double *p, const double *q, const double *r,
+                                 const double lo[3], const double hi[3], int k)
+{
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double ei = q[i] - p[i], ej = q[j] - p[j];
+    double fr = ei * (r[j] - p[j]) - ej * (r[i] - p[i]);
+    double lo_j = lo[j] - p[j], hi_j = hi[j] - p[j], lo_i = lo[i] - p[i], hi_i = hi[i] - p[i];
+    double f_lo = ei * (ei > 0 ? lo_j : hi_j) - ej * (ej > 0 ? hi_i : lo_i);
+    double f_hi = ei * (ei > 0 ? hi_j : lo_j) - ej * (ej > 0 ? lo_i : hi_i);
+    double bound = fabs(ei) * (fmax(fabs(lo_j), fabs(hi_j)) + fabs(r[j] - p[j])) +
+                   fabs(ej) * (fmax(fabs(lo_i), fabs(hi_i)) + fabs(r[i] - p[i]));
+    bound = bound * 1e-14 + 1e-300;
+    return f_lo > fmax(0, fr) + bound || f_hi < fmin(0, fr) - bound;
+}
+
+static bool triangle_misses_box(const double *const v[3], const double lo[3],
+                                const double hi[3])
+{
+    if (plane_misses_box(v[0], v[1], v[2], lo, hi))
+        return true;
+    for (int e = 0; e < 3; e++)
+        for (int k = 0; k < 3; k++)
+            if (edge_axis_misses_box(v[e], v[(e + 1) % 3], v[(e + 2) % 3], lo, hi, k))
+                return true;
+    return false;
+}
+
+/* Faces listed in a cell are a superset of those touching it: a face is dropped only
+ * when its bounding box misses the cell or its plane or an edge axis provably does (the
+ * separating axis theorem in doubles with error bounds). Completeness is
+ * what matters (any point two faces share lies in a leaf cell listing both); an extra
+ * face only costs a candidate pair that the exact triangle test then rejects. */
+static bool face_touches_cell(const builder *b, uint32_t f, const mci_cell *cell)
+{
+    const double *box = b->face_box + 6 * (size_t)f;
     bool inside = true;
     for (int k = 0; k < 3; k++) {
-        double min = v[0][k], max = v[0][k];
-        for (int i = 1; i < 3; i++) {
-            min = v[i][k] < min ? v[i][k] : min;
-            max = v[i][k] > max ? v[i][k] : max;
-        }
-        if (max < cell->lo[k] || min > cell->hi[k])
+        if (box[3 + k] < cell->lo[k] || box[k] > cell->hi[k])
             return false;
-        inside = inside && cell->lo[k] <= min && max <= cell->hi[k];
+        inside = inside && cell->lo[k] <= box[k] && box[3 + k] <= cell->hi[k];
     }
-    return inside || mci_triangle_touches_box(v[0], v[1], v[2], cell->lo, cell->hi);
+    if (inside)
+        return true;
+    {
+        const double *v[3] = {mci_octree_face_vertex(b->tree, f, 0),
+                              mci_octree_face_vertex(b->tree, f, 1),
+                              mci_octree_face_vertex(b->tree, f, 2)};
+        return !triangle_misses_box(v, cell->lo, cell->hi);
+    }
+}
+
+static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
+{
+    double *box = mci_malloc_array(ctx, t->face_id_count + 1, 6 * sizeof *box);
+    for (uint32_t f = 0; box && f < t->face_id_count; f++) {
+        double *out = box + 6 * (size_t)f;
+        for (int v = 0; v < 3; v++) {
+            const double *p = mci_octree_face_vertex(t, f, v);
+            for (int k = 0; k < 3; k++) {
+                out[k] = v == 0 || p[k] < out[k] ? p[k] : out[k];
+                out[3 + k] = v == 0 || p[k] > out[3 + k] ? p[k] : out[3 + k];
+            }
+        }
+    }
+    return box;
 }
 
 /* Child `index` of `parent`: its box, and the parent's faces that touch it appended to
@@ -254,7 +331,7 @@ static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
     c->count = 0;
     for (uint32_t i = 0; i < p->count; i++) {
         uint32_t f = t->face_ids[p->first + i];
-        if (!face_touches_cell(t, f, c))
+        if (!face_touches_cell(b, f, c))
             continue;
         if (!grow(b->ctx, (void **)&t->face_ids, &b->id_capacity, t->face_id_count + 1,
                   sizeof *t->face_ids))
@@ -361,8 +438,10 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     b.tree = out;
     b.params.max_cell_faces = params ? params->max_cell_faces : DEFAULT_MAX_CELL_FACES;
     b.params.max_depth = params ? params->max_depth : DEFAULT_MAX_DEPTH;
-    ok = index_faces(ctx, out) && build_cells(&b);
+    ok = index_faces(ctx, out) && (b.face_box = face_boxes(ctx, out)) != NULL &&
+         build_cells(&b);
     mci_free(ctx, b.stack);
+    mci_free(ctx, b.face_box);
     if (!ok) {
         mci_octree_free(ctx, out);
         return mci_fail_nomem(err, "building the octree");
@@ -400,11 +479,37 @@ static bool face_boxes_overlap(const mci_octree *t, uint32_t f, uint32_t g)
     return true;
 }
 
-static int compare_u64(const void *a, const void *b)
+/* Least-significant-digit radix sort, 16 bits per pass; passes over digits that are
+ * the same in every key are skipped (face ids rarely use all 32 bits). */
+static bool radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
+    uint64_t *tmp = mci_malloc_array(ctx, n, sizeof *tmp), *src = keys, *dst = tmp;
+    size_t *count = mci_malloc_array(ctx, 65536, sizeof *count);
+    bool ok = tmp && count;
+    for (int shift = 0; ok && shift < 64; shift += 16) {
+        size_t sum = 0;
+        memset(count, 0, 65536 * sizeof *count);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift) & 0xffff]++;
+        if (count[(src[0] >> shift) & 0xffff] == n)
+            continue; /* one digit value: the pass would not move anything */
+        for (size_t d = 0; d < 65536; d++) {
+            size_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            dst[count[(src[i] >> shift) & 0xffff]++] = src[i];
+        src = dst;
+        dst = src == keys ? tmp : keys;
+    }
+    if (ok && src != keys)
+        memcpy(keys, src, n * sizeof *keys);
+    mci_free(ctx, tmp);
+    mci_free(ctx, count);
+    return ok;
 }
+
 
 static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const mci_cell *cell,
                                uint64_t **pairs, size_t *count, size_t *capacity)
@@ -441,8 +546,12 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
         }
     }
     /* A pair sharing several cells was collected once per cell: keep one. */
-    if (*count)
-        qsort(*pairs, *count, sizeof **pairs, compare_u64);
+    if (*count && !radix_sort_u64(ctx, *pairs, *count)) {
+        mci_free(ctx, *pairs);
+        *pairs = NULL;
+        *count = 0;
+        return mci_fail_nomem(err, "collecting candidate pairs");
+    }
     for (size_t i = 0; i < *count; i++) {
         if (i == 0 || (*pairs)[i] != (*pairs)[i - 1])
             (*pairs)[unique++] = (*pairs)[i];

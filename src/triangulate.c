@@ -63,6 +63,8 @@ static int prev3(int i)
 static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
     const mci_point *pts = c->in->points;
+    if (c->in->known_collinear && c->in->known_collinear(c->in->user, a, b, p))
+        return 0;
     return c->in->sign * mci_orient2d_projected(&pts[a], &pts[b], &pts[p], c->in->axis);
 }
 

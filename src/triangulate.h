@@ -25,6 +25,11 @@ typedef struct mci_cdt_input {
     size_t insert_count;
     const uint32_t *edges;
     size_t edge_count;
+    /* Optional (may be NULL): true when points a, b, c are known to be collinear by
+     * construction (e.g. all on one segment's line). Such triples are answered without
+     * a predicate, whose exact stage is slow on the exact zeros they produce. */
+    bool (*known_collinear)(const void *user, uint32_t a, uint32_t b, uint32_t c);
+    const void *user;
 } mci_cdt_input;
 
 /* The triangles (point ids, counter-clockwise in the face's orientation) tile the face

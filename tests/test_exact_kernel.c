@@ -837,6 +837,71 @@ static void check_point_bounds(const scenario *s, int i)
     }
 }
 
+/* ---------------------------------------------------------------- point boxes */
+
+static long box_points, box_infinite, box_tight; /* mci_point_bounds of implicit points */
+static int box_printed;
+
+/* lo <= x (upper: x <= hi), exactly. An infinite bound on its own side always holds. */
+static bool box_bound_holds(double b, mpq_srcptr x, bool upper)
+{
+    mpq_t q;
+    int c;
+    if (isinf(b) && (b > 0) == upper)
+        return true;
+    if (!isfinite(b))
+        return false;
+    mpq_init(q);
+    mpq_set_d(q, b);
+    c = mpq_cmp(q, x);
+    mpq_clear(q);
+    return upper ? c >= 0 : c <= 0;
+}
+
+/* x - b rounded to a double (the size of a miss), or NaN when b is not finite. */
+static double box_gap(mpq_srcptr x, double b)
+{
+    mpq_t d;
+    double g;
+    if (!isfinite(b))
+        return NAN;
+    mpq_init(d);
+    mpq_set_d(d, b);
+    mpq_sub(d, x, d);
+    g = mpq_get_d(d);
+    mpq_clear(d);
+    return g;
+}
+
+/* The box of mci_point_bounds contains the exact point; counts infinite and tight boxes
+ * (tight: hi - lo <= 1e-10 (|lo| + |hi|) + 1e-300 on every axis). */
+static void check_point_box(const scenario *s, int i)
+{
+    const mci_point *p = &ws.kpt[i];
+    double lo[3], hi[3];
+    bool infinite = false, tight = true;
+    mci_point_bounds(p, lo, hi);
+    for (int k = 0; k < 3; k++) {
+        mpq_srcptr x = ws.rx[i].c[k];
+        bool ok = box_bound_holds(lo[k], x, false) && box_bound_holds(hi[k], x, true);
+        CHECK_MSG(ok, "mci_point_bounds (%s) axis %d: [%a, %a] misses exact %a",
+                  class_names[s->cls], k, lo[k], hi[k], mpq_get_d(x));
+        if (!ok && box_printed++ < MAX_PRINTED) {
+            print_point(s, "of", i);
+            fprintf(stderr, "  base %a, y = %a +- %a, w = %a +- %a; exact - lo = %a, "
+                    "exact - hi = %a\n", p->v[0][k], p->y[k].v, p->y[k].e, p->w.v,
+                    p->w.e, box_gap(x, lo[k]), box_gap(x, hi[k]));
+        }
+        infinite |= isinf(lo[k]) || isinf(hi[k]);
+        tight &= hi[k] - lo[k] <= 1e-10 * (fabs(lo[k]) + fabs(hi[k])) + 1e-300;
+    }
+    if (p->kind != MCI_POINT_EXPLICIT) {
+        box_points++;
+        box_infinite += infinite;
+        box_tight += tight && !infinite;
+    }
+}
+
 /* ---------------------------------------------------------------- building a scenario */
 
 static void build_point(const scenario *s, int i)
@@ -867,6 +932,7 @@ static void build_point(const scenario *s, int i)
     zpoint_from_qvec(&ws.rpt[i], &ws.rx[i]);
     if (d->kind != MCI_POINT_EXPLICIT)
         check_point_bounds(s, i);
+    check_point_box(s, i);
 }
 
 static void build(const scenario *s)
@@ -1662,8 +1728,10 @@ static void print_predicate_table(void)
                nonzero ? 100.0 * (t.decided - t.decided_zero) / nonzero : 0.0,
                t.decided_zero, t.mismatches);
     }
-    printf("total cases: %ld; cached values with an uninformative bound (inf/NaN): %ld\n\n",
+    printf("total cases: %ld; cached values with an uninformative bound (inf/NaN): %ld\n",
            total, uninformative_bounds);
+    printf("implicit point boxes: %ld, infinite %ld, tight (1e-10) %ld\n\n", box_points,
+           box_infinite, box_tight);
 }
 
 int main(void)
