@@ -363,9 +363,27 @@ int mci_orient3d_exact(const mci_point *p, const mci_plane *plane)
     return big_orient3d(p, plane, s.e0);
 }
 
+static bool same_coordinates(const double *a, const double *b)
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+/* An explicit point equal to an input vertex that defines the plane lies on it: the
+ * common case of shared and duplicated vertices (identical operands), which the filter
+ * cannot decide (the value is exactly zero). */
+static bool explicit_on_plane(const mci_point *p, const mci_plane *plane)
+{
+    return p->kind == MCI_POINT_EXPLICIT &&
+           (same_coordinates(p->v[0], plane->a) || same_coordinates(p->v[0], plane->b) ||
+            same_coordinates(p->v[0], plane->c));
+}
+
 int mci_orient3d(const mci_point *p, const mci_plane *plane)
 {
-    int s = mci_orient3d_filtered(p, plane);
+    int s;
+    if (explicit_on_plane(p, plane))
+        return 0;
+    s = mci_orient3d_filtered(p, plane);
     return s != MCI_UNCERTAIN ? s : mci_orient3d_exact(p, plane);
 }
 
@@ -477,10 +495,19 @@ static int orient2d_intervals(const mci_point *p, const mci_point *q, const mci_
     return fv_sign(fv_sub(fv_mul(d[0][0], d[1][1]), fv_mul(d[0][1], d[1][0])));
 }
 
+static bool explicit_twins(const mci_point *a, const mci_point *b)
+{
+    return a->kind == MCI_POINT_EXPLICIT && b->kind == MCI_POINT_EXPLICIT &&
+           same_coordinates(a->v[0], b->v[0]);
+}
+
 int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
                            int axis)
 {
-    int s = mci_orient2d_projected_filtered(p, q, r, axis);
+    int s;
+    if (explicit_twins(p, q) || explicit_twins(q, r) || explicit_twins(p, r))
+        return 0;
+    s = mci_orient2d_projected_filtered(p, q, r, axis);
     if (s == MCI_UNCERTAIN)
         s = orient2d_intervals(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
