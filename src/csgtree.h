@@ -1,0 +1,98 @@
+/*
+ * CSG tree machinery of the classification stage (paper §5.1-5.3): space labels and
+ * their combination rules (Eq. 3), the positive tree (differences pushed down to
+ * complemented leaves, Eq. 4), and the CSGlist of a primitive (the subtrees hanging off
+ * its critical path, each with its desired labels), which decides whether a face of the
+ * primitive belongs to the result (Eq. 2, regularized: a face shared by several
+ * primitives is kept once).
+ */
+#ifndef MESHCSG_CSGTREE_H
+#define MESHCSG_CSGTREE_H
+
+#include "internal.h"
+
+/* Where a face (or a point of it) is with respect to a solid. SAME / OPPO: on the
+ * solid's boundary, with the solid's outward normal equal / opposite to the face's. */
+typedef enum mci_label {
+    MCI_LABEL_OUT = 0,
+    MCI_LABEL_IN = 1,
+    MCI_LABEL_SAME = 2,
+    MCI_LABEL_OPPO = 3,
+    MCI_LABEL_UNKNOWN = 4
+} mci_label;
+
+#define MCI_LABEL_BIT(l) (1u << (l))
+
+/* The label with respect to the complement of the solid. */
+mci_label mci_label_complement(mci_label l);
+/* SAME <-> OPPO (the face's normal reversed), IN and OUT unchanged. */
+mci_label mci_label_reverse(mci_label l);
+/* The label with respect to A op B from those with respect to A and B (paper Eq. 3);
+ * UNKNOWN propagates unless the other operand decides (IN for union, OUT for
+ * intersection). */
+mci_label mci_label_union(mci_label a, mci_label b);
+mci_label mci_label_intersection(mci_label a, mci_label b);
+
+typedef enum mci_pnode_kind {
+    MCI_PNODE_LEAF = 0, /* a primitive, possibly complemented */
+    MCI_PNODE_UNION,
+    MCI_PNODE_INTERSECTION,
+    MCI_PNODE_EMPTY, /* constant: the empty set */
+    MCI_PNODE_FULL   /* constant: all of space (a complemented empty set) */
+} mci_pnode_kind;
+
+/* Nodes are in post-order: the subtree of node i is nodes i - size + 1 .. i. */
+typedef struct mci_pnode {
+    uint8_t kind;
+    uint8_t complement; /* leaves only */
+    uint32_t leaf;      /* leaves only: the primitive's index */
+    uint32_t first, count; /* children: child[first .. first + count) */
+    uint32_t parent;    /* UINT32_MAX for the root */
+    uint32_t size;
+} mci_pnode;
+
+typedef struct mci_ptree {
+    mci_pnode *nodes;
+    size_t node_count;
+    uint32_t *child;
+    uint32_t *leaf_node;          /* per primitive: its node */
+    const mcsg_mesh **leaf_mesh;  /* per primitive */
+    mcsg_node_id *leaf_source;    /* per primitive: the mcsg_tree leaf */
+    size_t leaf_count;
+} mci_ptree;
+
+/* The positive tree of the subtree under mcsg_tree_root: primitives are the leaves with
+ * at least one triangle, numbered in post-order; empty leaves, empty operations and the
+ * complements of empty sets become constants. No recursion (trees may be 100,000 deep). */
+mcsg_status mci_ptree_build(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *out,
+                            mcsg_error *err);
+void mci_ptree_free(const mci_ctx *ctx, mci_ptree *t);
+
+/* The label of a face with respect to the subtree of `node`, from its labels with
+ * respect to each primitive as it is (not complemented: complements are applied here).
+ * scratch holds node_count labels. */
+mci_label mci_ptree_eval(const mci_ptree *t, uint32_t node, const mci_label *leaf_labels,
+                         mci_label *scratch);
+
+/* One subtree off a primitive's critical path and the labels it must have (bit set of
+ * MCI_LABEL_BIT) for the primitive's face to be kept. */
+typedef struct mci_csg_entry {
+    uint32_t node;
+    uint8_t desired;
+} mci_csg_entry;
+
+/* The CSGlist of primitive `leaf` (paper §5.3, Fig. 9): for every ancestor on the path
+ * to the root and every sibling subtree s of the path there, one entry; desired OUT
+ * under a union and IN under an intersection, plus SAME when s comes after the path
+ * (Eq. 2 keeps A's face in A op B when it is SAME on B, not B's). `out` needs room for
+ * node_count entries; returns the number written. */
+size_t mci_csglist(const mci_ptree *t, uint32_t leaf, mci_csg_entry *out);
+
+/* Whether the face belongs to the result: 1 yes, 0 no, -1 not decided (some entry is
+ * UNKNOWN and none is undesired). Labels as for mci_ptree_eval, relative to the face's
+ * normal as it will be output (reversed for a complemented primitive's face: see
+ * mci_label_reverse). */
+int mci_csglist_accepts(const mci_ptree *t, const mci_csg_entry *list, size_t n,
+                        const mci_label *leaf_labels, mci_label *scratch);
+
+#endif
