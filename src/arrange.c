@@ -86,29 +86,13 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     memset(arr, 0, sizeof *arr);
 }
 
-static bool grow(const mci_ctx *ctx, void **data, size_t *capacity, size_t need, size_t size)
-{
-    size_t cap = *capacity ? *capacity : 8;
-    void *grown;
-    if (need <= *capacity)
-        return true;
-    while (cap < need)
-        cap *= 2;
-    grown = mci_realloc_array(ctx, *data, cap, size);
-    if (!grown)
-        return false;
-    *data = grown;
-    *capacity = cap;
-    return true;
-}
-
 /* Add a point known to lie on `line` (0: none known). */
 static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
                          uint64_t line)
 {
     size_t capacity = arr->point_capacity;
-    if (!grow(ctx, (void **)&arr->points, &arr->point_capacity, arr->point_count + 1,
-              sizeof *arr->points))
+    if (!mci_grow_array(ctx, (void **)&arr->points, &arr->point_capacity,
+                        arr->point_count + 1, sizeof *arr->points, 8))
         return false;
     if (capacity != arr->point_capacity) {
         mci_point_lines *grown = mci_realloc_array(ctx, arr->lines, arr->point_capacity,
@@ -145,8 +129,8 @@ static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *
 {
     uint32_t ia = (uint32_t)arr->point_count;
     if (!add_point_on(ctx, arr, a, s->line) || !add_point_on(ctx, arr, b, s->line) ||
-        !grow(ctx, (void **)&arr->segments, &arr->segment_capacity, arr->segment_count + 1,
-              sizeof *arr->segments))
+        !mci_grow_array(ctx, (void **)&arr->segments, &arr->segment_capacity,
+                        arr->segment_count + 1, sizeof *arr->segments, 8))
         return false;
     arr->segments[arr->segment_count] = *s;
     arr->segments[arr->segment_count].a = ia;
@@ -481,8 +465,8 @@ typedef struct splitter {
 
 static void cut(splitter *sp, uint32_t s, uint32_t p)
 {
-    if (!sp->ok || !grow(sp->ctx, (void **)&sp->cuts, &sp->cut_capacity, sp->cut_count + 1,
-                         sizeof *sp->cuts)) {
+    if (!sp->ok || !mci_grow_array(sp->ctx, (void **)&sp->cuts, &sp->cut_capacity,
+                                   sp->cut_count + 1, sizeof *sp->cuts, 8)) {
         sp->ok = false;
         return;
     }

@@ -87,6 +87,26 @@ void *mci_realloc_array(const mci_ctx *ctx, void *ptr, size_t count, size_t elem
     return mci_realloc(ctx, ptr, count * elem_size);
 }
 
+bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
+                    size_t elem_size, size_t min_capacity)
+{
+    size_t cap = *capacity > min_capacity ? *capacity : min_capacity;
+    void *grown;
+    if (need <= *capacity)
+        return true;
+    while (cap < need) {
+        if (cap > SIZE_MAX / 2)
+            return false;
+        cap *= 2;
+    }
+    grown = mci_realloc_array(ctx, *array, cap, elem_size);
+    if (!grown)
+        return false;
+    *array = grown;
+    *capacity = cap;
+    return true;
+}
+
 char *mci_strdup(const mci_ctx *ctx, const char *s)
 {
     size_t n = strlen(s) + 1;

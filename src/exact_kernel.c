@@ -102,7 +102,7 @@ static mci_fv fv_det3(const mci_fv r0[3], const mci_fv r1[3], const mci_fv r2[3]
 /* ---------------------------------------------------------------------------------- */
 /* Exact stage: two instantiations of the same formulas                                */
 
-static int point_vertex_count(const mci_point *p)
+int mci_point_vertex_count(const mci_point *p)
 {
     return p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 5 : 9;
 }
@@ -145,7 +145,7 @@ static input_scale scale_of(const mci_point *const *points, int npoints,
 {
     input_scale s = {INT_MAX, INT_MIN};
     for (int i = 0; i < npoints; i++)
-        scale_vertices(&s, points[i]->v, point_vertex_count(points[i]));
+        scale_vertices(&s, points[i]->v, mci_point_vertex_count(points[i]));
     for (int i = 0; i < nplanes; i++) {
         const double *v[3] = {planes[i]->a, planes[i]->b, planes[i]->c};
         scale_vertices(&s, v, 3);
@@ -407,10 +407,10 @@ int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
     return big_compare_coord(a, b, axis, s.e0);
 }
 
-static bool same_definition(const mci_point *a, const mci_point *b)
+bool mci_points_same_definition(const mci_point *a, const mci_point *b)
 {
     return a->kind == b->kind &&
-           memcmp(a->v, b->v, (size_t)point_vertex_count(a) * sizeof a->v[0]) == 0;
+           memcmp(a->v, b->v, (size_t)mci_point_vertex_count(a) * sizeof a->v[0]) == 0;
 }
 
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
@@ -418,7 +418,7 @@ int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
     int s;
     if (a->kind == MCI_POINT_EXPLICIT && b->kind == MCI_POINT_EXPLICIT)
         return (a->v[0][axis] > b->v[0][axis]) - (a->v[0][axis] < b->v[0][axis]);
-    if (same_definition(a, b))
+    if (mci_points_same_definition(a, b))
         return 0;
     s = mci_compare_coord_filtered(a, b, axis);
     return s != MCI_UNCERTAIN ? s : mci_compare_coord_exact(a, b, axis);

@@ -82,6 +82,13 @@ int mci_compare_coord(const mci_point *a, const mci_point *b, int axis);
 /* Lexicographic order of (x, y, z): -1, 0 or +1. */
 int mci_compare_lex(const mci_point *a, const mci_point *b);
 
+/* Number of input vertices defining a point (1, 5 or 9: its used entries of v[]). */
+int mci_point_vertex_count(const mci_point *p);
+
+/* True when a and b have the same definition (kind and defining vertices, by address):
+ * then they are the same point, without any arithmetic. */
+bool mci_points_same_definition(const mci_point *a, const mci_point *b);
+
 /* True when a and b are the same point (whatever their definitions). */
 bool mci_points_equal(const mci_point *a, const mci_point *b);
 

@@ -39,6 +39,11 @@ void *mci_malloc_array(const mci_ctx *ctx, size_t count, size_t elem_size);
 void *mci_calloc_array(const mci_ctx *ctx, size_t count, size_t elem_size);
 void *mci_realloc_array(const mci_ctx *ctx, void *ptr, size_t count, size_t elem_size);
 char *mci_strdup(const mci_ctx *ctx, const char *s);
+/* Make room for `need` elements of `elem_size` bytes in the growable array *array of
+ * *capacity elements (doubling, at least `min_capacity`). False on allocation failure or
+ * overflow, leaving the array as it was. */
+bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
+                    size_t elem_size, size_t min_capacity);
 
 /* Record an error (if err is non-NULL) and return `status`, so that callers can write
  * `return mci_fail(err, MCSG_ERR_PARSE, "%s:%zu: ...", name, line);`. */

@@ -46,14 +46,8 @@ static void face_plane(const mci_scene *s, uint32_t f, mci_plane *plane)
 static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
                      const mci_tt_result *r)
 {
-    if (h->count == h->capacity) {
-        size_t cap = h->capacity ? 2 * h->capacity : 1024;
-        pair_hit *grown = mci_realloc_array(ctx, h->v, cap, sizeof *grown);
-        if (!grown)
-            return false;
-        h->v = grown;
-        h->capacity = cap;
-    }
+    if (!mci_grow_array(ctx, (void **)&h->v, &h->capacity, h->count + 1, sizeof *h->v, 1024))
+        return false;
     h->v[h->count].f = f;
     h->v[h->count].g = g;
     h->v[h->count].kind = (uint8_t)r->kind;
@@ -304,42 +298,62 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
     return x;
 }
 
-/* plane_rep[f]: one face of f's flat region among the faces that take part in hits
- * (neighbours across flat edges are joined): crossing segments from faces with one
- * representative lie on one line of the face they cross. */
-static uint32_t *plane_representatives(const mci_ctx *ctx, const mci_scene *s,
-                                       const hit_list *hits)
+/* What the arrangements need to know about the faces that take part in hits, computed
+ * once per face: crease bit i says the surface bends at edge i (edge_is_crease), and
+ * plane_rep names the face's flat region among those faces (neighbours across flat
+ * edges are joined), so that crossing segments from one region are known to lie on one
+ * line of the face they cross. */
+typedef struct face_facts {
+    uint32_t *plane_rep;
+    uint8_t *crease;
+} face_facts;
+
+static void free_face_facts(const mci_ctx *ctx, face_facts *ff)
+{
+    mci_free(ctx, ff->plane_rep);
+    mci_free(ctx, ff->crease);
+    ff->plane_rep = NULL;
+    ff->crease = NULL;
+}
+
+static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit_list *hits,
+                               face_facts *ff)
 {
     uint32_t *parent = mci_malloc_array(ctx, s->face_count + 1, sizeof *parent);
     bool *in_hits = mci_calloc_array(ctx, s->face_count + 1, sizeof *in_hits);
-    if (!parent || !in_hits) {
-        mci_free(ctx, parent);
+    ff->plane_rep = parent;
+    ff->crease = mci_calloc_array(ctx, s->face_count + 1, sizeof *ff->crease);
+    if (!parent || !in_hits || !ff->crease) {
         mci_free(ctx, in_hits);
-        return NULL;
+        free_face_facts(ctx, ff);
+        return false;
     }
-    for (uint32_t f = 0; f < s->face_count; f++)
-        parent[f] = f;
     for (size_t h = 0; h < hits->count; h++)
         in_hits[hits->v[h].f] = in_hits[hits->v[h].g] = true;
     for (uint32_t f = 0; f < s->face_count; f++) {
         mci_plane plane;
+        parent[f] = f;
         if (!in_hits[f])
             continue;
         face_plane(s, f, &plane);
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 3; i++)
+            ff->crease[f] |= (uint8_t)(edge_is_crease(s, &plane, f, i) << i);
+    }
+    for (uint32_t f = 0; f < s->face_count; f++) {
+        for (int i = 0; in_hits[f] && i < 3; i++) {
             uint32_t nb = s->neighbour[3 * (size_t)f + i];
-            if (nb != MCI_NONE && nb > f && in_hits[nb] && !edge_is_crease(s, &plane, f, i))
+            if (nb != MCI_NONE && nb > f && in_hits[nb] && !((ff->crease[f] >> i) & 1))
                 parent[find_root(parent, nb)] = find_root(parent, f);
         }
     }
     for (uint32_t f = 0; f < s->face_count; f++)
         parent[f] = find_root(parent, f);
     mci_free(ctx, in_hits);
-    return parent;
+    return true;
 }
 
 static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
-                    const pair_hit *h, const uint32_t *plane_rep)
+                    const pair_hit *h, const face_facts *ff)
 {
     uint32_t other = h->f == arr->face ? h->g : h->f;
     mci_plane plane;
@@ -348,20 +362,20 @@ static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
     switch (h->kind) {
     case MCI_TT_SEGMENT:
         return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, &plane,
-                                    plane_rep[other], s->octree.face_leaf[other],
+                                    ff->plane_rep[other], s->octree.face_leaf[other],
                                     h->along_edge[h->f == arr->face ? 1 : 0]);
     case MCI_TT_POINT:
         return mci_arr_add_point(ctx, arr, &h->end[0]);
     default:
         for (int i = 0; i < 3; i++)
-            crease[i] = edge_is_crease(s, &plane, other, i);
+            crease[i] = (ff->crease[other] >> i) & 1;
         return mci_arr_add_coplanar(ctx, arr, other, &plane, crease, s->octree.face_leaf[other]);
     }
 }
 
 static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t f,
                                 const hit_list *hits, const uint32_t *ids, size_t n,
-                                const uint32_t *plane_rep, mci_face_arr *arr, mcsg_error *err)
+                                const face_facts *ff, mci_face_arr *arr, mcsg_error *err)
 {
     size_t coplanar = 0;
     mcsg_status st;
@@ -370,7 +384,7 @@ static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t
     st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
                       mci_scene_corner(s, f, 2), coplanar, err);
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
-        if (!add_hit(ctx, s, arr, &hits->v[ids[i]], plane_rep))
+        if (!add_hit(ctx, s, arr, &hits->v[ids[i]], ff))
             st = mci_fail_nomem(err, "arranging faces");
     return st == MCSG_OK ? mci_arr_merge(ctx, arr, err) : st;
 }
@@ -451,11 +465,13 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
                                       mcsg_error *err)
 {
-    uint32_t *start = NULL, *list = NULL, *plane_rep = plane_representatives(ctx, s, hits);
+    uint32_t *start = NULL, *list = NULL;
+    face_facts ff = {NULL, NULL};
     mcsg_status st = MCSG_OK;
+    bool facts = compute_face_facts(ctx, s, hits, &ff);
     s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
-    if (!plane_rep || !s->arr_of || !index_hits(ctx, s, hits, &start, &list)) {
-        mci_free(ctx, plane_rep);
+    if (!facts || !s->arr_of || !index_hits(ctx, s, hits, &start, &list)) {
+        free_face_facts(ctx, &ff);
         return mci_fail_nomem(err, "arranging faces");
     }
     for (uint32_t f = 0; f < s->face_count; f++)
@@ -469,9 +485,9 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hi
             continue;
         s->arr_of[f] = k;
         st = arrange_face(ctx, s, f, hits, list + start[f], start[f + 1] - start[f],
-                          plane_rep, &s->arrs[k++], err);
+                          &ff, &s->arrs[k++], err);
     }
-    mci_free(ctx, plane_rep);
+    free_face_facts(ctx, &ff);
     mci_free(ctx, start);
     mci_free(ctx, list);
     if (st == MCSG_OK)
@@ -561,8 +577,7 @@ typedef struct numbering {
 static uint64_t definition_hash(const mci_point *p)
 {
     uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)p->kind;
-    int n = p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 5 : 9;
-    for (int i = 0; i < n; i++) {
+    for (int i = 0; i < mci_point_vertex_count(p); i++) {
         h ^= (uint64_t)(uintptr_t)p->v[i];
         h *= 0xff51afd7ed558ccdu;
         h ^= h >> 32;
@@ -570,22 +585,11 @@ static uint64_t definition_hash(const mci_point *p)
     return h;
 }
 
-static bool same_definition(const mci_point *a, const mci_point *b)
-{
-    int n = a->kind == MCI_POINT_EXPLICIT ? 1 : a->kind == MCI_POINT_LPI ? 5 : 9;
-    return a->kind == b->kind && memcmp(a->v, b->v, (size_t)n * sizeof a->v[0]) == 0;
-}
-
-static uint32_t root_of(uint32_t *parent, uint32_t x)
-{
-    return find_root(parent, x);
-}
-
 /* Join with the smaller slot as root, so that roots are first occurrences. */
 static void join(uint32_t *parent, uint32_t a, uint32_t b)
 {
-    a = root_of(parent, a);
-    b = root_of(parent, b);
+    a = find_root(parent, a);
+    b = find_root(parent, b);
     if (a < b)
         parent[b] = a;
     else if (b < a)
@@ -605,7 +609,8 @@ static bool join_same_definitions(const mci_ctx *ctx, numbering *nb)
         bucket[i] = MCI_NONE;
     for (uint32_t slot = 0; slot < nb->total; slot++) {
         size_t at = definition_hash(nb->table[slot]) & (size - 1);
-        while (bucket[at] != MCI_NONE && !same_definition(nb->table[bucket[at]], nb->table[slot]))
+        while (bucket[at] != MCI_NONE &&
+               !mci_points_same_definition(nb->table[bucket[at]], nb->table[slot]))
             at = (at + 1) & (size - 1);
         if (bucket[at] == MCI_NONE)
             bucket[at] = slot;
@@ -683,7 +688,7 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
         s->gid_start[s->arr_count] = (uint32_t)nb.total;
     ok = ok && join_same_definitions(ctx, &nb) && join_equal_points(ctx, &nb);
     for (uint32_t slot = 0; ok && slot < nb.total; slot++) {
-        uint32_t root = root_of(nb.parent, slot);
+        uint32_t root = find_root(nb.parent, slot);
         s->gid[slot] = root == slot ? (uint32_t)id++ : s->gid[root];
     }
     s->point_count = ok ? id : 0;

@@ -121,27 +121,10 @@ const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
     return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)local + (size_t)k];
 }
 
-static bool grow(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
-                 size_t elem)
-{
-    void *grown;
-    size_t cap = *capacity ? *capacity : 64;
-    if (need <= *capacity)
-        return true;
-    while (cap < need)
-        cap *= 2;
-    grown = mci_realloc_array(ctx, *array, cap, elem);
-    if (!grown)
-        return false;
-    *array = grown;
-    *capacity = cap;
-    return true;
-}
-
 static bool push_cell(builder *b, uint32_t cell)
 {
-    if (!grow(b->ctx, (void **)&b->stack, &b->stack_capacity, b->stack_len + 1,
-              sizeof *b->stack))
+    if (!mci_grow_array(b->ctx, (void **)&b->stack, &b->stack_capacity,
+                        b->stack_len + 1, sizeof *b->stack, 64))
         return false;
     b->stack[b->stack_len++] = cell;
     return true;
@@ -333,8 +316,8 @@ static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
         uint32_t f = t->face_ids[p->first + i];
         if (!face_touches_cell(b, f, c))
             continue;
-        if (!grow(b->ctx, (void **)&t->face_ids, &b->id_capacity, t->face_id_count + 1,
-                  sizeof *t->face_ids))
+        if (!mci_grow_array(b->ctx, (void **)&t->face_ids, &b->id_capacity,
+                            t->face_id_count + 1, sizeof *t->face_ids, 64))
             return false;
         t->face_ids[t->face_id_count++] = f;
         c = &t->cells[child]; /* unchanged: cells are not reallocated here */
@@ -353,8 +336,8 @@ static bool split_cell(builder *b, uint32_t cell, const double mid[3], bool *spl
     mci_octree *t = b->tree;
     uint32_t first_child = (uint32_t)t->cell_count, largest = 0;
     size_t ids_before = t->face_id_count;
-    if (!grow(b->ctx, (void **)&t->cells, &b->cell_capacity, t->cell_count + 8,
-              sizeof *t->cells))
+    if (!mci_grow_array(b->ctx, (void **)&t->cells, &b->cell_capacity,
+                        t->cell_count + 8, sizeof *t->cells, 64))
         return false;
     t->cell_count += 8;
     for (int i = 0; i < 8; i++) {
@@ -520,7 +503,7 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const mc
             uint32_t g = t->face_ids[cell->first + j];
             if (t->face_leaf[f] == t->face_leaf[g] || !face_boxes_overlap(t, f, g))
                 continue;
-            if (!grow(ctx, (void **)pairs, capacity, *count + 1, sizeof **pairs))
+            if (!mci_grow_array(ctx, (void **)pairs, capacity, *count + 1, sizeof **pairs, 64))
                 return false;
             (*pairs)[(*count)++] = f < g ? (uint64_t)f << 32 | g : (uint64_t)g << 32 | f;
         }
