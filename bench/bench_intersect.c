@@ -8,37 +8,17 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "scene.h"
-#include "scenes.h"
+#include "benchlib.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define RUNS 5
 #define STEPS 7
 
 static const char *step_names[STEPS] = {"octree", "pairs", "tri-tri", "arrange", "number",
                                         "triangulate", "total"};
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
-static int compare_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static void fail(const mcsg_error *err)
-{
-    fprintf(stderr, "%s\n", err->message);
-    exit(1);
-}
 
 /* One run; fills the step times and, on the last run, the counts. */
 static void run_once(const mcsg_mesh *const *leaves, size_t n, double t[STEPS],
@@ -47,24 +27,24 @@ static void run_once(const mcsg_mesh *const *leaves, size_t n, double t[STEPS],
     mci_ctx ctx;
     mci_scene s;
     mcsg_error err;
-    double t0 = now(), t1, t2;
+    double t0 = bench_seconds(), t1, t2;
     mci_ctx_init(&ctx, NULL);
     if (mci_scene_build(&ctx, leaves, n, &s, &err) != MCSG_OK)
-        fail(&err);
-    t1 = now();
+        bench_fail(&err);
+    t1 = bench_seconds();
     if (mci_scene_number_points(&ctx, &s, &err) != MCSG_OK)
-        fail(&err);
-    t2 = now();
+        bench_fail(&err);
+    t2 = bench_seconds();
     for (size_t k = 0; k < s.arr_count; k++)
         if (mci_arr_triangulate(&ctx, &s.arrs[k], NULL, &err) != MCSG_OK)
-            fail(&err);
+            bench_fail(&err);
     t[0] = s.stats.seconds_octree;
     t[1] = s.stats.seconds_pairs;
     t[2] = s.stats.seconds_intersect;
     t[3] = s.stats.seconds_arrange;
     t[4] = t2 - t1;
-    t[5] = now() - t2;
-    t[6] = now() - t0;
+    t[5] = bench_seconds() - t2;
+    t[6] = bench_seconds() - t0;
     if (keep)
         *keep = s;
     else
@@ -90,10 +70,8 @@ static void run(const char *name, const mcsg_mesh *const *leaves, size_t n)
            "%zu arranged faces, %zu points, %zu sub-triangles\n ", name, s.face_count,
            s.stats.candidate_pairs, s.stats.intersecting_pairs, s.stats.coplanar_pairs,
            s.arr_count, s.point_count, tris);
-    for (int k = 0; k < STEPS; k++) {
-        qsort(times[k], RUNS, sizeof times[k][0], compare_double);
-        printf(" %s %.3f s", step_names[k], times[k][RUNS / 2]);
-    }
+    for (int k = 0; k < STEPS; k++)
+        printf(" %s %.3f s", step_names[k], bench_median(times[k], RUNS));
     printf("\n");
     mci_scene_free(&ctx, &s);
 }
@@ -101,16 +79,9 @@ static void run(const char *name, const mcsg_mesh *const *leaves, size_t n)
 static void ring(int spheres)
 {
     mcsg_tree *tree;
-    mcsg_error err;
-    const mcsg_mesh **leaves;
-    size_t n = 0;
+    size_t n;
+    const mcsg_mesh **leaves = bench_ring_leaves(spheres, &tree, &n);
     char name[64];
-    if (scene_ring_spheres(spheres, 1, NULL, &tree, &err) != MCSG_OK)
-        fail(&err);
-    leaves = malloc(mcsg_tree_node_count(tree) * sizeof *leaves);
-    for (mcsg_node_id id = 0; id < mcsg_tree_node_count(tree); id++)
-        if (mcsg_tree_leaf_mesh(tree, id))
-            leaves[n++] = mcsg_tree_leaf_mesh(tree, id);
     snprintf(name, sizeof name, "ring + %d spheres", spheres);
     run(name, leaves, n);
     free(leaves);
@@ -119,22 +90,14 @@ static void ring(int spheres)
 
 static void model_vs_shifted(const char *shared, const char *model)
 {
-    char path[4096];
+    char name[256];
     mcsg_mesh a, b;
-    mcsg_error err;
-    const double c = 0.99875026039496628, s = 0.049979169270678331;
-    double m[12] = {c, -s, 0, 0.07, s, c, 0, 0.04, 0, 0, 1, 0.03};
-    snprintf(path, sizeof path, "%s/models/%s", shared, model);
-    if (mcsg_mesh_read(path, MCSG_FORMAT_AUTO, NULL, &a, &err) != MCSG_OK ||
-        mcsg_mesh_copy(&a, NULL, &b, &err) != MCSG_OK)
-        fail(&err);
-    mcsg_mesh_transform(&b, m);
-    const mcsg_mesh *leaves[2] = {&a, &b};
-    snprintf(path, sizeof path, "%s vs shifted copy", model);
-    run(path, leaves, 2);
-    const mcsg_mesh *same[2] = {&a, &a};
-    snprintf(path, sizeof path, "%s vs itself", model);
-    run(path, same, 2);
+    bench_model_and_shifted(shared, model, &a, &b);
+    const mcsg_mesh *leaves[2] = {&a, &b}, *same[2] = {&a, &a};
+    snprintf(name, sizeof name, "%s vs shifted copy", model);
+    run(name, leaves, 2);
+    snprintf(name, sizeof name, "%s vs itself", model);
+    run(name, same, 2);
     mcsg_mesh_free(&a, NULL);
     mcsg_mesh_free(&b, NULL);
 }
