@@ -299,7 +299,7 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
 }
 
 /* What the arrangements need to know about the faces that take part in hits, computed
- * once per face: crease bit i says the surface bends at edge i (edge_is_crease), and
+ * once per face edge: crease bit i says the surface bends at edge i (edge_is_crease), and
  * plane_rep names the face's flat region among those faces (neighbours across flat
  * edges are joined), so that crossing segments from one region are known to lie on one
  * line of the face they cross. */
@@ -320,7 +320,7 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit
                                face_facts *ff)
 {
     uint32_t *parent = mci_malloc_array(ctx, s->face_count + 1, sizeof *parent);
-    bool *in_hits = mci_calloc_array(ctx, s->face_count + 1, sizeof *in_hits);
+    uint8_t *in_hits = mci_calloc_array(ctx, s->face_count + 1, sizeof *in_hits);
     ff->plane_rep = parent;
     ff->crease = mci_calloc_array(ctx, s->face_count + 1, sizeof *ff->crease);
     if (!parent || !in_hits || !ff->crease) {
@@ -328,16 +328,26 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit
         free_face_facts(ctx, ff);
         return false;
     }
-    for (size_t h = 0; h < hits->count; h++)
-        in_hits[hits->v[h].f] = in_hits[hits->v[h].g] = true;
+    /* in_hits: 1 in a hit, 2 in a coplanar hit (all its crease bits are needed). */
+    for (size_t h = 0; h < hits->count; h++) {
+        uint8_t mark = hits->v[h].kind == MCI_TT_COPLANAR ? 2 : 1;
+        in_hits[hits->v[h].f] |= mark;
+        in_hits[hits->v[h].g] |= mark;
+    }
+    /* Crease tests cost an exact zero on planar quads: only the bits used are computed
+     * (edges between two faces in hits, for the union below, and coplanar faces). */
     for (uint32_t f = 0; f < s->face_count; f++) {
         mci_plane plane;
         parent[f] = f;
         if (!in_hits[f])
             continue;
         face_plane(s, f, &plane);
-        for (int i = 0; i < 3; i++)
-            ff->crease[f] |= (uint8_t)(edge_is_crease(s, &plane, f, i) << i);
+        for (int i = 0; i < 3; i++) {
+            uint32_t nb = s->neighbour[3 * (size_t)f + i];
+            bool used = (in_hits[f] & 2) || (nb != MCI_NONE && nb > f && in_hits[nb]);
+            if (used)
+                ff->crease[f] |= (uint8_t)(edge_is_crease(s, &plane, f, i) << i);
+        }
     }
     for (uint32_t f = 0; f < s->face_count; f++) {
         for (int i = 0; in_hits[f] && i < 3; i++) {
