@@ -514,8 +514,26 @@ static int cmd_demo(int argc, char **argv)
     printf("  build scene      %8.3f s\n", t1 - t0);
     printf("  validate leaves  %8.3f s  (%s)\n", t2 - t1,
            valid ? "every leaf closed, oriented, manifold" : "INVALID LEAVES");
-    printf("evaluation is not built yet: meshcsg cannot compute the CSG result so far, so "
-           "no result mesh is written.\n");
+    if (valid) {
+        mcsg_curves curves;
+        mcsg_intersect_stats st;
+        if (mcsg_intersect(tree, &opts, &curves, &st, &err) != MCSG_OK) {
+            fail_line(&err);
+            mcsg_tree_free(tree);
+            return EXIT_PROBLEM;
+        }
+        printf("  octree           %8.3f s  (%zu cells)\n", st.seconds_octree, st.cells);
+        printf("  candidate pairs  %8.3f s  (%zu)\n", st.seconds_pairs, st.candidate_pairs);
+        printf("  intersect        %8.3f s  (%zu crossing pairs)\n", st.seconds_intersect,
+               st.intersecting_pairs);
+        printf("  arrange faces    %8.3f s  (%zu faces)\n", st.seconds_arrange,
+               st.arranged_faces);
+        printf("  number points    %8.3f s  (%zu curve segments)\n", st.seconds_merge,
+               curves.segment_count);
+        mcsg_curves_free(&curves, &opts);
+    }
+    printf("classification is not built yet: meshcsg cannot compute the CSG result so far, "
+           "so no result mesh is written.\n");
     mcsg_tree_free(tree);
     return valid ? 0 : EXIT_PROBLEM;
 }
