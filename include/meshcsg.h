@@ -376,6 +376,44 @@ mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg
 
 void mcsg_curves_free(mcsg_curves *curves, const mcsg_options *opts);
 
+/* ------------------------------------------------------------------------------------ */
+/* Evaluation                                                                            */
+
+/* Where an output triangle comes from: it lies in triangle `face` of the mesh of tree
+ * leaf `leaf` (with that leaf's orientation, or reversed when the leaf is subtracted). */
+typedef struct mcsg_provenance {
+    mcsg_node_id leaf;
+    uint32_t face;
+} mcsg_provenance;
+
+typedef struct mcsg_eval_stats {
+    size_t primitives;        /* leaves with at least one triangle that the root reaches */
+    size_t faces;             /* their triangles in total ... */
+    size_t faces_min, faces_max; /* ... and in the smallest and largest primitive */
+    size_t pieces;            /* triangles after the touched faces were split */
+    size_t regions;           /* groups of pieces that share all labels (paper §5.2) */
+    size_t rays;              /* exact ray tests for first seeds (paper §5.5) */
+    size_t local_tests;       /* exact label changes across intersection curves */
+    size_t output_vertices, output_triangles;
+    size_t rounding_dropped_triangles; /* flattened when distinct exact vertices rounded
+                                          to the same doubles were joined */
+    mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
+    double seconds_tree;        /* positive tree and CSG lists */
+    double seconds_triangulate; /* tessellating the split faces */
+    double seconds_classify;    /* regions, labels and selection */
+    double seconds_assemble;    /* welding and rounding the output */
+    double seconds_total;
+} mcsg_eval_stats;
+
+/* Evaluate the CSG tree exactly: the boundary of the regularized result as a closed,
+ * consistently oriented, edge-manifold triangle mesh whose vertices are the exact result
+ * vertices rounded to double (only at the end). Leaves must be closed and edge-manifold
+ * (see mcsg_mesh_check). An empty result gives a mesh with no triangles.
+ * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
+ * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
+mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
+                      mcsg_provenance **provenance, mcsg_eval_stats *stats, mcsg_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static void *default_malloc(void *user, size_t size)
@@ -358,4 +359,24 @@ void mcsg_mesh_transform(mcsg_mesh *mesh, const double m[12])
      * zero, and a singular map (det ~ 0) collapses the mesh whatever we choose. */
     if (det < 0)
         mcsg_mesh_flip(mesh);
+}
+
+double mci_seconds_now(void)
+{
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+uint64_t mci_coordinate_hash(const double *x)
+{
+    uint64_t h = 0x9e3779b97f4a7c15u;
+    for (int k = 0; k < 3; k++) {
+        double v = x[k] == 0 ? 0.0 : x[k]; /* -0 and +0 are one coordinate */
+        uint64_t bits;
+        memcpy(&bits, &v, sizeof bits);
+        h = (h ^ bits) * 0xff51afd7ed558ccdu;
+        h ^= h >> 29;
+    }
+    return h;
 }

@@ -45,6 +45,12 @@ char *mci_strdup(const mci_ctx *ctx, const char *s);
 bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
                     size_t elem_size, size_t min_capacity);
 
+/* Wall-clock seconds since some fixed point (for step timings). */
+double mci_seconds_now(void);
+
+/* A hash of a point's three coordinates in which -0 and +0 are equal. */
+uint64_t mci_coordinate_hash(const double *x);
+
 /* Record an error (if err is non-NULL) and return `status`, so that callers can write
  * `return mci_fail(err, MCSG_ERR_PARSE, "%s:%zu: ...", name, line);`. */
 mcsg_status mci_fail(mcsg_error *err, mcsg_status status, const char *fmt, ...)

@@ -11,7 +11,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 typedef struct pair_hit {
     uint32_t f, g;
@@ -24,13 +23,6 @@ typedef struct hit_list {
     pair_hit *v;
     size_t count, capacity;
 } hit_list;
-
-static double seconds_now(void)
-{
-    struct timespec ts;
-    timespec_get(&ts, TIME_UTC);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
 
 const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
 {
@@ -119,19 +111,6 @@ typedef struct leaf_adjacency {
     uint32_t *faces;
 } leaf_adjacency;
 
-static uint64_t coordinate_hash(const double *x)
-{
-    uint64_t h = 0x9e3779b97f4a7c15u;
-    for (int k = 0; k < 3; k++) {
-        double v = x[k] == 0 ? 0.0 : x[k]; /* -0 and +0 are one coordinate */
-        uint64_t bits;
-        memcpy(&bits, &v, sizeof bits);
-        h = (h ^ bits) * 0xff51afd7ed558ccdu;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 static bool same_coordinates(const double *a, const double *b)
 {
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
@@ -152,7 +131,7 @@ static bool canonical_vertices(const mci_ctx *ctx, const mcsg_mesh *m, uint32_t 
         table[i] = MCI_NONE;
     for (uint32_t v = 0; v < m->vertex_count; v++) {
         const double *x = m->vertices + 3 * (size_t)v;
-        size_t at = coordinate_hash(x) & (size - 1);
+        size_t at = mci_coordinate_hash(x) & (size - 1);
         while (table[at] != MCI_NONE && !same_coordinates(m->vertices + 3 * (size_t)table[at], x))
             at = (at + 1) & (size - 1);
         if (table[at] == MCI_NONE)
@@ -515,16 +494,16 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     uint64_t *pairs = NULL;
     size_t count = 0;
     hit_list hits = {NULL, 0, 0};
-    double t0 = seconds_now(), t1, t2;
+    double t0 = mci_seconds_now(), t1, t2;
     mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);
     if (st != MCSG_OK)
         return st;
-    t1 = seconds_now();
+    t1 = mci_seconds_now();
     s->stats.candidate_pairs = count;
     if (!intersect_pairs(ctx, s, pairs, count, &hits))
         st = mci_fail_nomem(err, "intersecting faces");
     mci_free(ctx, pairs);
-    t2 = seconds_now();
+    t2 = mci_seconds_now();
     if (st == MCSG_OK && !build_neighbours(ctx, s, &hits))
         st = mci_fail_nomem(err, "finding neighbouring faces");
     if (st == MCSG_OK)
@@ -532,7 +511,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     mci_free(ctx, hits.v);
     s->stats.seconds_pairs = t1 - t0;
     s->stats.seconds_intersect = t2 - t1;
-    s->stats.seconds_arrange = seconds_now() - t2;
+    s->stats.seconds_arrange = mci_seconds_now() - t2;
     s->stats.arranged_faces = s->arr_count;
     return st;
 }
@@ -540,13 +519,13 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
-    double t0 = seconds_now();
+    double t0 = mci_seconds_now();
     mcsg_status st;
     memset(scene, 0, sizeof *scene);
     st = mci_octree_build(ctx, leaves, leaf_count, NULL, &scene->octree, err);
     if (st != MCSG_OK)
         return st;
-    scene->stats.seconds_octree = seconds_now() - t0;
+    scene->stats.seconds_octree = mci_seconds_now() - t0;
     scene->face_count = scene->octree.face_base[scene->octree.leaf_count];
     scene->stats.faces = scene->face_count;
     scene->stats.cells = scene->octree.cell_count;
@@ -677,7 +656,7 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     numbering nb = {NULL, NULL, 0};
     size_t id = 0;
     bool ok;
-    double t0 = seconds_now();
+    double t0 = mci_seconds_now();
     for (size_t k = 0; k < s->arr_count; k++)
         nb.total += s->arrs[k].point_count;
     if (nb.total >= UINT32_MAX)
@@ -704,7 +683,7 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     s->point_count = ok ? id : 0;
     mci_free(ctx, nb.table);
     mci_free(ctx, nb.parent);
-    s->stats.seconds_merge = seconds_now() - t0;
+    s->stats.seconds_merge = mci_seconds_now() - t0;
     return ok ? MCSG_OK : mci_fail_nomem(err, "numbering points");
 }
 

@@ -1,0 +1,850 @@
+/*
+ * Classification (paper §5) on the split, triangulated scene.
+ *
+ * Pieces: each leaf's surface is cut into pieces, the sub-triangles of its arranged
+ * faces and its untouched faces whole. Their vertices carry output ids (global point
+ * numbers), so pieces of one leaf meet along identical edges.
+ *
+ * Regions (the paper's intra-primitive groups, §5.2): pieces joined across every edge
+ * that is not a separator. A separator is an elementary edge of an arrangement, i.e.
+ * it lies on the surface of another leaf. A region's interior meets no other leaf's
+ * surface, except coplanar regions lying wholly on it, so its label with respect to
+ * every other leaf is constant.
+ *
+ * Labels: a first region (per connected part of a leaf) gets its labels by exact ray
+ * shooting (the first seeds, §5.5); the others inherit them across separators, which
+ * changes only the labels with respect to the leaves whose surface holds that separator
+ * (Prop. 2). Those are decided by an exact local test at the separator: the side of the
+ * piece's far vertex with respect to the face(s) of the other leaf containing the edge
+ * (a wedge test when the edge lies along an edge of that leaf), and SAME / OPPO by the
+ * orientations of coplanar faces.
+ *
+ * Only leaves whose bounding box meets this leaf's can have another label than OUT.
+ */
+#include "classify.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------------------------- */
+/* Exact ray shooting                                                                  */
+
+/* Orientation of a, b and p + (eps, eps^2) in the (y, z) projection, for an infinitely
+ * small eps: never 0 when a and b differ in the projection. The eps terms of
+ * (b - a) x (p' - a) are eps (a_z - b_z) and eps^2 (b_y - a_y). */
+static int perturbed_orient_yz(const mci_point *a, const mci_point *b, const mci_point *p)
+{
+    const double *u = a->v[0], *w = b->v[0];
+    int o = mci_orient2d_projected(a, b, p, 0);
+    if (o != 0)
+        return o;
+    if (u[2] != w[2])
+        return u[2] > w[2] ? 1 : -1;
+    return (w[1] > u[1]) - (w[1] < u[1]);
+}
+
+/* Whether the triangle's box misses the box lo..hi extended to +infinity in x (no
+ * ray from a point of lo..hi can meet it) and whether it misses lo..hi itself. */
+static void box_tests(const double *a, const double *b, const double *c,
+                      const double lo[3], const double hi[3], bool *misses_ray,
+                      bool *misses_point)
+{
+    *misses_ray = *misses_point = false;
+    for (int k = 0; k < 3; k++) {
+        double mn = a[k] < b[k] ? a[k] : b[k], mx = a[k] > b[k] ? a[k] : b[k];
+        mn = c[k] < mn ? c[k] : mn;
+        mx = c[k] > mx ? c[k] : mx;
+        if (mx < lo[k] || (k > 0 && mn > hi[k]))
+            *misses_ray = true;
+        if (mx < lo[k] || mn > hi[k])
+            *misses_point = true;
+    }
+}
+
+static bool point_on_triangle(const mci_point *p, const mci_plane *plane)
+{
+    int which;
+    return mci_orient3d(p, plane) == 0 && mci_point_in_triangle(p, plane, &which) != MCI_OUTSIDE;
+}
+
+mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m)
+{
+    double lo[3], hi[3];
+    int winding = 0;
+    mci_point_bounds(p, lo, hi);
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->triangles + 3 * t;
+        const double *a = m->vertices + 3 * (size_t)tri[0], *b = m->vertices + 3 * (size_t)tri[1],
+                     *c = m->vertices + 3 * (size_t)tri[2];
+        mci_point pa, pb, pc;
+        mci_plane plane;
+        int nx, side;
+        bool misses_ray, misses_point;
+        box_tests(a, b, c, lo, hi, &misses_ray, &misses_point);
+        if (misses_ray)
+            continue;
+        mci_plane_init(&plane, a, b, c);
+        if (!misses_point && point_on_triangle(p, &plane))
+            return MCI_LABEL_UNKNOWN; /* no ray decides for a point on the surface */
+        mci_point_explicit(&pa, a);
+        mci_point_explicit(&pb, b);
+        mci_point_explicit(&pc, c);
+        nx = mci_orient2d_projected(&pa, &pb, &pc, 0); /* sign of the normal's x */
+        if (nx == 0 || perturbed_orient_yz(&pa, &pb, p) != nx ||
+            perturbed_orient_yz(&pb, &pc, p) != nx || perturbed_orient_yz(&pc, &pa, p) != nx)
+            continue;
+        side = mci_orient3d(p, &plane);
+        if (side == 0)
+            return MCI_LABEL_UNKNOWN; /* unreachable: p would be on the triangle */
+        if (side == -nx)
+            winding += nx; /* crossed ahead of p; leaving the solid when nx > 0 */
+    }
+    return winding > 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Exact local test at a separator                                                     */
+
+static void face_plane(const mci_scene *s, uint32_t f, mci_plane *plane)
+{
+    mci_plane_init(plane, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
+                   mci_scene_corner(s, f, 2));
+}
+
+/* The edges of a triangle a point lies on, as a bit set. */
+static int edges_through(mci_containment c, int which)
+{
+    if (c == MCI_ON_EDGE)
+        return 1 << which;
+    if (c == MCI_ON_VERTEX)
+        return 1 << which | 1 << ((which + 2) % 3);
+    return 0;
+}
+
+/* SAME or OPPO for a piece of face arrangement fa lying on the coplanar face h. */
+static mci_label coplanar_label(const mci_face_arr *fa, const mci_plane *h)
+{
+    mci_point a, b, c;
+    mci_point_explicit(&a, h->a);
+    mci_point_explicit(&b, h->b);
+    mci_point_explicit(&c, h->c);
+    return mci_orient2d_projected(&a, &b, &c, fa->axis) == fa->sign ? MCI_LABEL_SAME
+                                                                    : MCI_LABEL_OPPO;
+}
+
+static mci_label one_face_label(int side, const mci_face_arr *fa, const mci_plane *h)
+{
+    return side > 0 ? MCI_LABEL_OUT : side < 0 ? MCI_LABEL_IN : coplanar_label(fa, h);
+}
+
+/* Side of the third corner of face h2 (the one off the plane, if any) w.r.t. h. */
+static int bend(const mci_scene *s, uint32_t h2, const mci_plane *h)
+{
+    for (int k = 0; k < 3; k++) {
+        mci_point q;
+        int side;
+        mci_point_explicit(&q, mci_scene_corner(s, h2, k));
+        if ((side = mci_orient3d(&q, h)) != 0)
+            return side;
+    }
+    return 0;
+}
+
+/* Two faces h1, h2 of a leaf meet at the edge; the leaf's interior is below both
+ * (convex edge) or below either (reflex edge). s1, s2: sides of the piece's far vertex. */
+static mci_label wedge_label(int convex, int s1, int s2, const mci_face_arr *fa,
+                             const mci_plane *h1, const mci_plane *h2)
+{
+    if (convex) {
+        if (s1 == 0)
+            return s2 < 0 ? coplanar_label(fa, h1) : MCI_LABEL_OUT;
+        if (s2 == 0)
+            return s1 < 0 ? coplanar_label(fa, h2) : MCI_LABEL_OUT;
+        return s1 < 0 && s2 < 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
+    }
+    if (s1 == 0)
+        return s2 > 0 ? coplanar_label(fa, h1) : MCI_LABEL_IN;
+    if (s2 == 0)
+        return s1 > 0 ? coplanar_label(fa, h2) : MCI_LABEL_IN;
+    return s1 > 0 && s2 > 0 ? MCI_LABEL_OUT : MCI_LABEL_IN;
+}
+
+/* Label of a piece of face arrangement fa with respect to the leaf of face h, where the
+ * piece's edge x-y lies in the closed face h and w is the piece's third vertex. The
+ * piece's interior does not meet that leaf's surface (or lies in it), so the side of w
+ * near the edge decides. */
+static mci_label local_label(const mci_scene *s, const mci_face_arr *fa, const mci_point *x,
+                             const mci_point *y, const mci_point *w, uint32_t h)
+{
+    mci_plane p1, p2;
+    int wx, wy, common, side1, c;
+    uint32_t h2 = MCI_NONE;
+    mci_containment cx, cy;
+    face_plane(s, h, &p1);
+    cx = mci_point_in_triangle(x, &p1, &wx);
+    cy = mci_point_in_triangle(y, &p1, &wy);
+    if (cx == MCI_OUTSIDE || cy == MCI_OUTSIDE)
+        return MCI_LABEL_UNKNOWN;
+    common = edges_through(cx, wx) & edges_through(cy, wy);
+    if (common)
+        h2 = s->neighbour[3 * (size_t)h + (common & 1 ? 0 : common & 2 ? 1 : 2)];
+    side1 = mci_orient3d(w, &p1);
+    if (h2 == MCI_NONE || (c = bend(s, h2, &p1)) == 0)
+        return one_face_label(side1, fa, &p1);
+    face_plane(s, h2, &p2);
+    return wedge_label(c < 0, side1, mci_orient3d(w, &p2), fa, &p1, &p2);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* The classifier: output vertex ids and leaf boxes                                    */
+
+typedef struct coord_table {
+    const double **key;
+    uint32_t *value;
+    size_t size;
+} coord_table;
+
+/* The id stored for coordinates x, or `fresh` after storing it. */
+static uint32_t coord_lookup(coord_table *t, const double *x, uint32_t fresh)
+{
+    size_t at = mci_coordinate_hash(x) & (t->size - 1);
+    while (t->key[at]) {
+        const double *k = t->key[at];
+        if (k[0] == x[0] && k[1] == x[1] && k[2] == x[2])
+            return t->value[at];
+        at = (at + 1) & (t->size - 1);
+    }
+    t->key[at] = x;
+    t->value[at] = fresh;
+    return fresh;
+}
+
+static void leaf_box(const mcsg_mesh *m, double box[6])
+{
+    for (int k = 0; k < 3; k++) {
+        box[k] = m->vertex_count ? m->vertices[k] : 0;
+        box[3 + k] = box[k];
+    }
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = m->vertices[3 * v + k];
+            box[k] = x < box[k] ? x : box[k];
+            box[3 + k] = x > box[3 + k] ? x : box[3 + k];
+        }
+}
+
+static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
+{
+    const mci_scene *s = cl->scene;
+    const mci_octree *o = &s->octree;
+    size_t total = 0, size = 16;
+    coord_table t;
+    bool ok;
+    for (size_t l = 0; l < o->leaf_count; l++)
+        total += o->leaves[l]->vertex_count;
+    while (size < 2 * (total + s->gid_start[s->arr_count]))
+        size *= 2;
+    t.size = size;
+    t.key = mci_calloc_array(ctx, size, sizeof *t.key);
+    t.value = mci_malloc_array(ctx, size, sizeof *t.value);
+    cl->vertex_first = mci_malloc_array(ctx, o->leaf_count + 1, sizeof *cl->vertex_first);
+    cl->vertex_id = mci_malloc_array(ctx, total + 1, sizeof *cl->vertex_id);
+    cl->new_vertex = mci_malloc_array(ctx, total + 1, sizeof *cl->new_vertex);
+    ok = t.key && t.value && cl->vertex_first && cl->vertex_id && cl->new_vertex &&
+         s->point_count + total < UINT32_MAX;
+    for (size_t k = 0; ok && k < s->arr_count; k++)
+        for (size_t p = 0; p < s->arrs[k].point_count; p++)
+            if (s->arrs[k].points[p].kind == MCI_POINT_EXPLICIT)
+                coord_lookup(&t, s->arrs[k].points[p].v[0], s->gid[s->gid_start[k] + p]);
+    for (size_t l = 0, at = 0; ok && l < o->leaf_count; l++) {
+        const mcsg_mesh *m = o->leaves[l];
+        cl->vertex_first[l] = at;
+        for (size_t v = 0; v < m->vertex_count; v++, at++) {
+            uint32_t fresh = (uint32_t)(s->point_count + cl->new_vertex_count);
+            uint32_t id = coord_lookup(&t, m->vertices + 3 * v, fresh);
+            if (id == fresh)
+                cl->new_vertex[cl->new_vertex_count++] = m->vertices + 3 * v;
+            cl->vertex_id[at] = id;
+        }
+    }
+    mci_free(ctx, t.key);
+    mci_free(ctx, t.value);
+    return ok;
+}
+
+mcsg_status mci_classifier_init(const mci_ctx *ctx, const mci_scene *scene,
+                                const mci_ptree *tree, mci_classifier *cl, mcsg_error *err)
+{
+    memset(cl, 0, sizeof *cl);
+    cl->scene = scene;
+    cl->tree = tree;
+    cl->box = mci_malloc_array(ctx, scene->octree.leaf_count + 1, sizeof *cl->box);
+    if (!cl->box || !assign_vertex_ids(ctx, cl)) {
+        mci_classifier_free(ctx, cl);
+        return mci_fail_nomem(err, "classifying faces");
+    }
+    for (size_t l = 0; l < scene->octree.leaf_count; l++)
+        leaf_box(scene->octree.leaves[l], cl->box[l]);
+    return MCSG_OK;
+}
+
+void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl)
+{
+    mci_free(ctx, cl->vertex_first);
+    mci_free(ctx, cl->vertex_id);
+    mci_free(ctx, cl->new_vertex);
+    mci_free(ctx, cl->box);
+    memset(cl, 0, sizeof *cl);
+}
+
+void mci_kept_free(const mci_ctx *ctx, mci_kept *kept)
+{
+    mci_free(ctx, kept->tris);
+    mci_free(ctx, kept->faces);
+    memset(kept, 0, sizeof *kept);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* One leaf: pieces, regions, labels, selection                                        */
+
+typedef struct keyed {
+    uint64_t key;
+    uint32_t ref;
+} keyed;
+
+static int compare_keyed(const void *x, const void *y)
+{
+    const keyed *a = x, *b = y;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->ref > b->ref) - (a->ref < b->ref);
+}
+
+static uint64_t edge_key(uint32_t u, uint32_t v)
+{
+    return u < v ? (uint64_t)u << 32 | v : (uint64_t)v << 32 | u;
+}
+
+typedef struct leaf_work {
+    const mci_ctx *ctx;
+    const mci_classifier *cl;
+    const mci_scene *s;
+    uint32_t leaf, face_base, face_count;
+    size_t np;        /* pieces */
+    uint32_t *pv;     /* 3 per piece: output vertex ids */
+    uint32_t *pface;  /* per piece: global face id */
+    uint32_t *plocal; /* 3 per piece: arrangement point id (arranged faces) */
+    uint32_t *mate;   /* per edge slot 3p + i (pv[i] -> pv[i + 1]): the slot across */
+    uint8_t *is_sep;  /* per edge slot */
+    keyed *sep;       /* separators: (edge key, face of another leaf holding it), sorted */
+    size_t nsep;
+    uint32_t *region; /* per piece */
+    size_t nreg;
+    uint32_t *reg_start, *reg_pieces; /* pieces by region (CSR) */
+    uint32_t *sep_start, *sep_slots;  /* separator slots by region (CSR) */
+    uint32_t *cand;   /* leaves whose box meets this leaf's */
+    size_t ncand;
+    uint32_t *slot_of_leaf; /* leaf -> index in cand, or MCI_NONE */
+    uint8_t *labels;  /* nreg x ncand */
+    mci_classify_stats *stats;
+    mcsg_error *err;
+} leaf_work;
+
+static void free_work(leaf_work *w)
+{
+    void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->region,
+                   w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
+                   w->slot_of_leaf, w->labels};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        mci_free(w->ctx, all[i]);
+}
+
+static const mci_face_arr *arr_of_face(const mci_scene *s, uint32_t f)
+{
+    return s->arr_of[f] == MCI_NONE ? NULL : &s->arrs[s->arr_of[f]];
+}
+
+static mcsg_status make_pieces(leaf_work *w)
+{
+    const mci_scene *s = w->s;
+    const mcsg_mesh *m = s->octree.leaves[w->leaf];
+    const uint32_t *vid = w->cl->vertex_id + w->cl->vertex_first[w->leaf];
+    size_t np = 0, at = 0;
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++)
+        np += arr_of_face(s, f) ? arr_of_face(s, f)->tri_count : 1;
+    if (np >= UINT32_MAX / 3)
+        return mci_fail(w->err, MCSG_ERR_LIMIT, "too many pieces in one leaf (%zu)", np);
+    w->np = np;
+    w->pv = mci_malloc_array(w->ctx, 3 * np + 1, sizeof *w->pv);
+    w->plocal = mci_malloc_array(w->ctx, 3 * np + 1, sizeof *w->plocal);
+    w->pface = mci_malloc_array(w->ctx, np + 1, sizeof *w->pface);
+    if (!w->pv || !w->plocal || !w->pface)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++) {
+        const mci_face_arr *arr = arr_of_face(s, f);
+        if (!arr) {
+            const uint32_t *t = m->triangles + 3 * (size_t)(f - w->face_base);
+            for (int i = 0; i < 3; i++) {
+                w->pv[3 * at + i] = vid[t[i]];
+                w->plocal[3 * at + i] = t[i];
+            }
+            w->pface[at++] = f;
+            continue;
+        }
+        for (size_t k = 0; k < arr->tri_count; k++, at++) {
+            const uint32_t *gid = s->gid + s->gid_start[s->arr_of[f]];
+            for (int i = 0; i < 3; i++) {
+                w->plocal[3 * at + i] = arr->tris[3 * k + i];
+                w->pv[3 * at + i] = gid[arr->tris[3 * k + i]];
+            }
+            w->pface[at] = f;
+        }
+    }
+    return MCSG_OK;
+}
+
+/* The point of vertex i of piece p. */
+static void piece_point(const leaf_work *w, size_t p, int i, mci_point *out)
+{
+    const mci_face_arr *arr = arr_of_face(w->s, w->pface[p]);
+    if (arr) {
+        *out = arr->points[w->plocal[3 * p + i]];
+    } else {
+        const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+        mci_point_explicit(out, m->vertices + 3 * (size_t)w->plocal[3 * p + i]);
+    }
+}
+
+static uint32_t slot_from(const leaf_work *w, size_t slot)
+{
+    return w->pv[slot];
+}
+
+static uint32_t slot_to(const leaf_work *w, size_t slot)
+{
+    return w->pv[slot - slot % 3 + (slot % 3 + 1) % 3];
+}
+
+/* Pair every directed piece edge with its opposite; a closed, consistently oriented
+ * edge-manifold surface has exactly one. */
+static mcsg_status pair_edges(leaf_work *w)
+{
+    size_t n = 3 * w->np, i = 0;
+    keyed *e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
+    mcsg_status st = MCSG_OK;
+    w->mate = mci_malloc_array(w->ctx, n + 1, sizeof *w->mate);
+    if (!e || !w->mate) {
+        mci_free(w->ctx, e);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (size_t k = 0; k < n; k++) {
+        e[k].key = edge_key(slot_from(w, k), slot_to(w, k));
+        e[k].ref = (uint32_t)k;
+    }
+    qsort(e, n, sizeof *e, compare_keyed);
+    while (i < n && st == MCSG_OK) {
+        size_t j = i;
+        while (j < n && e[j].key == e[i].key)
+            j++;
+        if (j - i != 2 || slot_from(w, e[i].ref) != slot_to(w, e[i + 1].ref))
+            st = mci_fail(w->err, MCSG_ERR_INTERNAL,
+                          "leaf %u does not close up after splitting: an edge is shared by "
+                          "%zu pieces%s (inputs must be closed and edge-manifold)",
+                          w->leaf, j - i, j - i == 2 ? " with equal orientations" : "");
+        else {
+            w->mate[e[i].ref] = e[i + 1].ref;
+            w->mate[e[i + 1].ref] = e[i].ref;
+        }
+        i = j;
+    }
+    mci_free(w->ctx, e);
+    return st;
+}
+
+/* Every elementary edge of the leaf's arrangements, with the other leaf's face. */
+static mcsg_status collect_separators(leaf_work *w)
+{
+    const mci_scene *s = w->s;
+    size_t n = 0;
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++)
+        n += arr_of_face(s, f) ? arr_of_face(s, f)->edge_count : 0;
+    w->sep = mci_malloc_array(w->ctx, n + 1, sizeof *w->sep);
+    w->is_sep = mci_calloc_array(w->ctx, 3 * w->np + 1, sizeof *w->is_sep);
+    if (!w->sep || !w->is_sep)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++) {
+        const mci_face_arr *arr = arr_of_face(s, f);
+        const uint32_t *gid = arr ? s->gid + s->gid_start[s->arr_of[f]] : NULL;
+        for (size_t e = 0; arr && e < arr->edge_count; e++) {
+            w->sep[w->nsep].key = edge_key(gid[arr->edges[e].a], gid[arr->edges[e].b]);
+            w->sep[w->nsep++].ref = arr->edges[e].other;
+        }
+    }
+    if (w->nsep > 0)
+        qsort(w->sep, w->nsep, sizeof *w->sep, compare_keyed);
+    return MCSG_OK;
+}
+
+/* Index of the first separator entry with this key, or nsep. */
+static size_t find_separator(const leaf_work *w, uint64_t key)
+{
+    size_t lo = 0, hi = w->nsep;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (w->sep[mid].key < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < w->nsep && w->sep[lo].key == key ? lo : w->nsep;
+}
+
+static uint32_t find_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+/* Regions: pieces joined across non-separator edges; numbered by first piece. */
+static mcsg_status build_regions(leaf_work *w)
+{
+    uint32_t *parent = mci_malloc_array(w->ctx, w->np + 1, sizeof *parent);
+    w->region = mci_malloc_array(w->ctx, w->np + 1, sizeof *w->region);
+    if (!parent || !w->region) {
+        mci_free(w->ctx, parent);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (uint32_t p = 0; p < w->np; p++)
+        parent[p] = p;
+    for (size_t k = 0; k < 3 * w->np; k++) {
+        uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+        w->is_sep[k] = find_separator(w, key) < w->nsep;
+        if (!w->is_sep[k]) {
+            uint32_t a = find_root(parent, (uint32_t)(k / 3));
+            uint32_t b = find_root(parent, w->mate[k] / 3);
+            parent[a > b ? a : b] = a > b ? b : a;
+        }
+    }
+    for (uint32_t p = 0; p < w->np; p++) {
+        uint32_t r = find_root(parent, p);
+        w->region[p] = r == p ? (uint32_t)w->nreg++ : w->region[r];
+    }
+    mci_free(w->ctx, parent);
+    return MCSG_OK;
+}
+
+/* CSR lists: pieces of each region, and separator slots of each region. */
+static mcsg_status index_regions(leaf_work *w)
+{
+    size_t nr = w->nreg;
+    w->reg_start = mci_calloc_array(w->ctx, nr + 2, sizeof *w->reg_start);
+    w->sep_start = mci_calloc_array(w->ctx, nr + 2, sizeof *w->sep_start);
+    w->reg_pieces = mci_malloc_array(w->ctx, w->np + 1, sizeof *w->reg_pieces);
+    w->sep_slots = mci_malloc_array(w->ctx, 3 * w->np + 1, sizeof *w->sep_slots);
+    if (!w->reg_start || !w->sep_start || !w->reg_pieces || !w->sep_slots)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t p = 0; p < w->np; p++) {
+        w->reg_start[w->region[p] + 2]++;
+        for (int i = 0; i < 3; i++)
+            w->sep_start[w->region[p] + 2] += w->is_sep[3 * p + i];
+    }
+    for (size_t r = 2; r < nr + 2; r++) {
+        w->reg_start[r] += w->reg_start[r - 1];
+        w->sep_start[r] += w->sep_start[r - 1];
+    }
+    for (size_t p = 0; p < w->np; p++) {
+        w->reg_pieces[w->reg_start[w->region[p] + 1]++] = (uint32_t)p;
+        for (int i = 0; i < 3; i++)
+            if (w->is_sep[3 * p + i])
+                w->sep_slots[w->sep_start[w->region[p] + 1]++] = (uint32_t)(3 * p + i);
+    }
+    return MCSG_OK;
+}
+
+static bool boxes_meet(const double a[6], const double b[6])
+{
+    for (int k = 0; k < 3; k++)
+        if (a[3 + k] < b[k] || b[3 + k] < a[k])
+            return false;
+    return true;
+}
+
+static mcsg_status find_candidates(leaf_work *w)
+{
+    size_t n = w->s->octree.leaf_count;
+    w->cand = mci_malloc_array(w->ctx, n + 1, sizeof *w->cand);
+    w->slot_of_leaf = mci_malloc_array(w->ctx, n + 1, sizeof *w->slot_of_leaf);
+    if (!w->cand || !w->slot_of_leaf)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t l = 0; l < n; l++) {
+        w->slot_of_leaf[l] = MCI_NONE;
+        if (l != w->leaf && boxes_meet(w->cl->box[l], w->cl->box[w->leaf])) {
+            w->slot_of_leaf[l] = (uint32_t)w->ncand;
+            w->cand[w->ncand++] = l;
+        }
+    }
+    if (w->nreg > 0 && w->ncand > SIZE_MAX / w->nreg)
+        return mci_fail(w->err, MCSG_ERR_LIMIT, "too many labels in one leaf");
+    w->labels = mci_malloc_array(w->ctx, w->nreg * w->ncand + 1, 1);
+    if (!w->labels)
+        return mci_fail_nomem(w->err, "classifying faces");
+    memset(w->labels, MCI_LABEL_UNKNOWN, w->nreg * w->ncand);
+    return MCSG_OK;
+}
+
+static bool point_outside_box(const mci_point *p, const double box[6])
+{
+    double lo[3], hi[3];
+    mci_point_bounds(p, lo, hi);
+    for (int k = 0; k < 3; k++)
+        if (hi[k] < box[k] || lo[k] > box[3 + k])
+            return true;
+    return false;
+}
+
+static void local_labels_at(leaf_work *w, uint8_t *to, size_t k, bool only_unknown);
+
+/* Labels a seed region's rays left open (every vertex tried lies on that leaf's
+ * surface): decided at a separator of the region on that leaf, if any. */
+static void seed_by_local_tests(leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (uint32_t i = w->sep_start[r]; i < w->sep_start[r + 1]; i++)
+        local_labels_at(w, lab, w->sep_slots[i], true);
+}
+
+/* First seed: the region's labels by rays from its vertices (untouched faces' vertices
+ * first: they lie on no other surface). A ray from a vertex on the other leaf's surface
+ * decides nothing; the next vertex is tried. */
+static void seed_region(leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1]; k++) {
+            uint32_t p = w->reg_pieces[k];
+            bool untouched = arr_of_face(w->s, w->pface[p]) == NULL;
+            if (untouched != (pass == 0))
+                continue;
+            for (int i = 0; i < 3; i++) {
+                mci_point v;
+                bool all = true;
+                piece_point(w, p, i, &v);
+                for (size_t c = 0; c < w->ncand; c++) {
+                    uint32_t m = w->cand[c];
+                    if (lab[c] != MCI_LABEL_UNKNOWN)
+                        continue;
+                    if (point_outside_box(&v, w->cl->box[m])) {
+                        lab[c] = MCI_LABEL_OUT;
+                        continue;
+                    }
+                    w->stats->rays++;
+                    lab[c] = (uint8_t)mci_ray_label(&v, w->s->octree.leaves[m]);
+                    all = all && lab[c] != MCI_LABEL_UNKNOWN;
+                }
+                if (all)
+                    return;
+            }
+        }
+    seed_by_local_tests(w, r);
+}
+
+/* Labels of the region of piece k / 3 with respect to the leaves holding its edge slot
+ * k, by local tests (only those still unknown if only_unknown). */
+static void local_labels_at(leaf_work *w, uint8_t *to, size_t k, bool only_unknown)
+{
+    const mci_scene *s = w->s;
+    size_t p = k / 3;
+    uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+    mci_point x, y, far;
+    piece_point(w, p, (int)(k % 3), &x);
+    piece_point(w, p, (int)(k % 3 + 1) % 3, &y);
+    piece_point(w, p, (int)(k % 3 + 2) % 3, &far);
+    for (size_t e = find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++) {
+        uint32_t h = w->sep[e].ref, c = w->slot_of_leaf[s->octree.face_leaf[h]];
+        if (c == MCI_NONE || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
+            continue;
+        w->stats->local_tests++;
+        to[c] = (uint8_t)local_label(s, arr_of_face(s, w->pface[p]), &x, &y, &far, h);
+    }
+}
+
+/* Labels of region r2 from those of r1 across separator slot k (a slot of r2): equal
+ * but for the leaves whose surface holds the separator (paper Prop. 2). */
+static void inherit_labels(leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
+{
+    uint8_t *to = w->labels + (size_t)r2 * w->ncand;
+    memcpy(to, w->labels + (size_t)r1 * w->ncand, w->ncand);
+    local_labels_at(w, to, k, false);
+}
+
+/* Whether separator slot k lies on the surface of leaf m. */
+static bool separator_on_leaf(const leaf_work *w, size_t k, uint32_t m)
+{
+    uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+    for (size_t e = find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++)
+        if (w->s->octree.face_leaf[w->sep[e].ref] == m)
+            return true;
+    return false;
+}
+
+/* Labels still unknown after the sweep (a seed whose vertices all lie on a leaf it
+ * touches only at points) are copied from neighbours across separators not on that
+ * leaf, until nothing changes. */
+static void fill_unknown_labels(leaf_work *w)
+{
+    bool changed = true;
+    while (changed) {
+        changed = false;
+        for (uint32_t r = 0; r < w->nreg; r++) {
+            uint8_t *lab = w->labels + (size_t)r * w->ncand;
+            for (size_t c = 0; c < w->ncand; c++) {
+                for (uint32_t i = w->sep_start[r];
+                     lab[c] == MCI_LABEL_UNKNOWN && i < w->sep_start[r + 1]; i++) {
+                    uint32_t k = w->sep_slots[i], r2 = w->region[w->mate[k] / 3];
+                    uint8_t there = w->labels[(size_t)r2 * w->ncand + c];
+                    if (there != MCI_LABEL_UNKNOWN && !separator_on_leaf(w, k, w->cand[c])) {
+                        lab[c] = there;
+                        changed = true;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* Breadth-first over regions across separators, seeding each unreached part. */
+static mcsg_status label_regions(leaf_work *w)
+{
+    uint32_t *queue = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *queue);
+    uint8_t *seen = mci_calloc_array(w->ctx, w->nreg + 1, 1);
+    size_t head = 0, tail = 0;
+    if (!queue || !seen) {
+        mci_free(w->ctx, queue);
+        mci_free(w->ctx, seen);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (uint32_t start = 0; start < w->nreg; start++) {
+        if (seen[start])
+            continue;
+        seed_region(w, start);
+        seen[start] = 1;
+        queue[tail++] = start;
+        while (head < tail) {
+            uint32_t r1 = queue[head++];
+            for (uint32_t i = w->sep_start[r1]; i < w->sep_start[r1 + 1]; i++) {
+                uint32_t k = w->mate[w->sep_slots[i]], r2 = w->region[k / 3];
+                if (seen[r2])
+                    continue;
+                inherit_labels(w, r1, r2, k);
+                seen[r2] = 1;
+                queue[tail++] = r2;
+            }
+        }
+    }
+    mci_free(w->ctx, queue);
+    mci_free(w->ctx, seen);
+    fill_unknown_labels(w);
+    return MCSG_OK;
+}
+
+static bool grow_kept(const mci_ctx *ctx, mci_kept *kept, size_t need)
+{
+    size_t cap = kept->capacity;
+    if (!mci_grow_array(ctx, (void **)&kept->tris, &cap, need, 3 * sizeof *kept->tris, 1024))
+        return false;
+    cap = kept->capacity;
+    if (!mci_grow_array(ctx, (void **)&kept->faces, &cap, need, sizeof *kept->faces, 1024))
+        return false;
+    kept->capacity = cap;
+    return true;
+}
+
+/* Evaluate each region's CSGlist and output the pieces of the kept ones. */
+static mcsg_status select_pieces(leaf_work *w, mci_kept *kept)
+{
+    const mci_ptree *t = w->cl->tree;
+    bool reversed = t->nodes[t->leaf_node[w->leaf]].complement;
+    mci_csg_entry *list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *list);
+    mci_label *scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *scratch);
+    mci_label *leaf_labels = mci_malloc_array(w->ctx, t->leaf_count + 1, sizeof *leaf_labels);
+    uint8_t *keep = mci_malloc_array(w->ctx, w->nreg + 1, 1);
+    mcsg_status st = MCSG_OK;
+    size_t n;
+    if (!list || !scratch || !leaf_labels || !keep) {
+        st = mci_fail_nomem(w->err, "classifying faces");
+        goto done;
+    }
+    n = mci_csglist(t, w->leaf, list);
+    for (size_t l = 0; l < t->leaf_count; l++)
+        leaf_labels[l] = MCI_LABEL_OUT;
+    for (size_t r = 0; r < w->nreg && st == MCSG_OK; r++) {
+        const uint8_t *lab = w->labels + r * w->ncand;
+        int accepts;
+        for (size_t c = 0; c < w->ncand; c++)
+            leaf_labels[w->cand[c]] =
+                reversed ? mci_label_reverse((mci_label)lab[c]) : (mci_label)lab[c];
+        accepts = mci_csglist_accepts(t, list, n, leaf_labels, scratch);
+        if (accepts < 0)
+            st = mci_fail(w->err, MCSG_ERR_INTERNAL,
+                          "leaf %u: a region's label could not be decided", w->leaf);
+        keep[r] = accepts == 1;
+    }
+    for (size_t p = 0; p < w->np && st == MCSG_OK; p++) {
+        uint32_t *tri;
+        if (!keep[w->region[p]])
+            continue;
+        if (!grow_kept(w->ctx, kept, kept->count + 1)) {
+            st = mci_fail_nomem(w->err, "classifying faces");
+            break;
+        }
+        tri = kept->tris + 3 * kept->count;
+        tri[0] = w->pv[3 * p];
+        tri[1] = w->pv[3 * p + (reversed ? 2 : 1)];
+        tri[2] = w->pv[3 * p + (reversed ? 1 : 2)];
+        kept->faces[kept->count++] = w->pface[p];
+    }
+done:
+    mci_free(w->ctx, list);
+    mci_free(w->ctx, scratch);
+    mci_free(w->ctx, leaf_labels);
+    mci_free(w->ctx, keep);
+    return st;
+}
+
+mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint32_t leaf,
+                              mci_kept *kept, mci_classify_stats *stats, mcsg_error *err)
+{
+    leaf_work w;
+    mcsg_status st;
+    memset(&w, 0, sizeof w);
+    w.ctx = ctx;
+    w.cl = cl;
+    w.s = cl->scene;
+    w.leaf = leaf;
+    w.face_base = w.s->octree.face_base[leaf];
+    w.face_count = w.s->octree.face_base[leaf + 1] - w.face_base;
+    w.stats = stats;
+    w.err = err;
+    st = make_pieces(&w);
+    if (st == MCSG_OK)
+        st = pair_edges(&w);
+    if (st == MCSG_OK)
+        st = collect_separators(&w);
+    if (st == MCSG_OK)
+        st = build_regions(&w);
+    if (st == MCSG_OK)
+        st = index_regions(&w);
+    if (st == MCSG_OK)
+        st = find_candidates(&w);
+    if (st == MCSG_OK)
+        st = label_regions(&w);
+    if (st == MCSG_OK)
+        st = select_pieces(&w, kept);
+    stats->pieces += w.np;
+    stats->regions += w.nreg;
+    free_work(&w);
+    return st;
+}

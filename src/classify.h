@@ -1,0 +1,59 @@
+/*
+ * The classification stage (paper §5): which pieces of the leaves' surfaces belong to
+ * the result. Works on a scene whose arrangements are split, numbered and triangulated.
+ * See classify.c for the method and docs/classification.md for its relation to the
+ * paper.
+ */
+#ifndef MESHCSG_CLASSIFY_H
+#define MESHCSG_CLASSIFY_H
+
+#include "csgtree.h"
+#include "scene.h"
+
+/* The kept pieces: triangle t has output vertices tris[3t..3t+2] (counter-clockwise
+ * seen from outside the result) and comes from face faces[t] (global face id). */
+typedef struct mci_kept {
+    uint32_t *tris;
+    uint32_t *faces;
+    size_t count, capacity;
+} mci_kept;
+
+void mci_kept_free(const mci_ctx *ctx, mci_kept *kept);
+
+/* What classification needs about the whole scene, built once.
+ *
+ * Output vertex ids: below scene->point_count they are the scene's global point
+ * numbers; a leaf vertex equal to an explicit arrangement point gets that point's
+ * number (the output is welded by exact identity), any other leaf vertex a new id
+ * point_count + k whose coordinates are new_vertex[k]. */
+typedef struct mci_classifier {
+    const mci_scene *scene;
+    const mci_ptree *tree;
+    size_t *vertex_first;          /* per leaf: index of its vertex 0 in vertex_id */
+    uint32_t *vertex_id;
+    const double **new_vertex;
+    size_t new_vertex_count;
+    double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
+} mci_classifier;
+
+mcsg_status mci_classifier_init(const mci_ctx *ctx, const mci_scene *scene,
+                                const mci_ptree *tree, mci_classifier *cl, mcsg_error *err);
+void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl);
+
+typedef struct mci_classify_stats {
+    size_t pieces, regions, rays, local_tests;
+} mci_classify_stats;
+
+/* Classify every piece of primitive `leaf` (the scene's leaf of the same index) and
+ * append those that belong to the result to *kept (reversed for a complemented
+ * primitive). Fails with MCSG_ERR_INTERNAL when the leaf's pieces do not close up (an
+ * input that is not closed and edge-manifold) or a label cannot be decided. */
+mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint32_t leaf,
+                              mci_kept *kept, mci_classify_stats *stats, mcsg_error *err);
+
+/* Where point p is with respect to the closed mesh m, by an exact ray along +x,
+ * symbolically perturbed so that rays through edges and vertices are decided
+ * consistently: IN, OUT, or UNKNOWN when p lies on m's surface. */
+mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m);
+
+#endif

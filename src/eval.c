@@ -1,0 +1,283 @@
+/*
+ * mcsg_eval: the whole pipeline in one pass over the tree. Positive tree and CSGlists
+ * (csgtree.c), intersection stage over the primitives (intersect.c), tessellation of the
+ * split faces (arrange.c, triangulate.c), classification (classify.c), and assembly:
+ * output vertices are the scene's exact points, welded by their global numbers, and
+ * rounded to double only here.
+ */
+#include "classify.h"
+
+#include <string.h>
+
+typedef struct eval_state {
+    mci_ctx ctx;
+    mci_ptree tree;
+    mci_scene scene;
+    mci_classifier cl;
+    mci_kept kept;
+    mcsg_eval_stats stats;
+} eval_state;
+
+static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
+{
+    st->primitives = t->leaf_count;
+    for (size_t l = 0; l < t->leaf_count; l++) {
+        size_t n = t->leaf_mesh[l]->triangle_count;
+        st->faces += n;
+        st->faces_min = l == 0 || n < st->faces_min ? n : st->faces_min;
+        st->faces_max = n > st->faces_max ? n : st->faces_max;
+    }
+}
+
+static mcsg_status triangulate_all(eval_state *e, mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    mcsg_status st = MCSG_OK;
+    for (size_t k = 0; k < e->scene.arr_count && st == MCSG_OK; k++)
+        st = mci_arr_triangulate(&e->ctx, &e->scene.arrs[k], NULL, err);
+    e->stats.seconds_triangulate = mci_seconds_now() - t0;
+    return st;
+}
+
+static mcsg_status classify_all(eval_state *e, mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    mci_classify_stats cs = {0, 0, 0, 0};
+    mcsg_status st = mci_classifier_init(&e->ctx, &e->scene, &e->tree, &e->cl, err);
+    for (uint32_t l = 0; l < e->tree.leaf_count && st == MCSG_OK; l++)
+        st = mci_classify_leaf(&e->ctx, &e->cl, l, &e->kept, &cs, err);
+    e->stats.pieces = cs.pieces;
+    e->stats.regions = cs.regions;
+    e->stats.rays = cs.rays;
+    e->stats.local_tests = cs.local_tests;
+    e->stats.seconds_classify = mci_seconds_now() - t0;
+    return st;
+}
+
+/* Coordinates of output vertex id (see mci_classifier), rounded to double. rep[g] names
+ * an arrangement point with global number g: (arrangement << 32 | point). */
+static void vertex_coordinates(const eval_state *e, const uint64_t *rep, uint32_t id,
+                               double *out)
+{
+    const mci_scene *s = &e->scene;
+    if (id >= s->point_count) {
+        memcpy(out, e->cl.new_vertex[id - s->point_count], 3 * sizeof *out);
+        return;
+    }
+    mci_point_approx(&s->arrs[rep[id] >> 32].points[(uint32_t)rep[id]], out);
+}
+
+static uint64_t *point_representatives(const eval_state *e)
+{
+    const mci_scene *s = &e->scene;
+    uint64_t *rep = mci_malloc_array(&e->ctx, s->point_count + 1, sizeof *rep);
+    if (!rep)
+        return NULL;
+    for (size_t g = 0; g < s->point_count; g++)
+        rep[g] = UINT64_MAX;
+    for (size_t k = 0; k < s->arr_count; k++)
+        for (size_t p = 0; p < s->arrs[k].point_count; p++) {
+            uint32_t g = s->gid[s->gid_start[k] + p];
+            if (rep[g] == UINT64_MAX)
+                rep[g] = (uint64_t)k << 32 | p;
+        }
+    return rep;
+}
+
+/* Vertices whose exact positions differ but round to the same doubles (points closer
+ * than the rounding error, e.g. where curves cross at a vertex up to the inputs'
+ * rounding) are joined, and the triangles this flattens are dropped. */
+static bool weld_rounded(const mci_ctx *ctx, const double *xyz, size_t n, uint32_t *canon)
+{
+    size_t size = 16;
+    uint32_t *table;
+    while (size < 2 * n)
+        size *= 2;
+    table = mci_malloc_array(ctx, size, sizeof *table);
+    if (!table)
+        return false;
+    for (size_t i = 0; i < size; i++)
+        table[i] = MCI_NONE;
+    for (uint32_t v = 0; v < n; v++) {
+        const double *x = xyz + 3 * (size_t)v;
+        size_t at = mci_coordinate_hash(x) & (size - 1);
+        while (table[at] != MCI_NONE) {
+            const double *y = xyz + 3 * (size_t)table[at];
+            if (x[0] == y[0] && x[1] == y[1] && x[2] == y[2])
+                break;
+            at = (at + 1) & (size - 1);
+        }
+        if (table[at] == MCI_NONE)
+            table[at] = v;
+        canon[v] = table[at];
+    }
+    mci_free(ctx, table);
+    return true;
+}
+
+/* The rounded coordinates of every used vertex, numbered densely in order of use. */
+typedef struct rounded {
+    uint32_t *dense; /* output vertex id -> dense index */
+    double *xyz;
+    uint32_t *canon; /* dense index -> first dense index with the same coordinates */
+    size_t count;
+} rounded;
+
+static mcsg_status round_vertices(const eval_state *e, rounded *r, mcsg_error *err)
+{
+    size_t ids = e->scene.point_count + e->cl.new_vertex_count;
+    uint64_t *rep = point_representatives(e);
+    bool ok;
+    r->dense = mci_malloc_array(&e->ctx, ids + 1, sizeof *r->dense);
+    ok = rep && r->dense;
+    for (size_t i = 0; ok && i < ids; i++)
+        r->dense[i] = MCI_NONE;
+    for (size_t i = 0; ok && i < 3 * e->kept.count; i++)
+        if (r->dense[e->kept.tris[i]] == MCI_NONE)
+            r->dense[e->kept.tris[i]] = (uint32_t)r->count++;
+    r->xyz = ok ? mci_malloc_array(&e->ctx, r->count + 1, 3 * sizeof *r->xyz) : NULL;
+    r->canon = ok ? mci_malloc_array(&e->ctx, r->count + 1, sizeof *r->canon) : NULL;
+    ok = ok && r->xyz && r->canon;
+    for (size_t id = 0; ok && id < ids; id++)
+        if (r->dense[id] != MCI_NONE)
+            vertex_coordinates(e, rep, (uint32_t)id, r->xyz + 3 * (size_t)r->dense[id]);
+    ok = ok && weld_rounded(&e->ctx, r->xyz, r->count, r->canon);
+    mci_free(&e->ctx, rep);
+    return ok ? MCSG_OK : mci_fail_nomem(err, "assembling the result");
+}
+
+static void free_rounded(const mci_ctx *ctx, rounded *r)
+{
+    mci_free(ctx, r->dense);
+    mci_free(ctx, r->xyz);
+    mci_free(ctx, r->canon);
+}
+
+/* Triangles with three distinct rounded vertices, renumbered by first use; *kept_tri
+ * lists the kept triangles' indices in e->kept. */
+static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
+                                uint32_t **kept_tri, mcsg_error *err)
+{
+    uint32_t *final = mci_malloc_array(&e->ctx, r->count + 1, sizeof *final);
+    uint32_t *tris = mci_malloc_array(&e->ctx, 3 * e->kept.count + 1, sizeof *tris);
+    uint32_t *which = mci_malloc_array(&e->ctx, e->kept.count + 1, sizeof *which);
+    size_t nt = 0, nv = 0;
+    mcsg_status st = final && tris && which ? MCSG_OK : mci_fail_nomem(err, "assembling the result");
+    for (size_t v = 0; st == MCSG_OK && v < r->count; v++)
+        final[v] = MCI_NONE;
+    for (size_t t = 0; st == MCSG_OK && t < e->kept.count; t++) {
+        uint32_t c[3];
+        for (int i = 0; i < 3; i++)
+            c[i] = r->canon[r->dense[e->kept.tris[3 * t + i]]];
+        if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0])
+            continue;
+        for (int i = 0; i < 3; i++) {
+            if (final[c[i]] == MCI_NONE)
+                final[c[i]] = (uint32_t)nv++;
+            tris[3 * nt + i] = final[c[i]];
+        }
+        which[nt++] = (uint32_t)t;
+    }
+    if (st == MCSG_OK)
+        st = mci_mesh_alloc(&e->ctx, out, nv, nt, err);
+    for (size_t v = 0; st == MCSG_OK && v < r->count; v++)
+        if (final[v] != MCI_NONE && r->canon[v] == v)
+            memcpy(out->vertices + 3 * (size_t)final[v], r->xyz + 3 * v, 3 * sizeof(double));
+    if (st == MCSG_OK)
+        memcpy(out->triangles, tris, 3 * nt * sizeof *tris);
+    e->stats.rounding_dropped_triangles = e->kept.count - nt;
+    mci_free(&e->ctx, final);
+    mci_free(&e->ctx, tris);
+    if (st == MCSG_OK)
+        *kept_tri = which;
+    else
+        mci_free(&e->ctx, which);
+    return st;
+}
+
+static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size_t n,
+                                   mcsg_provenance **provenance, mcsg_error *err)
+{
+    const mci_octree *o = &e->scene.octree;
+    mcsg_provenance *p = mci_malloc_array(&e->ctx, n + 1, sizeof *p);
+    if (!p)
+        return mci_fail_nomem(err, "assembling the result");
+    for (size_t t = 0; t < n; t++) {
+        uint32_t f = e->kept.faces[kept_tri[t]], leaf = o->face_leaf[f];
+        p[t].leaf = e->tree.leaf_source[leaf];
+        p[t].face = f - o->face_base[leaf];
+    }
+    *provenance = p;
+    return MCSG_OK;
+}
+
+static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **provenance,
+                            mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    rounded r = {NULL, NULL, NULL, 0};
+    uint32_t *kept_tri = NULL;
+    mcsg_status st = round_vertices(e, &r, err);
+    if (st == MCSG_OK)
+        st = build_output(e, &r, out, &kept_tri, err);
+    if (st == MCSG_OK && provenance)
+        st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
+    if (st != MCSG_OK)
+        mci_mesh_free(&e->ctx, out);
+    free_rounded(&e->ctx, &r);
+    mci_free(&e->ctx, kept_tri);
+    e->stats.output_vertices = out->vertex_count;
+    e->stats.output_triangles = out->triangle_count;
+    e->stats.seconds_assemble = mci_seconds_now() - t0;
+    return st;
+}
+
+static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
+                       mcsg_provenance **provenance, mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    mcsg_status st = mci_ptree_build(&e->ctx, tree, &e->tree, err);
+    e->stats.seconds_tree = mci_seconds_now() - t0;
+    if (st != MCSG_OK)
+        return st;
+    count_faces(&e->tree, &e->stats);
+    if (e->tree.leaf_count == 0)
+        return mci_mesh_alloc(&e->ctx, out, 0, 0, err);
+    st = mci_scene_build(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
+                         e->tree.leaf_count, &e->scene, err);
+    if (st == MCSG_OK)
+        st = mci_scene_number_points(&e->ctx, &e->scene, err);
+    e->stats.intersect = e->scene.stats;
+    if (st == MCSG_OK)
+        st = triangulate_all(e, err);
+    if (st == MCSG_OK)
+        st = classify_all(e, err);
+    if (st == MCSG_OK)
+        st = assemble(e, out, provenance, err);
+    return st;
+}
+
+mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
+                      mcsg_provenance **provenance, mcsg_eval_stats *stats, mcsg_error *err)
+{
+    eval_state e;
+    double t0 = mci_seconds_now();
+    mcsg_status st;
+    memset(&e, 0, sizeof e);
+    mci_ctx_init(&e.ctx, opts);
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (provenance)
+        *provenance = NULL;
+    if (!tree || !out)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_eval: NULL %s", tree ? "out" : "tree");
+    st = run(&e, tree, out, provenance, err);
+    mci_classifier_free(&e.ctx, &e.cl);
+    mci_kept_free(&e.ctx, &e.kept);
+    mci_scene_free(&e.ctx, &e.scene);
+    mci_ptree_free(&e.ctx, &e.tree);
+    e.stats.seconds_total = mci_seconds_now() - t0;
+    if (stats)
+        *stats = e.stats;
+    return st;
+}
