@@ -1,5 +1,6 @@
 # The README's commands. Everything builds out of tree under build/.
-#   make demo       build (Release) and run the built-in demo scene
+#   make demo       build (Release), evaluate the built-in demo scene, write
+#                   build/demo-result.off
 #   make test       gcc build with -Werror + the whole suite, then again under ASan+UBSan,
 #                   and a clang -Werror compile check
 #   make sanitize   only the ASan+UBSan build and suite
@@ -24,7 +25,7 @@ $(BUILD)/release/meshcsg: deps FORCE
 	@cmake --build $(BUILD)/release -j $(JOBS) --target meshcsg_cli
 
 demo: $(BUILD)/release/meshcsg
-	./$(BUILD)/release/meshcsg demo
+	./$(BUILD)/release/meshcsg demo -o $(BUILD)/demo-result.off
 
 test: check sanitize clang-check
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
-#   tools/ensure-deps.sh          gcc, make, cmake, GMP headers
+#   tools/ensure-deps.sh          gcc, make, cmake, GMP headers, python3 (for the tests)
 #   tools/ensure-deps.sh clang    also clang (compile check; libFuzzer runtime for make fuzz)
 set -euo pipefail
 
@@ -10,6 +10,7 @@ have() { command -v "$1" >/dev/null 2>&1; }
 have gcc   || missing+=(gcc)
 have make  || missing+=(make)
 have cmake || missing+=(cmake)
+have python3 || missing+=(python3) # the tests generate ../shared/scenes with it
 if ! have gcc || ! echo '#include <gmp.h>' | gcc -E -x c - >/dev/null 2>&1; then
   missing+=(libgmp-dev)
 fi

@@ -6,7 +6,7 @@
  *   meshcsg convert IN OUT [--format F]  convert between mesh formats
  *   meshcsg intersect FILE.scad [-o C]   intersection curves of all leaves, as OBJ lines
  *   meshcsg eval FILE.scad [-o OUT]      evaluate the CSG tree exactly, write the result
- *   meshcsg demo [-n N]                  run the built-in ring scene through what exists
+ *   meshcsg demo [-n N] [-o OUT]         evaluate the built-in ring scene, print timings
  *
  * Exit status: 0 on success (check: every mesh valid), 1 when a check finds a problem
  * or an operation fails, 2 on a usage error.
@@ -16,6 +16,7 @@
 #include "meshcsg.h"
 #include "scenes.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -564,19 +565,76 @@ static int demo_check_leaves(const mcsg_tree *tree, const mcsg_options *opts,
     return valid;
 }
 
+/* The reference volume of ring_spheres_N from $MCSG_SHARED_DIR/scenes/reference.tsv or
+ * ../shared/scenes/reference.tsv, if there (0 otherwise). */
+static double reference_volume(int spheres)
+{
+    char want[64], name[128], path[4096], line[512];
+    double faces, volume, found = 0;
+    const char *shared = getenv("MCSG_SHARED_DIR");
+    FILE *f;
+    snprintf(path, sizeof path, "%s/scenes/reference.tsv", shared ? shared : "../shared");
+    if (!(f = fopen(path, "r")))
+        return 0;
+    snprintf(want, sizeof want, "ring_spheres_%d", spheres);
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "%127s %lf %lf", name, &faces, &volume) == 3 &&
+            strcmp(name, want) == 0)
+            found = volume;
+    fclose(f);
+    return found;
+}
+
+static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const char *out,
+                         int spheres)
+{
+    mcsg_mesh result;
+    mcsg_eval_stats st;
+    mcsg_check_report rep;
+    mcsg_error err;
+    double ref = reference_volume(spheres);
+    int ok;
+    if (mcsg_eval(tree, opts, &result, NULL, &st, &err) != MCSG_OK) {
+        fail_line(&err);
+        return 0;
+    }
+    print_eval_stats(&st);
+    ok = mcsg_mesh_check(&result, opts, &rep, &err) == MCSG_OK &&
+         mcsg_check_report_is_valid(&rep);
+    printf("result: %zu vertices, %zu triangles, %zu shells, volume %.15g (%s)\n",
+           result.vertex_count, result.triangle_count, rep.components, rep.volume,
+           ok ? "closed, oriented, manifold" : "INVALID");
+    if (ref > 0)
+        printf("reference volume %.15g (../shared/scenes/reference.tsv): %s\n", ref,
+               fabs(rep.volume - ref) <= 1e-10 * ref ? "matches" : "DIFFERS");
+    if (out && mcsg_mesh_write(out, MCSG_FORMAT_AUTO, &result, opts, &err) != MCSG_OK) {
+        fail_line(&err);
+        ok = 0;
+    } else if (out) {
+        printf("wrote %s\n", out);
+    }
+    mcsg_mesh_free(&result, opts);
+    return ok;
+}
+
 static int cmd_demo(int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     int spheres = 200, valid;
     size_t faces = 0;
+    const char *out = NULL;
     mcsg_tree *tree;
     mcsg_error err;
     double t0, t1, t2;
-    if (argc == 2 && strcmp(argv[0], "-n") == 0 && atoi(argv[1]) > 0) {
-        spheres = atoi(argv[1]);
-    } else if (argc != 0) {
-        fprintf(stderr, "usage: meshcsg demo [-n SPHERES]\n");
-        return EXIT_USAGE;
+    for (int i = 0; i < argc; i++) {
+        if (strcmp(argv[i], "-n") == 0 && i + 1 < argc && atoi(argv[i + 1]) > 0) {
+            spheres = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
+            out = argv[++i];
+        } else {
+            fprintf(stderr, "usage: meshcsg demo [-n SPHERES] [-o OUT]\n");
+            return EXIT_USAGE;
+        }
     }
     t0 = now_seconds();
     if (scene_ring_spheres(spheres, 1, &opts, &tree, &err) != MCSG_OK) {
@@ -592,26 +650,8 @@ static int cmd_demo(int argc, char **argv)
     printf("  build scene      %8.3f s\n", t1 - t0);
     printf("  validate leaves  %8.3f s  (%s)\n", t2 - t1,
            valid ? "every leaf closed, oriented, manifold" : "INVALID LEAVES");
-    if (valid) {
-        mcsg_curves curves;
-        mcsg_intersect_stats st;
-        if (mcsg_intersect(tree, &opts, &curves, &st, &err) != MCSG_OK) {
-            fail_line(&err);
-            mcsg_tree_free(tree);
-            return EXIT_PROBLEM;
-        }
-        printf("  octree           %8.3f s  (%zu cells)\n", st.seconds_octree, st.cells);
-        printf("  candidate pairs  %8.3f s  (%zu)\n", st.seconds_pairs, st.candidate_pairs);
-        printf("  intersect        %8.3f s  (%zu crossing pairs)\n", st.seconds_intersect,
-               st.intersecting_pairs);
-        printf("  arrange faces    %8.3f s  (%zu faces)\n", st.seconds_arrange,
-               st.arranged_faces);
-        printf("  number points    %8.3f s  (%zu curve segments)\n", st.seconds_merge,
-               curves.segment_count);
-        mcsg_curves_free(&curves, &opts);
-    }
-    printf("classification is not built yet: meshcsg cannot compute the CSG result so far, "
-           "so no result mesh is written.\n");
+    if (valid)
+        valid = demo_evaluate(tree, &opts, out, spheres);
     mcsg_tree_free(tree);
     return valid ? 0 : EXIT_PROBLEM;
 }
@@ -631,7 +671,8 @@ static void usage(FILE *out)
             "  meshcsg intersect FILE.scad [-o C.obj] intersection curves of the leaves\n"
             "  meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N]\n"
             "                                      evaluate the CSG tree, write the result\n"
-            "  meshcsg demo [-n SPHERES]           build and validate the built-in scene\n"
+            "  meshcsg demo [-n SPHERES] [-o OUT]  evaluate the built-in scene (the paper's\n"
+            "                                      ring with 200 spheres), print timings\n"
             "exit status: 0 ok, 1 a problem was found or an operation failed, 2 usage error\n",
             MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
 }

@@ -1,0 +1,287 @@
+/*
+ * End-to-end evaluation (mcsg_eval) against known answers: exact volumes of box scenes
+ * (union, intersection, difference, nested), the identities A u A = A, A n A = A,
+ * A - A = empty, solids touching on a face, edge or vertex, coplanar half-overlaps,
+ * curved solids whose volumes add up, provenance, and allocation failures. Every
+ * non-empty output must be closed, consistently oriented and edge-manifold.
+ */
+#include "testlib.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct result {
+    mcsg_mesh mesh;
+    mcsg_check_report report;
+    mcsg_eval_stats stats;
+} result;
+
+static mcsg_tree *parse(const char *text)
+{
+    mcsg_tree *tree = NULL;
+    mcsg_error err;
+    CHECK_OK(mcsg_scad_read_memory(text, strlen(text), "test.scad", ".", NULL, &tree, &err),
+             &err);
+    return tree;
+}
+
+/* Evaluate and check the output's topology (closed, oriented, edge-manifold). */
+static bool eval_text(const char *text, result *r)
+{
+    mcsg_tree *tree = parse(text);
+    mcsg_error err;
+    mcsg_status st;
+    bool ok = false;
+    memset(r, 0, sizeof *r);
+    if (!tree)
+        return false;
+    st = mcsg_eval(tree, NULL, &r->mesh, NULL, &r->stats, &err);
+    CHECK_MSG(st == MCSG_OK, "%s: %s", text, err.message);
+    if (st == MCSG_OK) {
+        CHECK_OK(mcsg_mesh_check(&r->mesh, NULL, &r->report, &err), &err);
+        ok = true;
+    }
+    mcsg_tree_free(tree);
+    return ok;
+}
+
+static void expect_solid(const char *text, double volume, size_t components)
+{
+    result r;
+    if (!eval_text(text, &r))
+        return;
+    CHECK_MSG(mcsg_check_report_is_valid(&r.report) && !r.report.inverted,
+              "%s: not closed/oriented/manifold (%zu boundary, %zu non-manifold, %zu "
+              "inconsistent edges)", text, r.report.boundary_edges,
+              r.report.nonmanifold_edges, r.report.inconsistent_edges);
+    CHECK_MSG(r.report.components == components, "%s: %zu components, expected %zu", text,
+              r.report.components, components);
+    CHECK_MSG(fabs(r.report.volume - volume) <= 1e-12 * fabs(volume) + 1e-15,
+              "%s: volume %.17g, expected %.17g", text, r.report.volume, volume);
+    CHECK(fabs(test_signed_volume(&r.mesh) - r.report.volume) <= 1e-12 * fabs(volume) + 1e-15);
+    mcsg_mesh_free(&r.mesh, NULL);
+}
+
+static void expect_empty(const char *text)
+{
+    result r;
+    if (!eval_text(text, &r))
+        return;
+    CHECK_MSG(r.mesh.triangle_count == 0, "%s: %zu triangles, expected none", text,
+              r.mesh.triangle_count);
+    mcsg_mesh_free(&r.mesh, NULL);
+}
+
+TEST(box_scenes_have_exact_volumes)
+{
+    expect_solid("union() { cube(2); translate([1,1,1]) cube(2); }", 15, 1);
+    expect_solid("intersection() { cube(2); translate([1,1,1]) cube(2); }", 1, 1);
+    expect_solid("difference() { cube(2); translate([1,1,1]) cube(2); }", 7, 1);
+    expect_solid("difference() { cube(4, center=true); cube(2, center=true); }", 56, 2);
+    expect_solid("difference() { cube([4,4,1]); translate([1,1,-1]) cube([2,2,3]); }", 12, 1);
+    /* Nested: (A u B) - (C n D), with C n D = [1,2]^3 cutting into both. */
+    expect_solid("difference() { union() { cube(2); translate([1,0,0]) cube(2); }"
+                 " intersection() { translate([1,1,1]) cube(2); cube(2); } }",
+                 12 - 1, 1);
+    expect_solid("intersection() { union() { cube([3,1,1]); cube([1,3,1]); }"
+                 " difference() { cube(3); translate([0.5,0.5,-1]) cube([0.25,0.25,3]); } }",
+                 5 - 0.0625, 1);
+    /* Three overlapping boxes in one union. */
+    expect_solid("union() { cube(2); translate([1,0,0]) cube(2); translate([2,0,0]) cube(2); }",
+                 16, 1);
+}
+
+TEST(identical_operands)
+{
+    result r;
+    expect_solid("union() { cube(2); cube(2); }", 8, 1);
+    expect_solid("intersection() { cube(2); cube(2); }", 8, 1);
+    expect_empty("difference() { cube(2); cube(2); }");
+    expect_solid("union() { cube(2); cube(2); cube(2); }", 8, 1);
+    expect_empty("difference() { sphere(1, $fn=12); sphere(1, $fn=12); }");
+    /* A u A keeps exactly one copy of A's faces. */
+    if (eval_text("union() { sphere(1, $fn=16); sphere(1, $fn=16); }", &r)) {
+        mcsg_mesh a;
+        mcsg_resolution res = {16, 0, 0};
+        mcsg_error err;
+        CHECK_OK(mcsg_make_sphere(1, res, NULL, &a, &err), &err);
+        CHECK_EQ_SIZE(r.mesh.triangle_count, a.triangle_count);
+        CHECK_EQ_SIZE(r.mesh.vertex_count, a.vertex_count);
+        CHECK(fabs(r.report.volume - test_signed_volume(&a)) < 1e-12);
+        CHECK(mcsg_check_report_is_valid(&r.report));
+        mcsg_mesh_free(&a, NULL);
+        mcsg_mesh_free(&r.mesh, NULL);
+    }
+}
+
+TEST(touching_solids)
+{
+    /* B touches A on a face: A - B = A, A u B fuses into one box. */
+    expect_solid("difference() { cube(2); translate([2,0,0]) cube(2); }", 8, 1);
+    expect_solid("difference() { cube(2); translate([2,0.5,0.5]) cube(1); }", 8, 1);
+    expect_solid("union() { cube(2); translate([2,0,0]) cube(2); }", 16, 1);
+    expect_solid("union() { cube(2); translate([2,0.5,0.5]) cube(1); }", 9, 1);
+    expect_empty("intersection() { cube(2); translate([2,0,0]) cube(2); }");
+    /* Touching at a vertex: two shells sharing one point. */
+    expect_solid("union() { cube(2); translate([2,2,2]) cube(2); }", 16, 2);
+    /* A box carved from the inside of a face: a pocket. */
+    expect_solid("difference() { cube(2); translate([0.5,0.5,1]) cube([1,1,1]); }", 7, 1);
+}
+
+TEST(coplanar_overlaps)
+{
+    expect_solid("union() { cube(2); translate([1,0,0]) cube(2); }", 12, 1);
+    expect_solid("difference() { cube(2); translate([1,0,0]) cube(2); }", 4, 1);
+    expect_solid("intersection() { cube(2); translate([1,0,0]) cube(2); }", 4, 1);
+    expect_solid("union() { cube(2); translate([1,1,0]) cube(2); }", 14, 1);
+    expect_solid("difference() { cube(2); translate([1,1,0]) cube(2); }", 6, 1);
+    /* Offset by half a face in two directions and stacked. */
+    expect_solid("union() { cube(2); translate([1,1,2]) cube(2); }", 16, 1);
+}
+
+/* Exact volumes of curved solids are unknown, but they must add up: vol(A u B) +
+ * vol(A n B) = vol(A) + vol(B) and vol(A - B) = vol(A) - vol(A n B), to rounding. */
+TEST(curved_volumes_add_up)
+{
+    static const char *a = "sphere(1, $fn=24);";
+    static const char *b = "translate([0.5,0.2,0.1]) rotate([10,20,30]) cylinder(h=3, r=0.4, "
+                           "center=true, $fn=10);";
+    char text[512];
+    double v[5];
+    const char *ops[] = {"union", "intersection", "difference"};
+    result r;
+    for (int i = 0; i < 3; i++) {
+        snprintf(text, sizeof text, "%s() { %s %s }", ops[i], a, b);
+        if (!eval_text(text, &r))
+            return;
+        CHECK_MSG(mcsg_check_report_is_valid(&r.report), "%s: invalid output", text);
+        CHECK(r.report.components == 1);
+        v[i] = r.report.volume;
+        mcsg_mesh_free(&r.mesh, NULL);
+    }
+    for (int i = 0; i < 2; i++) {
+        snprintf(text, sizeof text, "union() { %s }", i == 0 ? a : b);
+        if (!eval_text(text, &r))
+            return;
+        v[3 + i] = r.report.volume;
+        mcsg_mesh_free(&r.mesh, NULL);
+    }
+    CHECK(v[1] > 0.1 && v[2] > 1);
+    CHECK_MSG(fabs(v[0] + v[1] - v[3] - v[4]) < 1e-12, "union + intersection %.17g vs %.17g",
+              v[0] + v[1], v[3] + v[4]);
+    CHECK_MSG(fabs(v[2] - (v[3] - v[1])) < 1e-12, "difference %.17g vs %.17g", v[2],
+              v[3] - v[1]);
+}
+
+/* A cylinder through a sphere along its axis, both with edges in the same vertical
+ * planes: crossings exactly on the sphere's edges, and intersection points closer than
+ * the rounding, which the output joins. */
+TEST(aligned_edges_and_close_points)
+{
+    result r[4];
+    const char *ops[] = {"union", "intersection", "difference"};
+    char text[256];
+    for (int i = 0; i < 3; i++) {
+        snprintf(text, sizeof text,
+                 "%s() { sphere(1, $fn=30); cylinder(h=3, r=0.3, center=true, $fn=12); }",
+                 ops[i]);
+        if (!eval_text(text, &r[i]))
+            return;
+        CHECK_MSG(mcsg_check_report_is_valid(&r[i].report), "%s: invalid output", text);
+    }
+    if (!eval_text("sphere(1, $fn=30);", &r[3]))
+        return;
+    CHECK(fabs(r[1].report.volume + r[2].report.volume - r[3].report.volume) < 1e-12);
+    CHECK(r[0].report.volume > r[3].report.volume);
+    for (int i = 0; i < 4; i++)
+        mcsg_mesh_free(&r[i].mesh, NULL);
+}
+
+TEST(provenance_names_leaf_faces)
+{
+    mcsg_tree *tree = parse("difference() { cube(2); translate([1,1,1]) cube(2); }");
+    mcsg_mesh out;
+    mcsg_provenance *prov = NULL;
+    mcsg_error err;
+    size_t from_second = 0;
+    if (!tree)
+        return;
+    CHECK_OK(mcsg_eval(tree, NULL, &out, &prov, NULL, &err), &err);
+    CHECK(prov != NULL);
+    for (size_t t = 0; prov && t < out.triangle_count; t++) {
+        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, prov[t].leaf);
+        const uint32_t *tri = out.triangles + 3 * t;
+        CHECK(mcsg_tree_node_kind(tree, prov[t].leaf) == MCSG_NODE_LEAF && leaf);
+        if (!leaf || prov[t].face >= leaf->triangle_count) {
+            CHECK(false);
+            continue;
+        }
+        /* The triangle lies in its face's plane (box faces: one coordinate constant). */
+        for (int k = 0; k < 3; k++) {
+            const uint32_t *f = leaf->triangles + 3 * (size_t)prov[t].face;
+            const double *a = leaf->vertices + 3 * (size_t)f[0], *b = leaf->vertices + 3 * (size_t)f[1],
+                         *c = leaf->vertices + 3 * (size_t)f[2];
+            if (a[k] == b[k] && b[k] == c[k])
+                for (int i = 0; i < 3; i++)
+                    CHECK(out.vertices[3 * (size_t)tri[i] + k] == a[k]);
+        }
+        from_second += prov[t].leaf != prov[0].leaf;
+    }
+    CHECK(from_second > 0); /* the carved corner comes from the second cube, reversed */
+    mcsg_free(prov, NULL);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_tree_free(tree);
+}
+
+TEST(empty_and_trivial_trees)
+{
+    expect_empty("union() { }");
+    expect_empty("difference() { }");
+    expect_empty("intersection() { cube(1); translate([5,0,0]) cube(1); }");
+    expect_solid("cube(3);", 27, 1);
+    expect_solid("difference() { cube(3); translate([5,0,0]) cube(1); }", 27, 1);
+    expect_solid("union() { cube(1); translate([5,0,0]) cube(1); }", 2, 2);
+}
+
+static mcsg_status eval_under(const void *ctx, const mcsg_options *opts, mcsg_error *err)
+{
+    mcsg_mesh out;
+    mcsg_provenance *prov;
+    mcsg_status st = mcsg_eval(ctx, opts, &out, &prov, NULL, err);
+    if (st == MCSG_OK) {
+        CHECK(out.triangle_count > 0);
+        mcsg_free(prov, opts);
+        mcsg_mesh_free(&out, opts);
+    }
+    return st;
+}
+
+TEST(allocation_failures_leak_nothing)
+{
+    /* Small (the sweep is quadratic in the allocation count) but with crossings,
+     * coplanar faces, several regions and a complemented leaf. */
+    mcsg_tree *tree = parse("difference() { union() { cube(2); translate([1,1,0]) cube(2); }"
+                            " translate([0.5,0.5,0.5]) cube(1); }");
+    long calls;
+    if (!tree)
+        return;
+    calls = test_allocation_failures("mcsg_eval", eval_under, tree, false);
+    CHECK(calls > 100);
+    printf("mcsg_eval: %ld allocations, each failed once\n", calls);
+    mcsg_tree_free(tree);
+}
+
+int main(void)
+{
+    RUN(box_scenes_have_exact_volumes);
+    RUN(identical_operands);
+    RUN(touching_solids);
+    RUN(coplanar_overlaps);
+    RUN(curved_volumes_add_up);
+    RUN(aligned_edges_and_close_points);
+    RUN(provenance_names_leaf_faces);
+    RUN(empty_and_trivial_trees);
+    RUN(allocation_failures_leak_nothing);
+    return test_summary();
+}
