@@ -83,12 +83,20 @@ typedef enum mcsg_log_level {
  * the call. Called from the thread that called the library function. */
 typedef void (*mcsg_log_fn)(void *user, mcsg_log_level level, const char *message);
 
+/* Progress callback: called with done = 0 when a step of a long operation (e.g. "intersect",
+ * "classify") starts and done = 1 when it ends, from the thread that called the library. */
+typedef void (*mcsg_progress_fn)(void *user, const char *step, int done);
+
 /* Zero means default for every field. */
 typedef struct mcsg_options {
     mcsg_allocator allocator; /* zero: malloc/realloc/free */
     mcsg_log_fn log;          /* NULL: messages are dropped */
     void *log_user;           /* passed to log */
-    int threads;              /* worker threads for evaluation; 0: all cores */
+    int threads;              /* worker threads for evaluation; 0: all cores. With more
+                                 than one, the allocator is called from several threads
+                                 at once and must be thread-safe (malloc is) */
+    mcsg_progress_fn progress; /* NULL: no progress reports */
+    void *progress_user;       /* passed to progress */
 } mcsg_options;
 
 /* Release a buffer returned by the library (e.g. from mcsg_mesh_write_memory).
@@ -394,6 +402,7 @@ typedef struct mcsg_eval_stats {
     size_t regions;           /* groups of pieces that share all labels (paper §5.2) */
     size_t rays;              /* exact ray tests for first seeds (paper §5.5) */
     size_t local_tests;       /* exact label changes across intersection curves */
+    size_t rejected_primitives; /* dropped whole by their first trimmed CSGlist (§5.3) */
     size_t output_vertices, output_triangles;
     size_t rounding_dropped_triangles; /* flattened when distinct exact vertices rounded
                                           to the same doubles were joined */

@@ -109,6 +109,14 @@ mcsg_status mci_arr_split(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err
 mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const bool *use,
                                 mcsg_error *err);
 
+/* After classification: piece_keep[t] says whether triangle t of the current
+ * tessellation (all constraints) belongs to the result. Re-tessellates with only the
+ * constraints between kept and dropped triangles (when that drops any) and returns in
+ * *tri_keep (allocated with ctx) the flags of the triangles now in arr->tris. */
+mcsg_status mci_arr_retessellate(const mci_ctx *ctx, mci_face_arr *arr,
+                                 const uint8_t *piece_keep, uint8_t **tri_keep,
+                                 mcsg_error *err);
+
 /* Sort ids by the exact lexicographic order of the points table[id] (stable merge sort;
  * tmp has n entries). */
 void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n);

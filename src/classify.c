@@ -272,7 +272,7 @@ static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
     return ok;
 }
 
-mcsg_status mci_classifier_init(const mci_ctx *ctx, const mci_scene *scene,
+mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err)
 {
     memset(cl, 0, sizeof *cl);
@@ -346,6 +346,11 @@ typedef struct leaf_work {
     size_t ncand;
     uint32_t *slot_of_leaf; /* leaf -> index in cand, or MCI_NONE */
     uint8_t *labels;  /* nreg x ncand */
+    uint8_t *needed;  /* per candidate: in a subtree of the trimmed CSGlist */
+    mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
+    size_t nlist;
+    bool rejected;    /* the trimmed CSGlist drops every face of the leaf */
+    mci_label *scratch, *leaf_labels;
     mci_classify_stats *stats;
     mcsg_error *err;
 } leaf_work;
@@ -354,7 +359,8 @@ static void free_work(leaf_work *w)
 {
     void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->region,
                    w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
-                   w->slot_of_leaf, w->labels};
+                   w->slot_of_leaf, w->labels, w->needed, w->list, w->scratch,
+                   w->leaf_labels};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
 }
@@ -634,7 +640,7 @@ static void seed_region(leaf_work *w, uint32_t r)
                 piece_point(w, p, i, &v);
                 for (size_t c = 0; c < w->ncand; c++) {
                     uint32_t m = w->cand[c];
-                    if (lab[c] != MCI_LABEL_UNKNOWN)
+                    if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
                         continue;
                     if (point_outside_box(&v, w->cl->box[m])) {
                         lab[c] = MCI_LABEL_OUT;
@@ -664,7 +670,7 @@ static void local_labels_at(leaf_work *w, uint8_t *to, size_t k, bool only_unkno
     piece_point(w, p, (int)(k % 3 + 2) % 3, &far);
     for (size_t e = find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++) {
         uint32_t h = w->sep[e].ref, c = w->slot_of_leaf[s->octree.face_leaf[h]];
-        if (c == MCI_NONE || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
+        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
             continue;
         w->stats->local_tests++;
         to[c] = (uint8_t)local_label(s, arr_of_face(s, w->pface[p]), &x, &y, &far, h);
@@ -702,7 +708,7 @@ static void fill_unknown_labels(leaf_work *w)
             uint8_t *lab = w->labels + (size_t)r * w->ncand;
             for (size_t c = 0; c < w->ncand; c++) {
                 for (uint32_t i = w->sep_start[r];
-                     lab[c] == MCI_LABEL_UNKNOWN && i < w->sep_start[r + 1]; i++) {
+                     w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN && i < w->sep_start[r + 1]; i++) {
                     uint32_t k = w->sep_slots[i], r2 = w->region[w->mate[k] / 3];
                     uint8_t there = w->labels[(size_t)r2 * w->ncand + c];
                     if (there != MCI_LABEL_UNKNOWN && !separator_on_leaf(w, k, w->cand[c])) {
@@ -762,54 +768,131 @@ static bool grow_kept(const mci_ctx *ctx, mci_kept *kept, size_t need)
     return true;
 }
 
+static bool push_triangle(const mci_ctx *ctx, mci_kept *kept, const uint32_t *v,
+                          bool reversed, uint32_t face)
+{
+    uint32_t *tri;
+    if (!grow_kept(ctx, kept, kept->count + 1))
+        return false;
+    tri = kept->tris + 3 * kept->count;
+    tri[0] = v[0];
+    tri[1] = v[reversed ? 2 : 1];
+    tri[2] = v[reversed ? 1 : 2];
+    kept->faces[kept->count++] = face;
+    return true;
+}
+
+/* The kept triangles of arranged face f, whose pieces start at piece `first`, after
+ * re-tessellating it with its valid constraints only. */
+static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first,
+                                      const uint8_t *keep, bool reversed, mci_kept *kept)
+{
+    mci_face_arr *arr = &w->cl->scene->arrs[w->s->arr_of[f]];
+    const uint32_t *gid = w->s->gid + w->s->gid_start[w->s->arr_of[f]];
+    uint8_t *piece_keep = mci_malloc_array(w->ctx, arr->tri_count + 1, 1), *tri_keep = NULL;
+    mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
+        piece_keep[i] = keep[w->region[first + i]];
+    if (st == MCSG_OK)
+        st = mci_arr_retessellate(w->ctx, arr, piece_keep, &tri_keep, w->err);
+    for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
+        uint32_t v[3];
+        if (!tri_keep[t])
+            continue;
+        for (int i = 0; i < 3; i++)
+            v[i] = gid[arr->tris[3 * t + i]];
+        if (!push_triangle(w->ctx, kept, v, reversed, f))
+            st = mci_fail_nomem(w->err, "classifying faces");
+    }
+    mci_free(w->ctx, piece_keep);
+    mci_free(w->ctx, tri_keep);
+    return st;
+}
+
+static mcsg_status emit_kept(leaf_work *w, const uint8_t *keep, bool reversed, mci_kept *kept)
+{
+    mcsg_status st = MCSG_OK;
+    size_t p = 0;
+    while (p < w->np && st == MCSG_OK) {
+        uint32_t f = w->pface[p];
+        const mci_face_arr *arr = arr_of_face(w->s, f);
+        if (arr) {
+            size_t n = arr->tri_count;
+            st = emit_arranged_face(w, f, p, keep, reversed, kept);
+            p += n;
+            continue;
+        }
+        if (keep[w->region[p]] && !push_triangle(w->ctx, kept, w->pv + 3 * p, reversed, f))
+            st = mci_fail_nomem(w->err, "classifying faces");
+        p++;
+    }
+    return st;
+}
+
+/* The first trimmed tree (paper §5.2, §5.3): every leaf whose box misses this leaf's is
+ * OUT for all its faces. CSGlist entries that this decides are dropped when desired and
+ * reject the whole leaf when not; the candidates outside the remaining entries need no
+ * labels at all (the paper's pseudo-IPs). */
+static mcsg_status trim_csglist(leaf_work *w)
+{
+    const mci_ptree *t = w->cl->tree;
+    int32_t *cover = mci_calloc_array(w->ctx, t->node_count + 2, sizeof *cover);
+    size_t kept = 0;
+    w->list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->list);
+    w->scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->scratch);
+    w->leaf_labels = mci_malloc_array(w->ctx, t->leaf_count + 1, sizeof *w->leaf_labels);
+    w->needed = mci_calloc_array(w->ctx, w->ncand + 1, 1);
+    if (!cover || !w->list || !w->scratch || !w->leaf_labels || !w->needed) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (size_t l = 0; l < t->leaf_count; l++)
+        w->leaf_labels[l] = MCI_LABEL_OUT;
+    for (size_t c = 0; c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = MCI_LABEL_UNKNOWN;
+    w->nlist = mci_csglist(t, w->leaf, w->list);
+    for (size_t i = 0; i < w->nlist && !w->rejected; i++) {
+        const mci_csg_entry *e = &w->list[i];
+        mci_label l = mci_ptree_eval(t, e->node, w->leaf_labels, w->scratch);
+        if (l == MCI_LABEL_UNKNOWN) {
+            w->list[kept++] = *e;
+            cover[e->node + 1 - t->nodes[e->node].size]++;
+            cover[e->node + 1]--;
+        } else if (!(e->desired & MCI_LABEL_BIT(l))) {
+            w->rejected = true;
+        }
+    }
+    w->nlist = kept;
+    for (size_t n = 1; n <= t->node_count; n++)
+        cover[n] += cover[n - 1];
+    for (size_t c = 0; c < w->ncand; c++)
+        w->needed[c] = cover[t->leaf_node[w->cand[c]]] > 0;
+    mci_free(w->ctx, cover);
+    return MCSG_OK;
+}
+
 /* Evaluate each region's CSGlist and output the pieces of the kept ones. */
 static mcsg_status select_pieces(leaf_work *w, mci_kept *kept)
 {
     const mci_ptree *t = w->cl->tree;
     bool reversed = t->nodes[t->leaf_node[w->leaf]].complement;
-    mci_csg_entry *list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *list);
-    mci_label *scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *scratch);
-    mci_label *leaf_labels = mci_malloc_array(w->ctx, t->leaf_count + 1, sizeof *leaf_labels);
     uint8_t *keep = mci_malloc_array(w->ctx, w->nreg + 1, 1);
     mcsg_status st = MCSG_OK;
-    size_t n;
-    if (!list || !scratch || !leaf_labels || !keep) {
-        st = mci_fail_nomem(w->err, "classifying faces");
-        goto done;
-    }
-    n = mci_csglist(t, w->leaf, list);
-    for (size_t l = 0; l < t->leaf_count; l++)
-        leaf_labels[l] = MCI_LABEL_OUT;
+    if (!keep)
+        return mci_fail_nomem(w->err, "classifying faces");
     for (size_t r = 0; r < w->nreg && st == MCSG_OK; r++) {
         const uint8_t *lab = w->labels + r * w->ncand;
         int accepts;
         for (size_t c = 0; c < w->ncand; c++)
-            leaf_labels[w->cand[c]] =
+            w->leaf_labels[w->cand[c]] =
                 reversed ? mci_label_reverse((mci_label)lab[c]) : (mci_label)lab[c];
-        accepts = mci_csglist_accepts(t, list, n, leaf_labels, scratch);
+        accepts = mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch);
         if (accepts < 0)
             st = mci_fail(w->err, MCSG_ERR_INTERNAL,
                           "leaf %u: a region's label could not be decided", w->leaf);
         keep[r] = accepts == 1;
     }
-    for (size_t p = 0; p < w->np && st == MCSG_OK; p++) {
-        uint32_t *tri;
-        if (!keep[w->region[p]])
-            continue;
-        if (!grow_kept(w->ctx, kept, kept->count + 1)) {
-            st = mci_fail_nomem(w->err, "classifying faces");
-            break;
-        }
-        tri = kept->tris + 3 * kept->count;
-        tri[0] = w->pv[3 * p];
-        tri[1] = w->pv[3 * p + (reversed ? 2 : 1)];
-        tri[2] = w->pv[3 * p + (reversed ? 1 : 2)];
-        kept->faces[kept->count++] = w->pface[p];
-    }
-done:
-    mci_free(w->ctx, list);
-    mci_free(w->ctx, scratch);
-    mci_free(w->ctx, leaf_labels);
+    st = st == MCSG_OK ? emit_kept(w, keep, reversed, kept) : st;
     mci_free(w->ctx, keep);
     return st;
 }
@@ -840,9 +923,12 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
     if (st == MCSG_OK)
         st = find_candidates(&w);
     if (st == MCSG_OK)
+        st = trim_csglist(&w);
+    if (st == MCSG_OK && !w.rejected)
         st = label_regions(&w);
-    if (st == MCSG_OK)
+    if (st == MCSG_OK && !w.rejected)
         st = select_pieces(&w, kept);
+    stats->rejected_leaves += w.rejected;
     stats->pieces += w.np;
     stats->regions += w.nreg;
     free_work(&w);

@@ -27,7 +27,7 @@ void mci_kept_free(const mci_ctx *ctx, mci_kept *kept);
  * number (the output is welded by exact identity), any other leaf vertex a new id
  * point_count + k whose coordinates are new_vertex[k]. */
 typedef struct mci_classifier {
-    const mci_scene *scene;
+    mci_scene *scene; /* its arrangements are re-tessellated as leaves are classified */
     const mci_ptree *tree;
     size_t *vertex_first;          /* per leaf: index of its vertex 0 in vertex_id */
     uint32_t *vertex_id;
@@ -36,12 +36,13 @@ typedef struct mci_classifier {
     double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
 } mci_classifier;
 
-mcsg_status mci_classifier_init(const mci_ctx *ctx, const mci_scene *scene,
+mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err);
 void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl);
 
 typedef struct mci_classify_stats {
     size_t pieces, regions, rays, local_tests;
+    size_t rejected_leaves; /* dropped whole by their trimmed CSGlist */
 } mci_classify_stats;
 
 /* Classify every piece of primitive `leaf` (the scene's leaf of the same index) and

@@ -47,6 +47,8 @@ void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts)
         ctx->log = opts->log;
         ctx->log_user = opts->log_user;
         ctx->threads = opts->threads;
+        ctx->progress = opts->progress;
+        ctx->progress_user = opts->progress_user;
     }
 }
 
@@ -379,4 +381,10 @@ uint64_t mci_coordinate_hash(const double *x)
         h ^= h >> 29;
     }
     return h;
+}
+
+void mci_progress(const mci_ctx *ctx, const char *step, int done)
+{
+    if (ctx->progress)
+        ctx->progress(ctx->progress_user, step, done);
 }

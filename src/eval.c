@@ -29,27 +29,82 @@ static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
     }
 }
 
+static mcsg_status triangulate_one(void *user, size_t k, mcsg_error *err)
+{
+    eval_state *e = user;
+    return mci_arr_triangulate(&e->ctx, &e->scene.arrs[k], NULL, err);
+}
+
 static mcsg_status triangulate_all(eval_state *e, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
-    mcsg_status st = MCSG_OK;
-    for (size_t k = 0; k < e->scene.arr_count && st == MCSG_OK; k++)
-        st = mci_arr_triangulate(&e->ctx, &e->scene.arrs[k], NULL, err);
+    mcsg_status st = mci_parallel_for(&e->ctx, e->scene.arr_count, triangulate_one, e, err);
     e->stats.seconds_triangulate = mci_seconds_now() - t0;
     return st;
+}
+
+/* Each primitive is classified on its own (it re-tessellates only its own faces), into
+ * its own buffer; the buffers are joined in primitive order, as a sequential run would. */
+typedef struct leaf_jobs {
+    eval_state *e;
+    mci_kept *kept;
+    mci_classify_stats *stats;
+} leaf_jobs;
+
+static mcsg_status classify_one(void *user, size_t leaf, mcsg_error *err)
+{
+    leaf_jobs *j = user;
+    return mci_classify_leaf(&j->e->ctx, &j->e->cl, (uint32_t)leaf, &j->kept[leaf],
+                             &j->stats[leaf], err);
+}
+
+static bool join_kept(eval_state *e, const leaf_jobs *j)
+{
+    size_t total = 0;
+    for (size_t l = 0; l < e->tree.leaf_count; l++)
+        total += j->kept[l].count;
+    e->kept.tris = mci_malloc_array(&e->ctx, 3 * total + 1, sizeof *e->kept.tris);
+    e->kept.faces = mci_malloc_array(&e->ctx, total + 1, sizeof *e->kept.faces);
+    if (!e->kept.tris || !e->kept.faces)
+        return false;
+    for (size_t l = 0; l < e->tree.leaf_count; l++) {
+        const mci_kept *k = &j->kept[l];
+        memcpy(e->kept.tris + 3 * e->kept.count, k->tris, 3 * k->count * sizeof *k->tris);
+        memcpy(e->kept.faces + e->kept.count, k->faces, k->count * sizeof *k->faces);
+        e->kept.count += k->count;
+    }
+    e->kept.capacity = total;
+    return true;
+}
+
+static void add_classify_stats(mcsg_eval_stats *to, const mci_classify_stats *s)
+{
+    to->pieces += s->pieces;
+    to->regions += s->regions;
+    to->rays += s->rays;
+    to->local_tests += s->local_tests;
+    to->rejected_primitives += s->rejected_leaves;
 }
 
 static mcsg_status classify_all(eval_state *e, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
-    mci_classify_stats cs = {0, 0, 0, 0};
-    mcsg_status st = mci_classifier_init(&e->ctx, &e->scene, &e->tree, &e->cl, err);
-    for (uint32_t l = 0; l < e->tree.leaf_count && st == MCSG_OK; l++)
-        st = mci_classify_leaf(&e->ctx, &e->cl, l, &e->kept, &cs, err);
-    e->stats.pieces = cs.pieces;
-    e->stats.regions = cs.regions;
-    e->stats.rays = cs.rays;
-    e->stats.local_tests = cs.local_tests;
+    size_t n = e->tree.leaf_count;
+    leaf_jobs j = {e, mci_calloc_array(&e->ctx, n + 1, sizeof *j.kept),
+                   mci_calloc_array(&e->ctx, n + 1, sizeof *j.stats)};
+    mcsg_status st = j.kept && j.stats ? mci_classifier_init(&e->ctx, &e->scene, &e->tree,
+                                                             &e->cl, err)
+                                       : mci_fail_nomem(err, "classifying faces");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(&e->ctx, n, classify_one, &j, err);
+    if (st == MCSG_OK && !join_kept(e, &j))
+        st = mci_fail_nomem(err, "classifying faces");
+    for (size_t l = 0; j.kept && j.stats && l < n; l++) {
+        add_classify_stats(&e->stats, &j.stats[l]);
+        mci_kept_free(&e->ctx, &j.kept[l]);
+    }
+    mci_free(&e->ctx, j.kept);
+    mci_free(&e->ctx, j.stats);
     e->stats.seconds_classify = mci_seconds_now() - t0;
     return st;
 }
@@ -232,6 +287,27 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
     return st;
 }
 
+typedef mcsg_status (*step_fn)(eval_state *e, mcsg_error *err);
+
+static mcsg_status step(eval_state *e, const char *name, step_fn fn, mcsg_error *err)
+{
+    mcsg_status st;
+    mci_progress(&e->ctx, name, 0);
+    st = fn(e, err);
+    mci_progress(&e->ctx, name, 1);
+    return st;
+}
+
+static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
+{
+    mcsg_status st = mci_scene_build(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
+                                     e->tree.leaf_count, &e->scene, err);
+    if (st == MCSG_OK)
+        st = mci_scene_number_points(&e->ctx, &e->scene, err);
+    e->stats.intersect = e->scene.stats;
+    return st;
+}
+
 static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
                        mcsg_provenance **provenance, mcsg_error *err)
 {
@@ -243,17 +319,16 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     count_faces(&e->tree, &e->stats);
     if (e->tree.leaf_count == 0)
         return mci_mesh_alloc(&e->ctx, out, 0, 0, err);
-    st = mci_scene_build(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
-                         e->tree.leaf_count, &e->scene, err);
+    st = step(e, "intersect", intersect_step, err);
     if (st == MCSG_OK)
-        st = mci_scene_number_points(&e->ctx, &e->scene, err);
-    e->stats.intersect = e->scene.stats;
+        st = step(e, "triangulate", triangulate_all, err);
     if (st == MCSG_OK)
-        st = triangulate_all(e, err);
-    if (st == MCSG_OK)
-        st = classify_all(e, err);
-    if (st == MCSG_OK)
+        st = step(e, "classify", classify_all, err);
+    if (st == MCSG_OK) {
+        mci_progress(&e->ctx, "assemble", 0);
         st = assemble(e, out, provenance, err);
+        mci_progress(&e->ctx, "assemble", 1);
+    }
     return st;
 }
 

@@ -25,7 +25,12 @@ typedef struct mci_ctx {
     mcsg_log_fn log;
     void *log_user;
     int threads;
+    mcsg_progress_fn progress;
+    void *progress_user;
 } mci_ctx;
+
+/* Report the start (done = 0) or end (done = 1) of a step, if asked to. */
+void mci_progress(const mci_ctx *ctx, const char *step, int done);
 
 /* Fill *ctx from opts (NULL or zero fields mean defaults). */
 void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts);
@@ -44,6 +49,16 @@ char *mci_strdup(const mci_ctx *ctx, const char *s);
  * overflow, leaving the array as it was. */
 bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
                     size_t elem_size, size_t min_capacity);
+
+/* Run fn(user, i, err) for i in 0 .. count-1 on up to mci_thread_count(ctx) threads
+ * (the calling thread included). Tasks must be independent. Returns MCSG_OK, or the
+ * status and message of the failing task with the smallest index (no task is started
+ * after a failure). */
+typedef mcsg_status (*mci_task_fn)(void *user, size_t index, mcsg_error *err);
+mcsg_status mci_parallel_for(const mci_ctx *ctx, size_t count, mci_task_fn fn, void *user,
+                             mcsg_error *err);
+/* ctx->threads, or the number of online processors when it is 0 (at most 64). */
+int mci_thread_count(const mci_ctx *ctx);
 
 /* Wall-clock seconds since some fixed point (for step timings). */
 double mci_seconds_now(void);

@@ -134,6 +134,7 @@ mcsg_options test_allocator_options(test_allocator *a)
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
     opts.allocator = (mcsg_allocator){test_malloc, test_realloc, test_free, a};
+    opts.threads = 1; /* the counting allocator is not thread-safe */
     return opts;
 }
 

@@ -21,8 +21,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <pthread.h>
 #include <sys/resource.h>
 #include <time.h>
+#include <unistd.h>
 
 #define EXIT_PROBLEM 1
 #define EXIT_USAGE 2
@@ -466,6 +468,78 @@ static int cmd_intersect(int argc, char **argv)
 /* demo                                                                                */
 
 /* ---------------------------------------------------------------------------------- */
+/* Progress: when stderr is a terminal, a line names the step that has been running for
+ * more than a second (a ticker thread watches the step the library reports). */
+
+typedef struct progress_state {
+    pthread_mutex_t lock;
+    pthread_t thread;
+    const char *step;
+    double started;
+    int shown, quit, running;
+} progress_state;
+
+static progress_state progress;
+
+static void on_progress(void *user, const char *step, int done)
+{
+    (void)user;
+    pthread_mutex_lock(&progress.lock);
+    if (progress.shown)
+        fprintf(stderr, "\r%60s\r", "");
+    progress.shown = 0;
+    progress.step = done ? NULL : step;
+    progress.started = now_seconds();
+    pthread_mutex_unlock(&progress.lock);
+}
+
+static void *progress_ticker(void *arg)
+{
+    struct timespec tick = {0, 250000000};
+    (void)arg;
+    for (;;) {
+        nanosleep(&tick, NULL);
+        pthread_mutex_lock(&progress.lock);
+        if (progress.quit) {
+            pthread_mutex_unlock(&progress.lock);
+            return NULL;
+        }
+        if (progress.step && now_seconds() - progress.started > 1.0) {
+            fprintf(stderr, "\rmeshcsg: %s ... %.0f s ", progress.step,
+                    now_seconds() - progress.started);
+            progress.shown = 1;
+        }
+        pthread_mutex_unlock(&progress.lock);
+    }
+}
+
+static void start_progress(mcsg_options *opts)
+{
+    if (!isatty(2) || pthread_mutex_init(&progress.lock, NULL) != 0)
+        return;
+    if (pthread_create(&progress.thread, NULL, progress_ticker, NULL) != 0) {
+        pthread_mutex_destroy(&progress.lock);
+        return;
+    }
+    progress.running = 1;
+    opts->progress = on_progress;
+}
+
+static void stop_progress(void)
+{
+    if (!progress.running)
+        return;
+    pthread_mutex_lock(&progress.lock);
+    progress.quit = 1;
+    if (progress.shown)
+        fprintf(stderr, "\r%60s\r", "");
+    pthread_mutex_unlock(&progress.lock);
+    pthread_join(progress.thread, NULL);
+    pthread_mutex_destroy(&progress.lock);
+    progress.running = 0;
+}
+
+/* ---------------------------------------------------------------------------------- */
 
 static double peak_memory_mib(void)
 {
@@ -489,8 +563,9 @@ static void print_eval_stats(const mcsg_eval_stats *s)
     printf("  arrange faces    %8.3f s  (%zu faces)\n", x->seconds_arrange, x->arranged_faces);
     printf("  number points    %8.3f s\n", x->seconds_merge);
     printf("  triangulate      %8.3f s  (%zu pieces)\n", s->seconds_triangulate, s->pieces);
-    printf("  classify         %8.3f s  (%zu regions, %zu rays, %zu local tests)\n",
-           s->seconds_classify, s->regions, s->rays, s->local_tests);
+    printf("  classify         %8.3f s  (%zu regions, %zu rays, %zu local tests, "
+           "%zu primitives dropped whole)\n", s->seconds_classify, s->regions, s->rays,
+           s->local_tests, s->rejected_primitives);
     printf("  assemble         %8.3f s  (%zu vertices, %zu triangles)\n", s->seconds_assemble,
            s->output_vertices, s->output_triangles);
     printf("  total            %8.3f s\n", s->seconds_total);
@@ -502,6 +577,7 @@ static int cmd_eval(int argc, char **argv)
     mcsg_options opts = cli_options();
     const char *in = NULL, *out = NULL;
     int show_stats = 0, ok;
+    mcsg_status st;
     mcsg_tree *tree;
     mcsg_mesh result;
     mcsg_eval_stats stats;
@@ -524,7 +600,10 @@ static int cmd_eval(int argc, char **argv)
         fail_line(&err);
         return EXIT_PROBLEM;
     }
-    if (mcsg_eval(tree, &opts, &result, NULL, &stats, &err) != MCSG_OK) {
+    start_progress(&opts);
+    st = mcsg_eval(tree, &opts, &result, NULL, &stats, &err);
+    stop_progress();
+    if (st != MCSG_OK) {
         fail_line(&err);
         mcsg_tree_free(tree);
         return EXIT_PROBLEM;
@@ -594,7 +673,12 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
     mcsg_error err;
     double ref = reference_volume(spheres);
     int ok;
-    if (mcsg_eval(tree, opts, &result, NULL, &st, &err) != MCSG_OK) {
+    mcsg_options with_progress = *opts;
+    mcsg_status status;
+    start_progress(&with_progress);
+    status = mcsg_eval(tree, &with_progress, &result, NULL, &st, &err);
+    stop_progress();
+    if (status != MCSG_OK) {
         fail_line(&err);
         return 0;
     }
