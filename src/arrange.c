@@ -147,7 +147,7 @@ bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point
                           uint32_t plane_id, uint32_t group, bool on_edge)
 {
     mci_arr_segment s = {0, 0, other, 0, {other_plane->a, other_plane->b, other_plane->c},
-                         (uint64_t)plane_id + 1, group, on_edge};
+                         (uint64_t)plane_id + 1, group, on_edge, 0};
     return add_segment(ctx, arr, a, b, &s);
 }
 
@@ -218,12 +218,13 @@ static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t o
         return true;
     if (order == 0)
         return mci_arr_add_point(ctx, arr, c.start);
-    if (c.on_boundary || !crease)
+    if (c.on_boundary)
         return mci_arr_add_point(ctx, arr, c.start) && mci_arr_add_point(ctx, arr, c.end);
     {
         const double *aux = add_aux(arr, u);
         mci_arr_segment s = {0, 0, other, 1, {u, v, aux},
-                             COPLANAR_LINE + 3 * (uint64_t)other + (uint64_t)edge, group, 1};
+                             COPLANAR_LINE + 3 * (uint64_t)other + (uint64_t)edge, group, 1,
+                             !crease};
         return aux && add_segment(ctx, arr, c.start, c.end, &s);
     }
 }
@@ -658,11 +659,12 @@ static bool sweep(splitter *sp)
             const sweep_item *a = &items[i], *b = &items[j];
             if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || (a->is_point && b->is_point))
                 continue;
-            if (!a->is_point && !b->is_point && !one_surface(sp->arr, a->id, b->id))
+            if (!a->is_point && !b->is_point && !one_surface(sp->arr, a->id, b->id) &&
+                !(sp->arr->segments[a->id].phantom && sp->arr->segments[b->id].phantom))
                 relate_segments(sp, a->id, b->id);
             else if (!a->is_point && !b->is_point)
                 continue;
-            else
+            else if (!sp->arr->segments[a->is_point ? b->id : a->id].phantom)
                 relate_point(sp, a->is_point ? a->id : b->id, a->is_point ? b->id : a->id);
         }
     }
@@ -730,7 +732,8 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
         ids[n++] = arr->segments[s].b;
         for (; c < cut_count && cuts[c][0] == s; c++)
             ids[n++] = cuts[c][1];
-        emit_pieces(arr, table, &arr->segments[s], ids, tmp, n);
+        if (!arr->segments[s].phantom)
+            emit_pieces(arr, table, &arr->segments[s], ids, tmp, n);
     }
     if (arr->edge_count > 0)
         qsort(arr->edges, arr->edge_count, sizeof *arr->edges, compare_edges);

@@ -37,6 +37,9 @@ typedef struct mci_arr_segment {
     uint64_t line; /* segments with equal `line` lie on one line (see mci_arr_add_crossing) */
     uint32_t group;  /* the leaf of `other` */
     uint8_t on_edge; /* lies along an edge of `other` (always for coplanar edges) */
+    uint8_t phantom; /* an edge inside a flat region of the coplanar `other`: no
+                        constraint, but the points where segments of other leaves cross
+                        it are added (the faces across it have them as segment ends) */
 } mci_arr_segment;
 
 /* Lines a point is known to lie on, by construction (at most 3 kept: the list only
