@@ -69,6 +69,8 @@ static bool join_kept(eval_state *e, const leaf_jobs *j)
         return false;
     for (size_t l = 0; l < e->tree.leaf_count; l++) {
         const mci_kept *k = &j->kept[l];
+        if (k->count == 0)
+            continue; /* its arrays may be NULL */
         memcpy(e->kept.tris + 3 * e->kept.count, k->tris, 3 * k->count * sizeof *k->tris);
         memcpy(e->kept.faces + e->kept.count, k->faces, k->count * sizeof *k->faces);
         e->kept.count += k->count;
@@ -238,7 +240,7 @@ static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
     for (size_t v = 0; st == MCSG_OK && v < r->count; v++)
         if (final[v] != MCI_NONE && r->canon[v] == v)
             memcpy(out->vertices + 3 * (size_t)final[v], r->xyz + 3 * v, 3 * sizeof(double));
-    if (st == MCSG_OK)
+    if (st == MCSG_OK && nt > 0)
         memcpy(out->triangles, tris, 3 * nt * sizeof *tris);
     e->stats.rounding_dropped_triangles = e->kept.count - nt;
     mci_free(&e->ctx, final);
