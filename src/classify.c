@@ -23,7 +23,6 @@
  */
 #include "classify.h"
 
-#include <stdlib.h>
 #include <string.h>
 
 /* ---------------------------------------------------------------------------------- */
@@ -307,24 +306,6 @@ void mci_kept_free(const mci_ctx *ctx, mci_kept *kept)
 /* ---------------------------------------------------------------------------------- */
 /* One leaf: pieces, regions, labels, selection                                        */
 
-typedef struct keyed {
-    uint64_t key;
-    uint32_t ref;
-} keyed;
-
-static int compare_keyed(const void *x, const void *y)
-{
-    const keyed *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->ref > b->ref) - (a->ref < b->ref);
-}
-
-static uint64_t edge_key(uint32_t u, uint32_t v)
-{
-    return u < v ? (uint64_t)u << 32 | v : (uint64_t)v << 32 | u;
-}
-
 typedef struct leaf_work {
     const mci_ctx *ctx;
     const mci_classifier *cl;
@@ -336,7 +317,7 @@ typedef struct leaf_work {
     uint32_t *plocal; /* 3 per piece: arrangement point id (arranged faces) */
     uint32_t *mate;   /* per edge slot 3p + i (pv[i] -> pv[i + 1]): the slot across */
     uint8_t *is_sep;  /* per edge slot */
-    keyed *sep;       /* separators: (edge key, face of another leaf holding it), sorted */
+    mci_keyed *sep;       /* separators: (edge key, face of another leaf holding it), sorted */
     size_t nsep;
     uint32_t *region; /* per piece */
     size_t nreg;
@@ -436,7 +417,7 @@ static uint32_t slot_to(const leaf_work *w, size_t slot)
 static mcsg_status pair_edges(leaf_work *w)
 {
     size_t n = 3 * w->np, i = 0;
-    keyed *e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
+    mci_keyed *e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
     mcsg_status st = MCSG_OK;
     w->mate = mci_malloc_array(w->ctx, n + 1, sizeof *w->mate);
     if (!e || !w->mate) {
@@ -444,10 +425,10 @@ static mcsg_status pair_edges(leaf_work *w)
         return mci_fail_nomem(w->err, "classifying faces");
     }
     for (size_t k = 0; k < n; k++) {
-        e[k].key = edge_key(slot_from(w, k), slot_to(w, k));
+        e[k].key = mci_edge_key(slot_from(w, k), slot_to(w, k));
         e[k].ref = (uint32_t)k;
     }
-    qsort(e, n, sizeof *e, compare_keyed);
+    mci_sort_keyed(e, n);
     while (i < n && st == MCSG_OK) {
         size_t j = i;
         while (j < n && e[j].key == e[i].key)
@@ -482,27 +463,18 @@ static mcsg_status collect_separators(leaf_work *w)
         const mci_face_arr *arr = arr_of_face(s, f);
         const uint32_t *gid = arr ? s->gid + s->gid_start[s->arr_of[f]] : NULL;
         for (size_t e = 0; arr && e < arr->edge_count; e++) {
-            w->sep[w->nsep].key = edge_key(gid[arr->edges[e].a], gid[arr->edges[e].b]);
+            w->sep[w->nsep].key = mci_edge_key(gid[arr->edges[e].a], gid[arr->edges[e].b]);
             w->sep[w->nsep++].ref = arr->edges[e].other;
         }
     }
-    if (w->nsep > 0)
-        qsort(w->sep, w->nsep, sizeof *w->sep, compare_keyed);
+    mci_sort_keyed(w->sep, w->nsep);
     return MCSG_OK;
 }
 
 /* Index of the first separator entry with this key, or nsep. */
 static size_t find_separator(const leaf_work *w, uint64_t key)
 {
-    size_t lo = 0, hi = w->nsep;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (w->sep[mid].key < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < w->nsep && w->sep[lo].key == key ? lo : w->nsep;
+    return mci_find_key(w->sep, w->nsep, key);
 }
 
 static uint32_t find_root(uint32_t *parent, uint32_t x)
@@ -526,7 +498,7 @@ static mcsg_status build_regions(leaf_work *w)
     for (uint32_t p = 0; p < w->np; p++)
         parent[p] = p;
     for (size_t k = 0; k < 3 * w->np; k++) {
-        uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+        uint64_t key = mci_edge_key(slot_from(w, k), slot_to(w, k));
         w->is_sep[k] = find_separator(w, key) < w->nsep;
         if (!w->is_sep[k]) {
             uint32_t a = find_root(parent, (uint32_t)(k / 3));
@@ -663,7 +635,7 @@ static void local_labels_at(leaf_work *w, uint8_t *to, size_t k, bool only_unkno
 {
     const mci_scene *s = w->s;
     size_t p = k / 3;
-    uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+    uint64_t key = mci_edge_key(slot_from(w, k), slot_to(w, k));
     mci_point x, y, far;
     piece_point(w, p, (int)(k % 3), &x);
     piece_point(w, p, (int)(k % 3 + 1) % 3, &y);
@@ -689,7 +661,7 @@ static void inherit_labels(leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
 /* Whether separator slot k lies on the surface of leaf m. */
 static bool separator_on_leaf(const leaf_work *w, size_t k, uint32_t m)
 {
-    uint64_t key = edge_key(slot_from(w, k), slot_to(w, k));
+    uint64_t key = mci_edge_key(slot_from(w, k), slot_to(w, k));
     for (size_t e = find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++)
         if (w->s->octree.face_leaf[w->sep[e].ref] == m)
             return true;

@@ -388,3 +388,64 @@ void mci_progress(const mci_ctx *ctx, const char *step, int done)
     if (ctx->progress)
         ctx->progress(ctx->progress_user, step, done);
 }
+
+bool mci_first_equal_coordinates(const mci_ctx *ctx, const double *xyz, size_t n,
+                                 uint32_t *canon)
+{
+    size_t size = 16;
+    uint32_t *table;
+    while (size < 2 * n)
+        size *= 2;
+    table = mci_malloc_array(ctx, size, sizeof *table);
+    if (!table)
+        return false;
+    for (size_t i = 0; i < size; i++)
+        table[i] = UINT32_MAX;
+    for (uint32_t v = 0; v < n; v++) {
+        const double *x = xyz + 3 * (size_t)v;
+        size_t at = mci_coordinate_hash(x) & (size - 1);
+        while (table[at] != UINT32_MAX) {
+            const double *y = xyz + 3 * (size_t)table[at];
+            if (x[0] == y[0] && x[1] == y[1] && x[2] == y[2])
+                break;
+            at = (at + 1) & (size - 1);
+        }
+        if (table[at] == UINT32_MAX)
+            table[at] = v;
+        canon[v] = table[at];
+    }
+    mci_free(ctx, table);
+    return true;
+}
+
+uint64_t mci_edge_key(uint32_t u, uint32_t v)
+{
+    return u < v ? (uint64_t)u << 32 | v : (uint64_t)v << 32 | u;
+}
+
+static int compare_keyed(const void *x, const void *y)
+{
+    const mci_keyed *a = x, *b = y;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->ref > b->ref) - (a->ref < b->ref);
+}
+
+void mci_sort_keyed(mci_keyed *items, size_t n)
+{
+    if (n > 1)
+        qsort(items, n, sizeof *items, compare_keyed);
+}
+
+size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (items[mid].key < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && items[lo].key == key ? lo : n;
+}

@@ -144,34 +144,6 @@ static uint64_t *point_representatives(const eval_state *e)
 /* Vertices whose exact positions differ but round to the same doubles (points closer
  * than the rounding error, e.g. where curves cross at a vertex up to the inputs'
  * rounding) are joined, and the triangles this flattens are dropped. */
-static bool weld_rounded(const mci_ctx *ctx, const double *xyz, size_t n, uint32_t *canon)
-{
-    size_t size = 16;
-    uint32_t *table;
-    while (size < 2 * n)
-        size *= 2;
-    table = mci_malloc_array(ctx, size, sizeof *table);
-    if (!table)
-        return false;
-    for (size_t i = 0; i < size; i++)
-        table[i] = MCI_NONE;
-    for (uint32_t v = 0; v < n; v++) {
-        const double *x = xyz + 3 * (size_t)v;
-        size_t at = mci_coordinate_hash(x) & (size - 1);
-        while (table[at] != MCI_NONE) {
-            const double *y = xyz + 3 * (size_t)table[at];
-            if (x[0] == y[0] && x[1] == y[1] && x[2] == y[2])
-                break;
-            at = (at + 1) & (size - 1);
-        }
-        if (table[at] == MCI_NONE)
-            table[at] = v;
-        canon[v] = table[at];
-    }
-    mci_free(ctx, table);
-    return true;
-}
-
 /* The rounded coordinates of every used vertex, numbered densely in order of use. */
 typedef struct rounded {
     uint32_t *dense; /* output vertex id -> dense index */
@@ -198,7 +170,7 @@ static mcsg_status round_vertices(const eval_state *e, rounded *r, mcsg_error *e
     for (size_t id = 0; ok && id < ids; id++)
         if (r->dense[id] != MCI_NONE)
             vertex_coordinates(e, rep, (uint32_t)id, r->xyz + 3 * (size_t)r->dense[id]);
-    ok = ok && weld_rounded(&e->ctx, r->xyz, r->count, r->canon);
+    ok = ok && mci_first_equal_coordinates(&e->ctx, r->xyz, r->count, r->canon);
     mci_free(&e->ctx, rep);
     return ok ? MCSG_OK : mci_fail_nomem(err, "assembling the result");
 }

@@ -65,6 +65,23 @@ double mci_seconds_now(void);
 
 /* A hash of a point's three coordinates in which -0 and +0 are equal. */
 uint64_t mci_coordinate_hash(const double *x);
+/* canon[i] = the first j with point j's coordinates equal to point i's, for the n points
+ * xyz[3i..3i+2] (hash table; -0 == +0). False on allocation failure. */
+bool mci_first_equal_coordinates(const mci_ctx *ctx, const double *xyz, size_t n,
+                                 uint32_t *canon);
+
+/* A 64-bit key with a reference, for sorting and looking up edges and the like. */
+typedef struct mci_keyed {
+    uint64_t key;
+    uint32_t ref;
+} mci_keyed;
+
+/* The key of the undirected edge u-v (smaller id in the high half). */
+uint64_t mci_edge_key(uint32_t u, uint32_t v);
+/* Sort by key, then ref. */
+void mci_sort_keyed(mci_keyed *items, size_t n);
+/* Index of the first item with this key in sorted items[0 .. n), or n. */
+size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key);
 
 /* Record an error (if err is non-NULL) and return `status`, so that callers can write
  * `return mci_fail(err, MCSG_ERR_PARSE, "%s:%zu: ...", name, line);`. */

@@ -111,44 +111,13 @@ typedef struct leaf_adjacency {
     uint32_t *faces;
 } leaf_adjacency;
 
-static bool same_coordinates(const double *a, const double *b)
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
-}
-
-/* Meshes need not share vertices between faces (STL never does): vertices with equal
- * coordinates are identified, through a hash table. */
-static bool canonical_vertices(const mci_ctx *ctx, const mcsg_mesh *m, uint32_t *canon)
-{
-    size_t size = 16;
-    uint32_t *table;
-    while (size < 2 * m->vertex_count)
-        size *= 2;
-    table = mci_malloc_array(ctx, size, sizeof *table);
-    if (!table)
-        return false;
-    for (size_t i = 0; i < size; i++)
-        table[i] = MCI_NONE;
-    for (uint32_t v = 0; v < m->vertex_count; v++) {
-        const double *x = m->vertices + 3 * (size_t)v;
-        size_t at = mci_coordinate_hash(x) & (size - 1);
-        while (table[at] != MCI_NONE && !same_coordinates(m->vertices + 3 * (size_t)table[at], x))
-            at = (at + 1) & (size - 1);
-        if (table[at] == MCI_NONE)
-            table[at] = v;
-        canon[v] = table[at];
-    }
-    mci_free(ctx, table);
-    return true;
-}
-
 static bool build_adjacency(const mci_ctx *ctx, const mcsg_mesh *m, leaf_adjacency *a)
 {
     size_t n = m->triangle_count;
     a->canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *a->canon);
     a->start = mci_calloc_array(ctx, m->vertex_count + 2, sizeof *a->start);
     a->faces = mci_malloc_array(ctx, 3 * n + 1, sizeof *a->faces);
-    if (!a->canon || !a->start || !a->faces || !canonical_vertices(ctx, m, a->canon))
+    if (!a->canon || !a->start || !a->faces || !mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, a->canon))
         return false;
     for (size_t c = 0; c < 3 * n; c++)
         a->start[a->canon[m->triangles[c]] + 2]++;

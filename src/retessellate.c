@@ -11,26 +11,9 @@
  */
 #include "arrange.h"
 
-#include <stdlib.h>
 #include <string.h>
 
-typedef struct side {
-    uint64_t key; /* local point ids, smaller first */
-    uint32_t ref; /* 3 * triangle + edge */
-} side;
-
-static int compare_sides(const void *x, const void *y)
-{
-    const side *a = x, *b = y;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->ref > b->ref) - (a->ref < b->ref);
-}
-
-static uint64_t local_key(uint32_t u, uint32_t v)
-{
-    return u < v ? (uint64_t)u << 32 | v : (uint64_t)v << 32 | u;
-}
+typedef mci_keyed side; /* key: local point ids of an edge; ref: 3 * triangle + edge */
 
 /* The 3 * n edge sides of triangles tris[0 .. 3n), sorted by key. */
 static side *sorted_sides(const mci_ctx *ctx, const uint32_t *tris, size_t n)
@@ -39,32 +22,17 @@ static side *sorted_sides(const mci_ctx *ctx, const uint32_t *tris, size_t n)
     if (!s)
         return NULL;
     for (size_t r = 0; r < 3 * n; r++) {
-        s[r].key = local_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]);
+        s[r].key = mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]);
         s[r].ref = (uint32_t)r;
     }
-    if (n > 0)
-        qsort(s, 3 * n, sizeof *s, compare_sides);
+    mci_sort_keyed(s, 3 * n);
     return s;
-}
-
-/* Index of the first side with this key in s[0 .. n), or n. */
-static size_t find_side(const side *s, size_t n, uint64_t key)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (s[mid].key < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < n && s[lo].key == key ? lo : n;
 }
 
 /* Whether the interior edge `key` of the old tessellation separates kept from dropped. */
 static bool is_valid_edge(const side *old, size_t n, const uint8_t *keep, uint64_t key)
 {
-    size_t i = find_side(old, n, key);
+    size_t i = mci_find_key(old, n, key);
     return i + 1 < n && old[i + 1].key == key && keep[old[i].ref / 3] != keep[old[i + 1].ref / 3];
 }
 
@@ -93,7 +61,7 @@ static mcsg_status spread_status(const mci_ctx *ctx, const side *old, size_t old
         size_t j;
         if (mate[r] != UINT32_MAX || keep[t] != 2)
             continue;
-        j = find_side(old, old_n, local_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]));
+        j = mci_find_key(old, old_n, mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]));
         if (j < old_n) {
             keep[t] = piece_keep[old[j].ref / 3];
             queue[tail++] = t;
@@ -106,7 +74,7 @@ static mcsg_status spread_status(const mci_ctx *ctx, const side *old, size_t old
             if (u == UINT32_MAX || keep[u] != 2)
                 continue;
             keep[u] = is_valid_edge(old, old_n, piece_keep,
-                                    local_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]))
+                                    mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]))
                           ? !keep[t]
                           : keep[t];
             queue[tail++] = u;
@@ -128,8 +96,8 @@ static void choose_valid(const mci_face_arr *arr, const side *old, size_t old_n,
 {
     *droppable = false;
     for (size_t e = 0; e < arr->edge_count; e++) {
-        uint64_t key = local_key(arr->edges[e].a, arr->edges[e].b);
-        size_t i = find_side(old, old_n, key);
+        uint64_t key = mci_edge_key(arr->edges[e].a, arr->edges[e].b);
+        size_t i = mci_find_key(old, old_n, key);
         bool interior = i + 1 < old_n && old[i + 1].key == key;
         use[e] = is_valid_edge(old, old_n, piece_keep, key);
         *droppable = *droppable || (interior && !use[e]);
