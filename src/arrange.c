@@ -487,16 +487,7 @@ static void cut_if_inside(splitter *sp, uint32_t s, uint32_t p)
     }
 }
 
-static bool plane_before(const mci_plane *p, const mci_plane *q)
-{
-    const double *a[3] = {p->a, p->b, p->c}, *b[3] = {q->a, q->b, q->c};
-    for (int i = 0; i < 3; i++)
-        if (a[i] != b[i])
-            return (uintptr_t)a[i] < (uintptr_t)b[i];
-    return false;
-}
-
-/* The TPI of three planes given in a canonical order (by their vertices' addresses), so
+/* The TPI of three planes given in a canonical order (mci_plane_before), so
  * that the three faces of a triple point define it identically: their arrangements'
  * copies are then recognised as one point by definition, without arithmetic. */
 static bool canonical_tpi(mci_point *out, const mci_plane *p1, const mci_plane *p2,
@@ -505,7 +496,7 @@ static bool canonical_tpi(mci_point *out, const mci_plane *p1, const mci_plane *
     const mci_plane *q[3] = {p1, p2, p3}, *t;
     for (int m = 0; m < 2; m++)
         for (int k = 0; k < 2 - m; k++)
-            if (plane_before(q[k + 1], q[k]))
+            if (mci_plane_before(q[k + 1], q[k]))
                 t = q[k], q[k] = q[k + 1], q[k + 1] = t;
     return mci_point_tpi(out, q[0], q[1], q[2]);
 }

@@ -203,6 +203,23 @@ static i128 i128_from_double(double x, int e0)
 /* ---------------------------------------------------------------------------------- */
 /* Planes and points                                                                   */
 
+bool mci_vertex_before(const double *a, const double *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a[k] != b[k])
+            return a[k] < b[k];
+    return (uintptr_t)a < (uintptr_t)b;
+}
+
+bool mci_plane_before(const mci_plane *p, const mci_plane *q)
+{
+    const double *a[3] = {p->a, p->b, p->c}, *b[3] = {q->a, q->b, q->c};
+    for (int i = 0; i < 3; i++)
+        if (a[i] != b[i])
+            return mci_vertex_before(a[i], b[i]);
+    return false;
+}
+
 void mci_plane_init(mci_plane *plane, const double *a, const double *b, const double *c)
 {
     mci_fv d1[3], d2[3];

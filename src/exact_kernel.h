@@ -46,6 +46,15 @@ typedef struct mci_plane {
 
 void mci_plane_init(mci_plane *plane, const double *a, const double *b, const double *c);
 
+/* A total order on input vertices by coordinates (lexicographic), then by address among
+ * vertices with equal coordinates. Canonical definitions (edge ends, TPI plane order)
+ * use it so that a point's definition, and hence its floating-point approximation and
+ * rounded output, never depends on where the meshes happen to sit in memory. */
+bool mci_vertex_before(const double *a, const double *b);
+
+/* Whether plane p comes before plane q: mci_vertex_before on their defining vertices. */
+bool mci_plane_before(const mci_plane *p, const mci_plane *q);
+
 typedef enum mci_point_kind {
     MCI_POINT_EXPLICIT = 0,
     MCI_POINT_LPI = 1,

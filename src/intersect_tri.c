@@ -39,7 +39,7 @@ static bool all_strictly_one_side(const int side[3])
 static void edge_crossing(mci_point *out, const double *u, const double *v,
                           const mci_plane *plane)
 {
-    bool swap = (uintptr_t)u > (uintptr_t)v;
+    bool swap = mci_vertex_before(v, u);
     /* The sides differ strictly, so the line is not parallel to the plane. */
     (void)mci_point_lpi(out, swap ? v : u, swap ? u : v, plane);
 }

@@ -8,6 +8,7 @@
 #include "testlib.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -244,6 +245,87 @@ TEST(empty_and_trivial_trees)
     expect_solid("union() { cube(1); translate([5,0,0]) cube(1); }", 2, 2);
 }
 
+/* An allocator that hands out blocks from the top of an arena downwards, so that the
+ * leaves' meshes sit in memory in the reverse of the usual order. Single-threaded. */
+typedef struct downward_arena {
+    unsigned char *base;
+    size_t top;
+} downward_arena;
+
+static void *arena_malloc(void *user, size_t size)
+{
+    downward_arena *a = user;
+    size_t need = (size + 2 * sizeof(max_align_t) - 1) / sizeof(max_align_t) * sizeof(max_align_t);
+    if (need > a->top)
+        return NULL;
+    a->top -= need;
+    memcpy(a->base + a->top, &size, sizeof size);
+    return a->base + a->top + sizeof(max_align_t);
+}
+
+static void *arena_realloc(void *user, void *ptr, size_t size)
+{
+    size_t old;
+    void *fresh = arena_malloc(user, size);
+    if (ptr && fresh) {
+        memcpy(&old, (unsigned char *)ptr - sizeof(max_align_t), sizeof old);
+        memcpy(fresh, ptr, old < size ? old : size);
+    }
+    return fresh;
+}
+
+static void arena_free(void *user, void *ptr)
+{
+    (void)user;
+    (void)ptr;
+}
+
+static bool eval_with(const char *text, const mcsg_options *opts, mcsg_mesh *out)
+{
+    mcsg_tree *tree = NULL;
+    mcsg_error err;
+    mcsg_status st = mcsg_scad_read_memory(text, strlen(text), "test.scad", ".", opts, &tree,
+                                           &err);
+    CHECK_OK(st, &err);
+    if (st != MCSG_OK)
+        return false;
+    st = mcsg_eval(tree, opts, out, NULL, NULL, &err);
+    CHECK_OK(st, &err);
+    mcsg_tree_free(tree);
+    return st == MCSG_OK;
+}
+
+/* The output must not depend on the thread count or on where the leaves sit in memory:
+ * canonical point definitions once followed memory addresses, and their floating-point
+ * approximations (hence the rounded output) changed from run to run. */
+TEST(output_is_independent_of_memory_layout_and_threads)
+{
+    const char *scene =
+        "union() { rotate([10,20,30]) sphere(r=2,$fn=24); translate([1.3,0.2,0.1])"
+        " rotate([40,5,70]) sphere(r=1.7,$fn=20); translate([0.4,1.1,-0.3]) rotate([3,60,9])"
+        " cylinder(h=4,r=1,center=true,$fn=18); translate([-0.7,0.3,0.9]) rotate([33,-12,7])"
+        " cube([2,1.5,1.2],center=true); }";
+    size_t arena_size = (size_t)256 << 20;
+    downward_arena arena = {malloc(arena_size), arena_size};
+    mcsg_options normal = {0}, reversed = {0};
+    mcsg_mesh a, b;
+    reversed.allocator = (mcsg_allocator){arena_malloc, arena_realloc, arena_free, &arena};
+    reversed.threads = 1;
+    normal.threads = 2;
+    if (!arena.base || !eval_with(scene, &normal, &a))
+        return;
+    if (eval_with(scene, &reversed, &b)) {
+        CHECK(a.vertex_count == b.vertex_count && a.triangle_count == b.triangle_count);
+        if (a.vertex_count == b.vertex_count && a.triangle_count == b.triangle_count) {
+            CHECK(memcmp(a.vertices, b.vertices, 3 * a.vertex_count * sizeof(double)) == 0);
+            CHECK(memcmp(a.triangles, b.triangles, 3 * a.triangle_count * sizeof(uint32_t)) == 0);
+        }
+    }
+    CHECK(a.triangle_count > 500);
+    mcsg_mesh_free(&a, &normal);
+    free(arena.base);
+}
+
 static mcsg_status eval_under(const void *ctx, const mcsg_options *opts, mcsg_error *err)
 {
     mcsg_mesh out;
@@ -282,6 +364,7 @@ int main(void)
     RUN(aligned_edges_and_close_points);
     RUN(provenance_names_leaf_faces);
     RUN(empty_and_trivial_trees);
+    RUN(output_is_independent_of_memory_layout_and_threads);
     RUN(allocation_failures_leak_nothing);
     return test_summary();
 }
