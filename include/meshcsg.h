@@ -404,8 +404,12 @@ typedef struct mcsg_eval_stats {
     size_t local_tests;       /* exact label changes across intersection curves */
     size_t rejected_primitives; /* dropped whole by their first trimmed CSGlist (§5.3) */
     size_t output_vertices, output_triangles;
-    size_t rounding_dropped_triangles; /* flattened when distinct exact vertices rounded
-                                          to the same doubles were joined */
+    size_t rounding_dropped_triangles; /* collapsed (two corners joined) or folded onto an
+                                          opposite twin when distinct exact vertices that
+                                          round to the same doubles were joined */
+    size_t rounding_split_triangles; /* rounded to three collinear corners and removed by
+                                        splitting the neighbour at the middle corner */
+    size_t rounding_flat_triangles;  /* rounded flat and left (neighbour flat as well) */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_triangulate; /* tessellating the split faces */

@@ -6,6 +6,7 @@
  * rounded to double only here.
  */
 #include "classify.h"
+#include "rounding_repair.h"
 
 #include <string.h>
 
@@ -182,8 +183,53 @@ static void free_rounded(const mci_ctx *ctx, rounded *r)
     mci_free(ctx, r->canon);
 }
 
-/* Triangles with three distinct rounded vertices, renumbered by first use; *kept_tri
- * lists the kept triangles' indices in e->kept. */
+/* Drop the vertices no triangle uses any more (after cancelled triangles), keeping the
+ * others in order: new ids never exceed old ones, so the move can be done in place. */
+static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
+{
+    size_t nv = 0;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        map[v] = MCI_NONE;
+    for (size_t i = 0; i < 3 * m->triangle_count; i++)
+        map[m->triangles[i]] = 0;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        if (map[v] != MCI_NONE) {
+            memmove(m->vertices + 3 * nv, m->vertices + 3 * v, 3 * sizeof(double));
+            map[v] = (uint32_t)nv++;
+        }
+    for (size_t i = 0; i < 3 * m->triangle_count; i++)
+        m->triangles[i] = map[m->triangles[i]];
+    m->vertex_count = nv;
+}
+
+/* See rounding_repair.h. Splitting a flat triangle can fold a sliver next to it onto an
+ * opposite twin, and cancelling twins can expose flat triangles: repeat while either
+ * changes something. `map` has room for every vertex of out. */
+static mcsg_status repair_rounding(eval_state *e, mcsg_mesh *out, uint32_t *which,
+                                   uint32_t *map, mcsg_error *err)
+{
+    mci_flat_repair repair = {0, 0};
+    size_t cancelled = 1, split = 0, total_cancelled = 0;
+    for (int round = 0; round < 8 && (cancelled > 0 || repair.split > 0); round++) {
+        if (!mci_cancel_opposite_triangles(&e->ctx, out->triangles, which,
+                                           &out->triangle_count, &cancelled) ||
+            !mci_split_flat_triangles(&e->ctx, out->vertices, out->triangles, which,
+                                      out->triangle_count, &repair))
+            return mci_fail_nomem(err, "assembling the result");
+        total_cancelled += cancelled;
+        split += repair.split;
+    }
+    if (total_cancelled > 0)
+        drop_unused_vertices(out, map);
+    e->stats.rounding_dropped_triangles += total_cancelled;
+    e->stats.rounding_split_triangles = split;
+    e->stats.rounding_flat_triangles = repair.remaining;
+    return MCSG_OK;
+}
+
+/* Triangles with three distinct rounded vertices, renumbered by first use, repaired
+ * where rounding folded or flattened them; *kept_tri lists the output triangles'
+ * indices in e->kept. */
 static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
                                 uint32_t **kept_tri, mcsg_error *err)
 {
@@ -215,6 +261,8 @@ static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
     if (st == MCSG_OK && nt > 0)
         memcpy(out->triangles, tris, 3 * nt * sizeof *tris);
     e->stats.rounding_dropped_triangles = e->kept.count - nt;
+    if (st == MCSG_OK)
+        st = repair_rounding(e, out, which, final, err);
     mci_free(&e->ctx, final);
     mci_free(&e->ctx, tris);
     if (st == MCSG_OK)
