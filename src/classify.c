@@ -668,12 +668,26 @@ static bool separator_on_leaf(const leaf_work *w, size_t k, uint32_t m)
     return false;
 }
 
-/* Labels still unknown after the sweep (a seed whose vertices all lie on a leaf it
- * touches only at points) are copied from neighbours across separators not on that
- * leaf, until nothing changes. */
+static bool has_unknown_label(const leaf_work *w, uint32_t r)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (size_t c = 0; c < w->ncand; c++)
+        if (w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN)
+            return true;
+    return false;
+}
+
+/* Labels still unknown after the sweep: a seed's vertices all lie on a leaf (e.g. a
+ * face coplanar with that leaf's face), and regions reached from it across curves of
+ * other leaves inherited the unknown. They are decided by local tests at the region's
+ * own separators on that leaf, if any, and otherwise copied from neighbours across
+ * separators not on that leaf, until nothing changes. */
 static void fill_unknown_labels(leaf_work *w)
 {
     bool changed = true;
+    for (uint32_t r = 0; r < w->nreg; r++)
+        if (has_unknown_label(w, r))
+            seed_by_local_tests(w, r);
     while (changed) {
         changed = false;
         for (uint32_t r = 0; r < w->nreg; r++) {
