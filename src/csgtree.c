@@ -1,7 +1,8 @@
 /*
  * CSG tree machinery (see csgtree.h): Requicha and Tilove's label combination rules as
  * stated in the paper's Eq. 3, Rossignac and Voelcker's positive form (Eq. 4), and the
- * paper's CSGlist (§5.3) with the desired labels of Eq. 2.
+ * paper's CSGlist (§5.3) with the desired labels of Eq. 2, and Hable and Rossignac's
+ * Blist for the lists' fast evaluation (§5.4).
  *
  * The positive tree is built and evaluated without recursion: nodes are stored in
  * post-order with their subtree sizes, so a subtree is a contiguous range evaluated
@@ -249,4 +250,138 @@ int mci_csglist_accepts(const mci_ptree *t, const mci_csg_entry *list, size_t n,
             return 0;
     }
     return unknown ? -1 : 1;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Blist                                                                               */
+
+typedef struct blist_builder {
+    const mci_ptree *t;
+    mci_label *value;  /* per node: IN / OUT if decided by the trimming labels, else UNKNOWN */
+    int32_t *first;    /* per undecided node: the step evaluated first in its subtree */
+    int32_t *on_true, *on_false; /* per undecided node: where its value IN / OUT leads */
+    mci_blist *out;
+} blist_builder;
+
+/* Bottom-up over the subtree: steps for undecided leaves, in post-order, and the first
+ * step of every undecided node (that of its first undecided child; decided children
+ * are neutral: OUT under a union, IN under an intersection). */
+static void number_steps(blist_builder *b, uint32_t node)
+{
+    const mci_ptree *t = b->t;
+    for (uint32_t i = node + 1 - t->nodes[node].size; i <= node; i++) {
+        const mci_pnode *p = &t->nodes[i];
+        b->first[i] = MCI_BLIST_REJECT;
+        if (b->value[i] != MCI_LABEL_UNKNOWN)
+            continue;
+        if (p->kind == MCI_PNODE_LEAF) {
+            b->out->steps[b->out->count].leaf = p->leaf;
+            b->first[i] = (int32_t)b->out->count++;
+            continue;
+        }
+        for (uint32_t c = 0; c < p->count && b->first[i] < 0; c++)
+            b->first[i] = b->first[t->child[p->first + c]];
+    }
+}
+
+/* Top-down (reverse post-order visits parents first): in a union, a child that is IN
+ * makes the union IN and one that is OUT passes on to the next child; dually for an
+ * intersection. A leaf's step jumps on its label (swapped when complemented). */
+static void link_steps(blist_builder *b, uint32_t node)
+{
+    const mci_ptree *t = b->t;
+    for (uint32_t i = node + 1; i-- > node + 1 - t->nodes[node].size;) {
+        const mci_pnode *p = &t->nodes[i];
+        int32_t next = b->on_false[i], next_true = b->on_true[i];
+        if (b->value[i] != MCI_LABEL_UNKNOWN)
+            continue;
+        if (p->kind == MCI_PNODE_LEAF) {
+            mci_blist_step *s = &b->out->steps[b->first[i]];
+            s->on_in = p->complement ? b->on_false[i] : b->on_true[i];
+            s->on_out = p->complement ? b->on_true[i] : b->on_false[i];
+            continue;
+        }
+        /* Children right to left: each one's "continue" target is the next child's
+         * first step (or the node's own target for the last). */
+        for (uint32_t c = p->count; c-- > 0;) {
+            uint32_t k = t->child[p->first + c];
+            if (b->value[k] != MCI_LABEL_UNKNOWN)
+                continue;
+            if (p->kind == MCI_PNODE_UNION) {
+                b->on_true[k] = next_true;
+                b->on_false[k] = next;
+                next = b->first[k];
+            } else {
+                b->on_true[k] = next_true;
+                b->on_false[k] = b->on_false[i];
+                next_true = b->first[k];
+            }
+        }
+    }
+}
+
+bool mci_blist_build(const mci_ctx *ctx, const mci_ptree *t, const mci_csg_entry *list,
+                     size_t n, const mci_label *leaf_labels, mci_blist *out)
+{
+    blist_builder b = {t, NULL, NULL, NULL, NULL, out};
+    int32_t next = MCI_BLIST_ACCEPT;
+    size_t nodes = t->node_count + 1;
+    bool ok;
+    memset(out, 0, sizeof *out);
+    b.value = mci_malloc_array(ctx, nodes, sizeof *b.value);
+    b.first = mci_malloc_array(ctx, nodes, sizeof *b.first);
+    b.on_true = mci_malloc_array(ctx, nodes, sizeof *b.on_true);
+    b.on_false = mci_malloc_array(ctx, nodes, sizeof *b.on_false);
+    out->steps = mci_malloc_array(ctx, t->leaf_count + 1, sizeof *out->steps);
+    ok = b.value && b.first && b.on_true && b.on_false && out->steps;
+    if (ok) {
+        for (size_t i = 0; i < n; i++) {
+            (void)mci_ptree_eval(t, list[i].node, leaf_labels, b.value);
+            number_steps(&b, list[i].node);
+        }
+        /* Entries right to left: the desired value goes on to the next entry. */
+        for (size_t i = n; i-- > 0;) {
+            uint32_t node = list[i].node;
+            bool want_in = list[i].desired & MCI_LABEL_BIT(MCI_LABEL_IN);
+            if (b.value[node] != MCI_LABEL_UNKNOWN) {
+                if (!(list[i].desired & MCI_LABEL_BIT(b.value[node])))
+                    next = MCI_BLIST_REJECT;
+                continue;
+            }
+            b.on_true[node] = want_in ? next : MCI_BLIST_REJECT;
+            b.on_false[node] = want_in ? MCI_BLIST_REJECT : next;
+            link_steps(&b, node);
+            next = b.first[node];
+        }
+        out->start = next;
+    }
+    mci_free(ctx, b.value);
+    mci_free(ctx, b.first);
+    mci_free(ctx, b.on_true);
+    mci_free(ctx, b.on_false);
+    if (!ok)
+        mci_blist_free(ctx, out);
+    return ok;
+}
+
+void mci_blist_free(const mci_ctx *ctx, mci_blist *b)
+{
+    mci_free(ctx, b->steps);
+    memset(b, 0, sizeof *b);
+}
+
+int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels)
+{
+    int32_t at = b->start;
+    while (at >= 0) {
+        const mci_blist_step *s = &b->steps[at];
+        mci_label l = leaf_labels[s->leaf];
+        if (l == MCI_LABEL_IN)
+            at = s->on_in;
+        else if (l == MCI_LABEL_OUT)
+            at = s->on_out;
+        else
+            return -1;
+    }
+    return at == MCI_BLIST_ACCEPT;
 }

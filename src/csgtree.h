@@ -95,4 +95,35 @@ size_t mci_csglist(const mci_ptree *t, uint32_t leaf, mci_csg_entry *out);
 int mci_csglist_accepts(const mci_ptree *t, const mci_csg_entry *list, size_t n,
                         const mci_label *leaf_labels, mci_label *scratch);
 
+/* Blist (Hable and Rossignac; paper §5.4): a trimmed CSGlist compiled into a walk over
+ * its undecided primitives. Each step reads one primitive's label and jumps to the next
+ * step (or accepts, or rejects) on IN or OUT, so a region is decided after reading a few
+ * labels instead of evaluating every subtree of the list. Valid only when all labels
+ * the walk reads are IN or OUT (no face coplanar with a primitive of the list); use
+ * mci_csglist_accepts otherwise. */
+#define MCI_BLIST_ACCEPT (-1)
+#define MCI_BLIST_REJECT (-2)
+
+typedef struct mci_blist_step {
+    uint32_t leaf;           /* the primitive whose label is read */
+    int32_t on_in, on_out;   /* next step, or MCI_BLIST_ACCEPT / MCI_BLIST_REJECT */
+} mci_blist_step;
+
+typedef struct mci_blist {
+    mci_blist_step *steps;
+    size_t count;
+    int32_t start; /* first step, or MCI_BLIST_ACCEPT for an empty list */
+} mci_blist;
+
+/* Compile the entries of `list` whose value depends on leaves labelled UNKNOWN in
+ * `leaf_labels` (every other leaf IN or OUT, as for trimming); entries must all be
+ * undecided (a trimmed list). Returns false when out of memory. No recursion. */
+bool mci_blist_build(const mci_ctx *ctx, const mci_ptree *t, const mci_csg_entry *list,
+                     size_t n, const mci_label *leaf_labels, mci_blist *out);
+void mci_blist_free(const mci_ctx *ctx, mci_blist *b);
+
+/* 1 if the face is kept, 0 if not, -1 if a label read is neither IN nor OUT (then ask
+ * mci_csglist_accepts). */
+int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels);
+
 #endif

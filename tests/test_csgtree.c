@@ -181,6 +181,69 @@ TEST(csglists_keep_exactly_the_result_faces)
     mcsg_mesh_free(&cube, NULL);
 }
 
+/* Blist: for a primitive's CSGlist trimmed by some leaves known OUT (as the classifier
+ * trims by boxes), the compiled walk must agree with evaluating the whole list, for
+ * every IN/OUT labelling of the other leaves; and defer (-1) on SAME/OPPO. */
+static void check_blist(const mci_ptree *t, uint32_t m, const mci_ctx *ctx)
+{
+    mci_csg_entry *list = malloc((t->node_count + 1) * sizeof *list);
+    mci_label *scratch = malloc((t->node_count + 1) * sizeof *scratch), trim[16], labels[16];
+    size_t n = mci_csglist(t, m, list), kept = 0;
+    bool rejected = false;
+    mci_blist b;
+    for (uint32_t k = 0; k < t->leaf_count; k++)
+        trim[k] = k != m && test_random_int(&rng, 0, 2) == 0 ? MCI_LABEL_OUT : MCI_LABEL_UNKNOWN;
+    mci_csg_entry *full = malloc((n + 1) * sizeof *full);
+    memcpy(full, list, n * sizeof *list);
+    for (size_t i = 0; i < n; i++) {
+        mci_label l = mci_ptree_eval(t, list[i].node, trim, scratch);
+        if (l == MCI_LABEL_UNKNOWN)
+            list[kept++] = list[i];
+        else if (!(list[i].desired & MCI_LABEL_BIT(l)))
+            rejected = true;
+    }
+    CHECK(mci_blist_build(ctx, t, list, kept, trim, &b));
+    CHECK(b.count <= t->leaf_count);
+    for (int trial = 0; trial < 16; trial++) {
+        int expected;
+        for (uint32_t k = 0; k < t->leaf_count; k++)
+            labels[k] = trim[k] == MCI_LABEL_OUT ? MCI_LABEL_OUT
+                                                 : (mci_label)test_random_int(&rng, 0, 1);
+        expected = mci_csglist_accepts(t, full, n, labels, scratch);
+        CHECK_MSG(expected == (rejected ? 0 : mci_blist_accepts(&b, labels)),
+                  "primitive %u: list says %d, blist %d", m, expected,
+                  mci_blist_accepts(&b, labels));
+    }
+    for (uint32_t k = 0; k < t->leaf_count; k++)
+        labels[k] = trim[k] == MCI_LABEL_OUT ? MCI_LABEL_OUT : MCI_LABEL_SAME;
+    CHECK(b.count == 0 || mci_blist_accepts(&b, labels) == -1);
+    mci_blist_free(ctx, &b);
+    free(full);
+    free(list);
+    free(scratch);
+}
+
+TEST(blists_agree_with_csglists)
+{
+    mcsg_mesh cube, empty = {0};
+    double size[3] = {1, 1, 1};
+    mcsg_error err;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mcsg_make_cube(size, 0, NULL, &cube, &err), &err);
+    for (int trial = 0; trial < 3000; trial++) {
+        random_tree r;
+        mci_ptree t;
+        random_tree_build(&r, &cube, &empty);
+        CHECK_OK(mci_ptree_build(&ctx, r.tree, &t, &err), &err);
+        for (uint32_t m = 0; m < t.leaf_count; m++)
+            check_blist(&t, m, &ctx);
+        mci_ptree_free(&ctx, &t);
+        mcsg_tree_free(r.tree);
+    }
+    mcsg_mesh_free(&cube, NULL);
+}
+
 TEST(difference_becomes_intersection_with_complements)
 {
     mcsg_mesh cube;
@@ -242,6 +305,7 @@ int main(void)
 {
     RUN(label_rules);
     RUN(csglists_keep_exactly_the_result_faces);
+    RUN(blists_agree_with_csglists);
     RUN(difference_becomes_intersection_with_complements);
     RUN(deep_trees_build);
     return test_summary();
