@@ -23,6 +23,7 @@
  */
 #include "classify.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* ---------------------------------------------------------------------------------- */
@@ -66,6 +67,36 @@ static bool point_on_triangle(const mci_point *p, const mci_plane *plane)
     return mci_orient3d(p, plane) == 0 && mci_point_in_triangle(p, plane, &which) != MCI_OUTSIDE;
 }
 
+/* One triangle's part in the ray test from p (bounds lo..hi): adds its crossing ahead
+ * of p to *winding; false when p lies on the triangle (no ray decides then). */
+static bool ray_crossing(const mci_point *p, const double lo[3], const double hi[3],
+                         const double *a, const double *b, const double *c, int *winding)
+{
+    mci_point pa, pb, pc;
+    mci_plane plane;
+    int nx, side;
+    bool misses_ray, misses_point;
+    box_tests(a, b, c, lo, hi, &misses_ray, &misses_point);
+    if (misses_ray)
+        return true;
+    mci_plane_init(&plane, a, b, c);
+    if (!misses_point && point_on_triangle(p, &plane))
+        return false;
+    mci_point_explicit(&pa, a);
+    mci_point_explicit(&pb, b);
+    mci_point_explicit(&pc, c);
+    nx = mci_orient2d_projected(&pa, &pb, &pc, 0); /* sign of the normal's x */
+    if (nx == 0 || perturbed_orient_yz(&pa, &pb, p) != nx ||
+        perturbed_orient_yz(&pb, &pc, p) != nx || perturbed_orient_yz(&pc, &pa, p) != nx)
+        return true;
+    side = mci_orient3d(p, &plane);
+    if (side == 0)
+        return false; /* unreachable: p would be on the triangle */
+    if (side == -nx)
+        *winding += nx; /* crossed ahead of p; leaving the solid when nx > 0 */
+    return true;
+}
+
 mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m)
 {
     double lo[3], hi[3];
@@ -73,32 +104,94 @@ mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m)
     mci_point_bounds(p, lo, hi);
     for (size_t t = 0; t < m->triangle_count; t++) {
         const uint32_t *tri = m->triangles + 3 * t;
-        const double *a = m->vertices + 3 * (size_t)tri[0], *b = m->vertices + 3 * (size_t)tri[1],
-                     *c = m->vertices + 3 * (size_t)tri[2];
-        mci_point pa, pb, pc;
-        mci_plane plane;
-        int nx, side;
-        bool misses_ray, misses_point;
-        box_tests(a, b, c, lo, hi, &misses_ray, &misses_point);
-        if (misses_ray)
-            continue;
-        mci_plane_init(&plane, a, b, c);
-        if (!misses_point && point_on_triangle(p, &plane))
-            return MCI_LABEL_UNKNOWN; /* no ray decides for a point on the surface */
-        mci_point_explicit(&pa, a);
-        mci_point_explicit(&pb, b);
-        mci_point_explicit(&pc, c);
-        nx = mci_orient2d_projected(&pa, &pb, &pc, 0); /* sign of the normal's x */
-        if (nx == 0 || perturbed_orient_yz(&pa, &pb, p) != nx ||
-            perturbed_orient_yz(&pb, &pc, p) != nx || perturbed_orient_yz(&pc, &pa, p) != nx)
-            continue;
-        side = mci_orient3d(p, &plane);
-        if (side == 0)
-            return MCI_LABEL_UNKNOWN; /* unreachable: p would be on the triangle */
-        if (side == -nx)
-            winding += nx; /* crossed ahead of p; leaving the solid when nx > 0 */
+        if (!ray_crossing(p, lo, hi, m->vertices + 3 * (size_t)tri[0],
+                          m->vertices + 3 * (size_t)tri[1], m->vertices + 3 * (size_t)tri[2],
+                          &winding))
+            return MCI_LABEL_UNKNOWN;
     }
     return winding > 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
+}
+
+void mci_ray_scratch_free(const mci_ctx *ctx, mci_ray_scratch *s)
+{
+    mci_free(ctx, s->faces);
+    mci_free(ctx, s->stack);
+    memset(s, 0, sizeof *s);
+}
+
+/* Whether closed cell c meets the ray from the box lo..hi along +x. */
+static bool cell_meets_ray(const mci_cell *c, const double lo[3], const double hi[3])
+{
+    return c->hi[0] >= lo[0] && c->lo[1] <= hi[1] && c->hi[1] >= lo[1] && c->lo[2] <= hi[2] &&
+           c->hi[2] >= lo[2];
+}
+
+static int compare_u32(const void *x, const void *y)
+{
+    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
+    return (a > b) - (a < b);
+}
+
+/* Faces of leaf m in the leaf cells the ray meets, sorted and unique in s->faces. Every
+ * face the (perturbed) ray crosses, or that holds p, touches the closed ray, so it is
+ * in a leaf cell that meets it. */
+static bool collect_ray_faces(const mci_ctx *ctx, const mci_octree *o, uint32_t m,
+                              const double lo[3], const double hi[3], mci_ray_scratch *s)
+{
+    uint32_t first = o->face_base[m], end = o->face_base[m + 1];
+    size_t depth = 0, n = 0;
+    if (!mci_grow_array(ctx, (void **)&s->stack, &s->stack_capacity, 1, sizeof *s->stack, 64))
+        return false;
+    s->stack[depth++] = 0;
+    while (depth > 0) {
+        const mci_cell *c = &o->cells[s->stack[--depth]];
+        if (!cell_meets_ray(c, lo, hi))
+            continue;
+        if (c->child != UINT32_MAX) {
+            if (!mci_grow_array(ctx, (void **)&s->stack, &s->stack_capacity, depth + 8,
+                                sizeof *s->stack, 64))
+                return false;
+            for (uint32_t k = 0; k < 8; k++)
+                s->stack[depth++] = c->child + k;
+            continue;
+        }
+        for (uint32_t i = c->first; i < c->first + c->count; i++) {
+            uint32_t f = o->face_ids[i];
+            if (f < first || f >= end)
+                continue;
+            if (!mci_grow_array(ctx, (void **)&s->faces, &s->face_capacity, n + 1,
+                                sizeof *s->faces, 64))
+                return false;
+            s->faces[n++] = f;
+        }
+    }
+    if (n > 1)
+        qsort(s->faces, n, sizeof *s->faces, compare_u32);
+    s->face_count = 0;
+    for (size_t i = 0; i < n; i++)
+        if (i == 0 || s->faces[i] != s->faces[i - 1])
+            s->faces[s->face_count++] = s->faces[i];
+    return true;
+}
+
+bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                          uint32_t m, mci_ray_scratch *s, mci_label *label)
+{
+    double lo[3], hi[3];
+    int winding = 0;
+    mci_point_bounds(p, lo, hi);
+    if (!collect_ray_faces(ctx, o, m, lo, hi, s))
+        return false;
+    *label = MCI_LABEL_UNKNOWN;
+    for (size_t i = 0; i < s->face_count; i++) {
+        uint32_t f = s->faces[i];
+        if (!ray_crossing(p, lo, hi, mci_octree_face_vertex(o, f, 0),
+                          mci_octree_face_vertex(o, f, 1), mci_octree_face_vertex(o, f, 2),
+                          &winding))
+            return true;
+    }
+    *label = winding > 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
+    return true;
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -331,6 +424,9 @@ typedef struct leaf_work {
     mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
     size_t nlist;
     bool rejected;    /* the trimmed CSGlist drops every face of the leaf */
+    mci_blist blist;  /* the trimmed CSGlist compiled for IN/OUT labels (paper §5.4) */
+    mci_ray_scratch ray;
+    bool out_of_memory; /* set by a ray test that could not allocate */
     mci_label *scratch, *leaf_labels;
     mci_classify_stats *stats;
     mcsg_error *err;
@@ -344,6 +440,8 @@ static void free_work(leaf_work *w)
                    w->leaf_labels};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
+    mci_blist_free(w->ctx, &w->blist);
+    mci_ray_scratch_free(w->ctx, &w->ray);
 }
 
 static const mci_face_arr *arr_of_face(const mci_scene *s, uint32_t f)
@@ -608,6 +706,7 @@ static void seed_region(leaf_work *w, uint32_t r)
                 continue;
             for (int i = 0; i < 3; i++) {
                 mci_point v;
+                mci_label label;
                 bool all = true;
                 piece_point(w, p, i, &v);
                 for (size_t c = 0; c < w->ncand; c++) {
@@ -619,8 +718,12 @@ static void seed_region(leaf_work *w, uint32_t r)
                         continue;
                     }
                     w->stats->rays++;
-                    lab[c] = (uint8_t)mci_ray_label(&v, w->s->octree.leaves[m]);
-                    all = all && lab[c] != MCI_LABEL_UNKNOWN;
+                    if (!mci_ray_label_octree(w->ctx, &v, &w->s->octree, m, &w->ray, &label)) {
+                        w->out_of_memory = true;
+                        return;
+                    }
+                    lab[c] = (uint8_t)label;
+                    all = all && label != MCI_LABEL_UNKNOWN;
                 }
                 if (all)
                     return;
@@ -718,7 +821,7 @@ static mcsg_status label_regions(leaf_work *w)
         mci_free(w->ctx, seen);
         return mci_fail_nomem(w->err, "classifying faces");
     }
-    for (uint32_t start = 0; start < w->nreg; start++) {
+    for (uint32_t start = 0; start < w->nreg && !w->out_of_memory; start++) {
         if (seen[start])
             continue;
         seed_region(w, start);
@@ -738,6 +841,8 @@ static mcsg_status label_regions(leaf_work *w)
     }
     mci_free(w->ctx, queue);
     mci_free(w->ctx, seen);
+    if (w->out_of_memory)
+        return mci_fail_nomem(w->err, "classifying faces");
     fill_unknown_labels(w);
     return MCSG_OK;
 }
@@ -854,6 +959,8 @@ static mcsg_status trim_csglist(leaf_work *w)
     for (size_t c = 0; c < w->ncand; c++)
         w->needed[c] = cover[t->leaf_node[w->cand[c]]] > 0;
     mci_free(w->ctx, cover);
+    if (!w->rejected && !mci_blist_build(w->ctx, t, w->list, w->nlist, w->leaf_labels, &w->blist))
+        return mci_fail_nomem(w->err, "classifying faces");
     return MCSG_OK;
 }
 
@@ -872,7 +979,10 @@ static mcsg_status select_pieces(leaf_work *w, mci_kept *kept)
         for (size_t c = 0; c < w->ncand; c++)
             w->leaf_labels[w->cand[c]] =
                 reversed ? mci_label_reverse((mci_label)lab[c]) : (mci_label)lab[c];
-        accepts = mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch);
+        /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
+        accepts = mci_blist_accepts(&w->blist, w->leaf_labels);
+        if (accepts < 0)
+            accepts = mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch);
         if (accepts < 0)
             st = mci_fail(w->err, MCSG_ERR_INTERNAL,
                           "leaf %u: a region's label could not be decided", w->leaf);

@@ -1,0 +1,134 @@
+/*
+ * First-seed rays (src/classify.c): the ray test through the octree must give the same
+ * label as the brute-force test over every face of the leaf, for points anywhere,
+ * including points whose rays graze vertices and edges exactly (integer grids) and
+ * points on the surface (UNKNOWN); and the labels must be right for boxes, where
+ * membership is known.
+ */
+#include "testlib.h"
+#include "classify.h"
+
+#include <math.h>
+#include <string.h>
+
+static uint64_t rng = 0x7261797361u;
+
+static double uniform(double lo, double hi)
+{
+    return lo + (hi - lo) * (double)test_random_int(&rng, 0, 1 << 30) / (double)(1 << 30);
+}
+
+typedef struct scene {
+    mcsg_mesh meshes[4];
+    const mcsg_mesh *leaves[4];
+    size_t count;
+    mci_octree tree;
+} scene;
+
+static void build_scene(scene *s, const mci_ctx *ctx)
+{
+    mcsg_error err;
+    mcsg_resolution fine = {48, 0, 0}, coarse = {7, 0, 0};
+    double box[3] = {2, 3, 2}, unit[3] = {1, 1, 1};
+    double shift[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.25, 0, 0, 1, -0.5};
+    double grid[12] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 0};
+    mci_octree_params params = {8, 10};
+    CHECK_OK(mcsg_make_sphere(1.5, fine, NULL, &s->meshes[0], &err), &err);
+    CHECK_OK(mcsg_make_cube(box, 1, NULL, &s->meshes[1], &err), &err);
+    CHECK_OK(mcsg_make_cylinder(3, 1, 0.5, 1, coarse, NULL, &s->meshes[2], &err), &err);
+    CHECK_OK(mcsg_make_cube(unit, 0, NULL, &s->meshes[3], &err), &err);
+    mcsg_mesh_transform(&s->meshes[2], shift);
+    mcsg_mesh_transform(&s->meshes[3], grid); /* [1,2] x [1,2] x [0,1] */
+    s->count = 4;
+    for (size_t i = 0; i < s->count; i++)
+        s->leaves[i] = &s->meshes[i];
+    CHECK_OK(mci_octree_build(ctx, s->leaves, s->count, &params, &s->tree, &err), &err);
+}
+
+static void free_scene(scene *s, const mci_ctx *ctx)
+{
+    mci_octree_free(ctx, &s->tree);
+    for (size_t i = 0; i < s->count; i++)
+        mcsg_mesh_free(&s->meshes[i], NULL);
+}
+
+/* Both tests on p for every leaf; returns the label for the last leaf. */
+static mci_label compare_at(const scene *s, const mci_ctx *ctx, mci_ray_scratch *scratch,
+                            const double x[3], int *unknown)
+{
+    mci_point p;
+    mci_label fast = MCI_LABEL_UNKNOWN;
+    mci_point_explicit(&p, x);
+    for (uint32_t m = 0; m < s->count; m++) {
+        mci_label slow = mci_ray_label(&p, s->leaves[m]);
+        CHECK(mci_ray_label_octree(ctx, &p, &s->tree, m, scratch, &fast));
+        CHECK_MSG(fast == slow, "leaf %u at (%.17g, %.17g, %.17g): octree %d, brute force %d",
+                  m, x[0], x[1], x[2], fast, slow);
+        *unknown += fast == MCI_LABEL_UNKNOWN;
+    }
+    return fast;
+}
+
+TEST(octree_rays_agree_with_brute_force)
+{
+    mci_ctx ctx;
+    scene s;
+    mci_ray_scratch scratch;
+    int unknown = 0;
+    memset(&scratch, 0, sizeof scratch);
+    mci_ctx_init(&ctx, NULL);
+    build_scene(&s, &ctx);
+    for (int i = 0; i < 3000; i++) { /* anywhere */
+        double x[3] = {uniform(-2, 2), uniform(-2, 2), uniform(-2, 2)};
+        compare_at(&s, &ctx, &scratch, x, &unknown);
+    }
+    for (int i = 0; i < 3000; i++) { /* on a quarter-integer grid: rays along edges */
+        double x[3] = {test_random_int(&rng, -8, 8) / 4.0, test_random_int(&rng, -8, 8) / 4.0,
+                       test_random_int(&rng, -8, 8) / 4.0};
+        compare_at(&s, &ctx, &scratch, x, &unknown);
+    }
+    for (uint32_t m = 0; m < s.count; m++) /* every vertex: on the surface */
+        for (size_t v = 0; v < s.meshes[m].vertex_count; v++) {
+            mci_point p;
+            mci_label label;
+            mci_point_explicit(&p, s.meshes[m].vertices + 3 * v);
+            CHECK(mci_ray_label_octree(&ctx, &p, &s.tree, m, &scratch, &label));
+            CHECK(label == MCI_LABEL_UNKNOWN);
+            compare_at(&s, &ctx, &scratch, s.meshes[m].vertices + 3 * v, &unknown);
+        }
+    CHECK(unknown > 0);
+    mci_ray_scratch_free(&ctx, &scratch);
+    free_scene(&s, &ctx);
+}
+
+TEST(octree_rays_know_the_box)
+{
+    mci_ctx ctx;
+    scene s;
+    mci_ray_scratch scratch;
+    memset(&scratch, 0, sizeof scratch);
+    mci_ctx_init(&ctx, NULL);
+    build_scene(&s, &ctx);
+    for (int i = 0; i < 2000; i++) {
+        /* Leaf 3 is [1,2] x [1,2] x [0,1]; grid points on its faces, edges and corners
+         * are on the surface. */
+        double x[3] = {test_random_int(&rng, 0, 12) / 4.0, test_random_int(&rng, 0, 12) / 4.0,
+                       test_random_int(&rng, -4, 8) / 4.0};
+        bool inside = x[0] > 1 && x[0] < 2 && x[1] > 1 && x[1] < 2 && x[2] > 0 && x[2] < 1;
+        bool closed = x[0] >= 1 && x[0] <= 2 && x[1] >= 1 && x[1] <= 2 && x[2] >= 0 && x[2] <= 1;
+        mci_point p;
+        mci_label label;
+        mci_point_explicit(&p, x);
+        CHECK(mci_ray_label_octree(&ctx, &p, &s.tree, 3, &scratch, &label));
+        CHECK(label == (inside ? MCI_LABEL_IN : closed ? MCI_LABEL_UNKNOWN : MCI_LABEL_OUT));
+    }
+    mci_ray_scratch_free(&ctx, &scratch);
+    free_scene(&s, &ctx);
+}
+
+int main(void)
+{
+    RUN(octree_rays_agree_with_brute_force);
+    RUN(octree_rays_know_the_box);
+    return test_summary();
+}
