@@ -410,6 +410,9 @@ typedef struct mcsg_eval_stats {
     size_t rounding_split_triangles; /* rounded to three collinear corners and removed by
                                         splitting the neighbour at the middle corner */
     size_t rounding_flat_triangles;  /* rounded flat and left (neighbour flat as well) */
+    size_t touching_vertices_split;  /* vertex copies added where parts of the result
+                                        touch along an edge or at a point, so that the
+                                        output is edge- and vertex-manifold */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_triangulate; /* tessellating the split faces */

@@ -6,6 +6,7 @@
  * rounded to double only here.
  */
 #include "classify.h"
+#include "manifold_split.h"
 #include "rounding_repair.h"
 
 #include <string.h>
@@ -272,6 +273,19 @@ static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
     return st;
 }
 
+/* Parts of the result that touch along an edge or at a point get separate vertices. */
+static mcsg_status split_touching(eval_state *e, mcsg_mesh *out, mcsg_error *err)
+{
+    mci_touching_split split;
+    if (!mci_split_touching(&e->ctx, out, &split))
+        return mci_fail_nomem(err, "assembling the result");
+    e->stats.touching_vertices_split = split.new_vertices;
+    if (split.unpaired_edges > 0) /* only after rounding moved vertices: leave them */
+        mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu edges of the result with more than two "
+                "triangles could not be separated after rounding", split.unpaired_edges);
+    return MCSG_OK;
+}
+
 static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size_t n,
                                    mcsg_provenance **provenance, mcsg_error *err)
 {
@@ -297,6 +311,8 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
     mcsg_status st = round_vertices(e, &r, err);
     if (st == MCSG_OK)
         st = build_output(e, &r, out, &kept_tri, err);
+    if (st == MCSG_OK)
+        st = split_touching(e, out, err);
     if (st == MCSG_OK && provenance)
         st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
     if (st != MCSG_OK)

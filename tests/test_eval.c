@@ -56,11 +56,32 @@ static void expect_solid(const char *text, double volume, size_t components)
               "%s: not closed/oriented/manifold (%zu boundary, %zu non-manifold, %zu "
               "inconsistent edges)", text, r.report.boundary_edges,
               r.report.nonmanifold_edges, r.report.inconsistent_edges);
+    CHECK_MSG(test_index_manifold_defects(&r.mesh) == 0, "%s: not manifold by index", text);
     CHECK_MSG(r.report.components == components, "%s: %zu components, expected %zu", text,
               r.report.components, components);
     CHECK_MSG(fabs(r.report.volume - volume) <= 1e-12 * fabs(volume) + 1e-15,
               "%s: volume %.17g, expected %.17g", text, r.report.volume, volume);
     CHECK(fabs(test_signed_volume(&r.mesh) - r.report.volume) <= 1e-12 * fabs(volume) + 1e-15);
+    mcsg_mesh_free(&r.mesh, NULL);
+}
+
+/* A result whose parts touch along edges: closed and oriented, its only geometric
+ * defect the shared edges, manifold by vertex index (parts have their own vertices). */
+static void expect_touching(const char *text, double volume, size_t new_vertices)
+{
+    result r;
+    if (!eval_text(text, &r))
+        return;
+    CHECK_MSG(r.report.boundary_edges == 0 && r.report.inconsistent_edges == 0 &&
+              r.report.nonmanifold_edges > 0 && r.report.degenerate_triangles == 0,
+              "%s: %zu boundary, %zu inconsistent, %zu non-manifold edges", text,
+              r.report.boundary_edges, r.report.inconsistent_edges,
+              r.report.nonmanifold_edges);
+    CHECK_MSG(test_index_manifold_defects(&r.mesh) == 0, "%s: not manifold by index", text);
+    CHECK_MSG(r.stats.touching_vertices_split == new_vertices, "%s: %zu vertices split", text,
+              r.stats.touching_vertices_split);
+    CHECK_MSG(fabs(test_signed_volume(&r.mesh) - volume) <= 1e-12 * volume, "%s: volume %.17g",
+              text, test_signed_volume(&r.mesh));
     mcsg_mesh_free(&r.mesh, NULL);
 }
 
@@ -126,6 +147,11 @@ TEST(touching_solids)
     expect_empty("intersection() { cube(2); translate([2,0,0]) cube(2); }");
     /* Touching at a vertex: two shells sharing one point. */
     expect_solid("union() { cube(2); translate([2,2,2]) cube(2); }", 16, 2);
+    /* Touching along an edge: geometrically non-manifold, but each box keeps its own
+     * copies of the edge's vertices, so the mesh is manifold by index. */
+    expect_touching("union() { cube(1); translate([1,1,0]) cube(1); }", 2, 2);
+    expect_touching("difference() { cube(2); translate([1,1,0]) cube([1,1,2]);"
+                    " translate([0,0,0]) cube([1,1,2]); }", 4, 2);
     /* A box carved from the inside of a face: a pocket. */
     expect_solid("difference() { cube(2); translate([0.5,0.5,1]) cube([1,1,1]); }", 7, 1);
 }

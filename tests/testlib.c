@@ -77,6 +77,64 @@ double test_signed_volume(const mcsg_mesh *m)
     return v / 6;
 }
 
+typedef struct directed_edge {
+    uint32_t from, to, tri;
+} directed_edge;
+
+static int compare_directed(const void *x, const void *y)
+{
+    const directed_edge *a = x, *b = y;
+    if (a->from != b->from)
+        return a->from < b->from ? -1 : 1;
+    return (a->to > b->to) - (a->to < b->to);
+}
+
+static const directed_edge *find_directed(const directed_edge *e, size_t n, uint32_t from,
+                                          uint32_t to)
+{
+    directed_edge key = {from, to, 0};
+    return bsearch(&key, e, n, sizeof *e, compare_directed);
+}
+
+size_t test_index_manifold_defects(const mcsg_mesh *m)
+{
+    size_t n = 3 * m->triangle_count, defects = 0, *seen_at;
+    directed_edge *e = malloc((n + 1) * sizeof *e);
+    size_t *umbrella = calloc(m->vertex_count + 1, sizeof *umbrella);
+    for (size_t t = 0; t < m->triangle_count; t++)
+        for (int k = 0; k < 3; k++)
+            e[3 * t + k] = (directed_edge){m->triangles[3 * t + k],
+                                           m->triangles[3 * t + (k + 1) % 3], (uint32_t)t};
+    qsort(e, n, sizeof *e, compare_directed);
+    for (size_t i = 0; i < n; i++) {
+        bool repeated = (i > 0 && compare_directed(&e[i - 1], &e[i]) == 0) ||
+                        (i + 1 < n && compare_directed(&e[i], &e[i + 1]) == 0);
+        defects += repeated || !find_directed(e, n, e[i].to, e[i].from);
+    }
+    /* Umbrellas: walk around each vertex from one of its out-edges; the walk must come
+     * back having visited every out-edge of the vertex. */
+    seen_at = calloc(m->vertex_count + 1, sizeof *seen_at);
+    for (size_t i = 0; i < n; i++)
+        umbrella[e[i].from]++;
+    for (size_t i = 0; i < n && defects == 0; i++) {
+        uint32_t v = e[i].from, steps = 0;
+        const directed_edge *at = &e[i];
+        if (seen_at[v]++)
+            continue;
+        do { /* next out-edge around v: the one after the edge into v of this triangle */
+            const uint32_t *t = m->triangles + 3 * (size_t)at->tri;
+            uint32_t prev = t[0] == v ? t[2] : t[1] == v ? t[0] : t[1];
+            at = find_directed(e, n, v, prev);
+            steps++;
+        } while (at && at != &e[i] && steps <= umbrella[v]);
+        defects += !at || steps != umbrella[v];
+    }
+    free(seen_at);
+    free(umbrella);
+    free(e);
+    return defects;
+}
+
 bool test_same_double(double a, double b)
 {
     return (isnan(a) && isnan(b)) || memcmp(&a, &b, sizeof a) == 0;

@@ -104,6 +104,10 @@ bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg
 
 /* Signed volume of a triangle mesh (positive when outward); 0 for NULL. */
 double test_signed_volume(const mcsg_mesh *m);
+/* Edges (undirected vertex-index pairs, vertices NOT identified by coordinates) that are
+ * not used exactly once in each direction, plus vertices whose triangles do not form a
+ * single umbrella: 0 for an index-manifold closed oriented mesh. */
+size_t test_index_manifold_defects(const mcsg_mesh *m);
 /* Equal bit for bit, except that any NaN equals any NaN. */
 bool test_same_double(double a, double b);
 /* Same counts, vertices (test_same_double) and triangles; false if either is NULL. */

@@ -572,6 +572,9 @@ static void print_eval_stats(const mcsg_eval_stats *s)
         printf("  rounding to doubles: %zu triangles collapsed or folded and dropped, %zu flat "
                "ones split away, %zu flat left\n", s->rounding_dropped_triangles,
                s->rounding_split_triangles, s->rounding_flat_triangles);
+    if (s->touching_vertices_split)
+        printf("  touching parts: %zu vertices given separate copies\n",
+               s->touching_vertices_split);
     printf("  total            %8.3f s\n", s->seconds_total);
     printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
 }

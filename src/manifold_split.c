@@ -1,0 +1,276 @@
+/*
+ * Where parts of a result touch along an edge or at a point (two boxes sharing only an
+ * edge, a cone tip on a face), the exact result is not a manifold: an edge has four (or
+ * more) triangles, or a vertex has two umbrellas. The output is made edge- and
+ * vertex-manifold by giving each umbrella its own copy of the vertex (same coordinates),
+ * which changes no geometry.
+ *
+ * At an edge with 2k triangles, the triangles are sorted by angle around the edge and
+ * paired: a triangle's solid side is at decreasing angle about its own edge direction
+ * (its normal points to increasing angle), so each triangle running u->v is paired with
+ * the one just before it in the turn about u->v, which runs v->u. Then, at every vertex,
+ * the triangles around it are grouped by crossing its edges (to the unique other triangle
+ * at a manifold edge, to the paired one at a non-manifold edge); each group beyond the
+ * first gets a new vertex. All angle comparisons are exact predicates on the rounded
+ * coordinates.
+ */
+#include "manifold_split.h"
+
+#include "exact.h"
+#include "exact_kernel.h"
+#include "scene.h"
+
+#include <string.h>
+
+typedef struct splitter {
+    const mci_ctx *ctx;
+    mcsg_mesh *m;
+    uint32_t *mate; /* per edge slot 3t + i (corner i -> i + 1): the paired slot */
+    size_t bad_edges;
+} splitter;
+
+static const double *vertex(const mcsg_mesh *m, uint32_t v)
+{
+    return m->vertices + 3 * (size_t)v;
+}
+
+static uint32_t slot_from(const mcsg_mesh *m, uint32_t s)
+{
+    return m->triangles[s];
+}
+
+static uint32_t slot_to(const mcsg_mesh *m, uint32_t s)
+{
+    return m->triangles[s - s % 3 + (s % 3 + 1) % 3];
+}
+
+static uint32_t slot_third(const mcsg_mesh *m, uint32_t s)
+{
+    return m->triangles[s - s % 3 + (s % 3 + 2) % 3];
+}
+
+/* Sign of the turn from half-plane a to half-plane b about the axis u -> v: +1 when b
+ * is within (0, pi) counter-clockwise of a. */
+static int turn(const double *u, const double *v, const double *a, const double *b)
+{
+    mci_plane plane;
+    mci_point p;
+    mci_plane_init(&plane, u, v, a);
+    mci_point_explicit(&p, b);
+    return mci_orient3d(&p, &plane);
+}
+
+/* For a and b in one plane with the axis: whether they are on the same side of it. */
+static bool same_side(const double *u, const double *v, const double *a, const double *b)
+{
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        int sa = mci_orient2d(u[i], u[j], v[i], v[j], a[i], a[j]);
+        if (sa != 0)
+            return sa == mci_orient2d(u[i], u[j], v[i], v[j], b[i], b[j]);
+    }
+    return true;
+}
+
+/* Angle class of half-plane w relative to the reference r: 0 same, 1 in (0, pi), 2 pi,
+ * 3 in (pi, 2 pi). */
+static int angle_class(const double *u, const double *v, const double *r, const double *w)
+{
+    int t = turn(u, v, r, w);
+    if (t != 0)
+        return t > 0 ? 1 : 3;
+    return same_side(u, v, r, w) ? 0 : 2;
+}
+
+/* Whether w1 comes before w2 in the turn about u -> v starting at r. */
+static bool angle_before(const double *u, const double *v, const double *r, const double *w1,
+                         const double *w2)
+{
+    int c1 = angle_class(u, v, r, w1), c2 = angle_class(u, v, r, w2);
+    if (c1 != c2)
+        return c1 < c2;
+    return (c1 == 1 || c1 == 3) && turn(u, v, w1, w2) > 0;
+}
+
+/* Pair the 2k slots of one edge (slots[0 .. n)) by angle; false if they do not
+ * alternate in direction (then the edge is left unpaired). */
+static bool pair_around_edge(splitter *sp, uint32_t *slots, size_t n)
+{
+    const mcsg_mesh *m = sp->m;
+    uint32_t u = slot_from(m, slots[0]), v = slot_to(m, slots[0]);
+    const double *pu = vertex(m, u), *pv = vertex(m, v), *r = vertex(m, slot_third(m, slots[0]));
+    for (size_t i = 1; i < n; i++) /* insertion sort: n is small */
+        for (size_t j = i; j > 0 && angle_before(pu, pv, r, vertex(m, slot_third(m, slots[j])),
+                                                 vertex(m, slot_third(m, slots[j - 1])));
+             j--) {
+            uint32_t t = slots[j];
+            slots[j] = slots[j - 1];
+            slots[j - 1] = t;
+        }
+    for (size_t i = 0; i < n; i++) {
+        uint32_t s = slots[i], before = slots[(i + n - 1) % n];
+        if (slot_from(m, s) != u)
+            continue;
+        if (slot_from(m, before) != v)
+            return false;
+        sp->mate[s] = before;
+        sp->mate[before] = s;
+    }
+    return true;
+}
+
+static bool pair_edges(splitter *sp)
+{
+    const mcsg_mesh *m = sp->m;
+    size_t n = 3 * m->triangle_count;
+    mci_keyed *half = mci_malloc_array(sp->ctx, n + 1, sizeof *half);
+    uint32_t *slots = mci_malloc_array(sp->ctx, n + 1, sizeof *slots);
+    bool ok = half && slots;
+    for (size_t s = 0; ok && s < n; s++) {
+        half[s].key = mci_edge_key(slot_from(m, (uint32_t)s), slot_to(m, (uint32_t)s));
+        half[s].ref = (uint32_t)s;
+        sp->mate[s] = MCI_NONE;
+    }
+    if (ok)
+        mci_sort_keyed(half, n);
+    for (size_t i = 0, j; ok && i < n; i = j) {
+        for (j = i + 1; j < n && half[j].key == half[i].key; j++)
+            ;
+        for (size_t k = i; k < j; k++)
+            slots[k - i] = half[k].ref;
+        if (j - i == 2 && slot_from(m, slots[0]) == slot_to(m, slots[1])) {
+            sp->mate[slots[0]] = slots[1];
+            sp->mate[slots[1]] = slots[0];
+        } else if ((j - i) % 2 != 0 || !pair_around_edge(sp, slots, j - i)) {
+            sp->bad_edges++;
+        }
+    }
+    mci_free(sp->ctx, half);
+    mci_free(sp->ctx, slots);
+    return ok;
+}
+
+static uint32_t find(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+/* Corners (3t + i) grouped by vertex in CSR form: corners of v are
+ * corner[start[v] .. start[v + 1]). */
+static bool corners_by_vertex(const splitter *sp, uint32_t **start_out, uint32_t **corner_out)
+{
+    const mcsg_mesh *m = sp->m;
+    size_t n = 3 * m->triangle_count;
+    uint32_t *start = mci_calloc_array(sp->ctx, m->vertex_count + 2, sizeof *start);
+    uint32_t *corner = mci_malloc_array(sp->ctx, n + 1, sizeof *corner);
+    if (!start || !corner) {
+        mci_free(sp->ctx, start);
+        mci_free(sp->ctx, corner);
+        return false;
+    }
+    for (size_t c = 0; c < n; c++)
+        start[m->triangles[c] + 2]++;
+    for (size_t v = 2; v < m->vertex_count + 2; v++)
+        start[v] += start[v - 1];
+    for (size_t c = 0; c < n; c++)
+        corner[start[m->triangles[c] + 1]++] = (uint32_t)c;
+    *start_out = start;
+    *corner_out = corner;
+    return true;
+}
+
+/* The corner of the triangle holding slot s (paired with an edge at vertex x) at x. */
+static uint32_t corner_at(const mcsg_mesh *m, uint32_t s, uint32_t x)
+{
+    uint32_t t = s - s % 3;
+    for (uint32_t i = 0; i < 3; i++)
+        if (m->triangles[t + i] == x)
+            return t + i;
+    return MCI_NONE;
+}
+
+/* Union the corners of one vertex across its edges; parent is indexed by corner. */
+static void group_corners(const splitter *sp, const uint32_t *corners, size_t n,
+                          uint32_t *parent)
+{
+    const mcsg_mesh *m = sp->m;
+    for (size_t k = 0; k < n; k++) {
+        uint32_t c = corners[k], x = m->triangles[c];
+        uint32_t at_x[2] = {c, c - c % 3 + (c % 3 + 2) % 3}; /* x -> next, prev -> x */
+        for (int e = 0; e < 2; e++) {
+            uint32_t other = sp->mate[at_x[e]], d;
+            if (other == MCI_NONE || (d = corner_at(m, other, x)) == MCI_NONE)
+                continue;
+            d = find(parent, d);
+            c = find(parent, c);
+            if (c != d)
+                parent[c > d ? c : d] = c < d ? c : d;
+        }
+    }
+}
+
+/* New vertices for every umbrella of a vertex but the one with its first corner. */
+static bool split_vertices(splitter *sp, size_t *added)
+{
+    mcsg_mesh *m = sp->m;
+    size_t n = 3 * m->triangle_count, nv = m->vertex_count, extra = 0;
+    uint32_t *start, *corner, *parent = mci_malloc_array(sp->ctx, n + 1, sizeof *parent);
+    uint32_t *copy = mci_malloc_array(sp->ctx, n + 1, sizeof *copy);
+    bool ok = parent && copy && corners_by_vertex(sp, &start, &corner);
+    if (!ok) {
+        mci_free(sp->ctx, parent);
+        mci_free(sp->ctx, copy);
+        return false;
+    }
+    for (size_t c = 0; c < n; c++)
+        parent[c] = (uint32_t)c, copy[c] = MCI_NONE;
+    for (size_t v = 0; v < nv; v++)
+        group_corners(sp, corner + start[v], start[v + 1] - start[v], parent);
+    for (size_t v = 0; v < nv; v++)
+        for (uint32_t k = start[v]; k < start[v + 1]; k++) {
+            uint32_t c = corner[k], root = find(parent, c);
+            if (root == find(parent, corner[start[v]]))
+                continue;
+            if (copy[root] == MCI_NONE)
+                copy[root] = (uint32_t)(nv + extra++);
+            m->triangles[c] = copy[root];
+        }
+    /* Second pass over the roots to fill the new vertices' coordinates. */
+    if (extra > 0) {
+        double *grown = mci_realloc_array(sp->ctx, m->vertices, nv + extra, 3 * sizeof(double));
+        ok = grown != NULL;
+        if (ok) {
+            m->vertices = grown;
+            for (size_t v = 0; v < nv; v++)
+                for (uint32_t k = start[v]; k < start[v + 1]; k++) {
+                    uint32_t id = m->triangles[corner[k]];
+                    if (id >= nv)
+                        memcpy(m->vertices + 3 * (size_t)id, m->vertices + 3 * v,
+                               3 * sizeof(double));
+                }
+            m->vertex_count = nv + extra;
+        }
+    }
+    *added = extra;
+    mci_free(sp->ctx, start);
+    mci_free(sp->ctx, corner);
+    mci_free(sp->ctx, parent);
+    mci_free(sp->ctx, copy);
+    return ok;
+}
+
+bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *result)
+{
+    splitter sp = {ctx, m, NULL, 0};
+    bool ok;
+    memset(result, 0, sizeof *result);
+    if (m->triangle_count == 0)
+        return true;
+    sp.mate = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *sp.mate);
+    ok = sp.mate && pair_edges(&sp) && split_vertices(&sp, &result->new_vertices);
+    result->unpaired_edges = sp.bad_edges;
+    mci_free(ctx, sp.mate);
+    return ok;
+}

@@ -1,0 +1,20 @@
+/*
+ * Making the output edge- and vertex-manifold where parts of the result touch along an
+ * edge or at a point: each umbrella of triangles around a vertex gets its own copy of
+ * the vertex. See manifold_split.c.
+ */
+#ifndef MESHCSG_MANIFOLD_SPLIT_H
+#define MESHCSG_MANIFOLD_SPLIT_H
+
+#include "internal.h"
+
+typedef struct mci_touching_split {
+    size_t new_vertices;   /* vertex copies added */
+    size_t unpaired_edges; /* edges whose triangles could not be paired (left as they are) */
+} mci_touching_split;
+
+/* m: closed, consistently oriented triangle mesh allocated with ctx (its vertex array
+ * grows). Returns false only when out of memory (m is then partly rewritten: free it). */
+bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *result);
+
+#endif
