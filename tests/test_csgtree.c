@@ -159,7 +159,10 @@ static void check_one_configuration(const random_tree *r, const mci_ptree *t)
     free(spot_of_node);
 }
 
-TEST(csglists_keep_exactly_the_result_faces)
+typedef void (*tree_check)(const random_tree *r, const mci_ptree *t, const mci_ctx *ctx);
+
+/* Run `check` on 3000 random trees of unit cubes (one leaf in ten empty). */
+static void for_random_trees(tree_check check)
 {
     mcsg_mesh cube, empty = {0};
     double size[3] = {1, 1, 1};
@@ -173,12 +176,23 @@ TEST(csglists_keep_exactly_the_result_faces)
         random_tree_build(&r, &cube, &empty);
         CHECK_OK(mci_ptree_build(&ctx, r.tree, &t, &err), &err);
         CHECK_EQ_SIZE(t.leaf_count, (size_t)r.leaf_count);
-        for (int c = 0; c < 20; c++)
-            check_one_configuration(&r, &t);
+        check(&r, &t, &ctx);
         mci_ptree_free(&ctx, &t);
         mcsg_tree_free(r.tree);
     }
     mcsg_mesh_free(&cube, NULL);
+}
+
+static void check_configurations(const random_tree *r, const mci_ptree *t, const mci_ctx *ctx)
+{
+    (void)ctx;
+    for (int c = 0; c < 20; c++)
+        check_one_configuration(r, t);
+}
+
+TEST(csglists_keep_exactly_the_result_faces)
+{
+    for_random_trees(check_configurations);
 }
 
 /* Blist: for a primitive's CSGlist trimmed by some leaves known OUT (as the classifier
@@ -223,25 +237,16 @@ static void check_blist(const mci_ptree *t, uint32_t m, const mci_ctx *ctx)
     free(scratch);
 }
 
+static void check_blists(const random_tree *r, const mci_ptree *t, const mci_ctx *ctx)
+{
+    (void)r;
+    for (uint32_t m = 0; m < t->leaf_count; m++)
+        check_blist(t, m, ctx);
+}
+
 TEST(blists_agree_with_csglists)
 {
-    mcsg_mesh cube, empty = {0};
-    double size[3] = {1, 1, 1};
-    mcsg_error err;
-    mci_ctx ctx;
-    mci_ctx_init(&ctx, NULL);
-    CHECK_OK(mcsg_make_cube(size, 0, NULL, &cube, &err), &err);
-    for (int trial = 0; trial < 3000; trial++) {
-        random_tree r;
-        mci_ptree t;
-        random_tree_build(&r, &cube, &empty);
-        CHECK_OK(mci_ptree_build(&ctx, r.tree, &t, &err), &err);
-        for (uint32_t m = 0; m < t.leaf_count; m++)
-            check_blist(&t, m, &ctx);
-        mci_ptree_free(&ctx, &t);
-        mcsg_tree_free(r.tree);
-    }
-    mcsg_mesh_free(&cube, NULL);
+    for_random_trees(check_blists);
 }
 
 TEST(difference_becomes_intersection_with_complements)
