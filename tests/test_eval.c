@@ -308,16 +308,9 @@ static void arena_free(void *user, void *ptr)
 
 static bool eval_with(const char *text, const mcsg_options *opts, mcsg_mesh *out)
 {
-    mcsg_tree *tree = NULL;
     mcsg_error err;
-    mcsg_status st = mcsg_scad_read_memory(text, strlen(text), "test.scad", ".", opts, &tree,
-                                           &err);
+    mcsg_status st = test_eval_scad(text, opts, out, NULL, &err);
     CHECK_OK(st, &err);
-    if (st != MCSG_OK)
-        return false;
-    st = mcsg_eval(tree, opts, out, NULL, NULL, &err);
-    CHECK_OK(st, &err);
-    mcsg_tree_free(tree);
     return st == MCSG_OK;
 }
 

@@ -66,15 +66,33 @@ bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg
 
 double test_signed_volume(const mcsg_mesh *m)
 {
-    double v = 0;
+    /* Relative to the first vertex, so that a mesh far from the origin does not lose its
+     * volume to cancellation. */
+    double v = 0, o[3] = {0, 0, 0};
+    if (m && m->vertex_count > 0)
+        memcpy(o, m->vertices, sizeof o);
     for (size_t t = 0; m && t < m->triangle_count; t++) {
-        const double *a = m->vertices + 3 * m->triangles[3 * t];
-        const double *b = m->vertices + 3 * m->triangles[3 * t + 1];
-        const double *c = m->vertices + 3 * m->triangles[3 * t + 2];
-        v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-             a[2] * (b[0] * c[1] - b[1] * c[0]);
+        double p[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                p[i][k] = m->vertices[3 * (size_t)m->triangles[3 * t + i] + k] - o[k];
+        v += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
+             p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+             p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
     }
     return v / 6;
+}
+
+mcsg_status test_eval_scad(const char *text, const mcsg_options *opts, mcsg_mesh *out,
+                           mcsg_eval_stats *stats, mcsg_error *err)
+{
+    mcsg_tree *tree = NULL;
+    mcsg_status st = mcsg_scad_read_memory(text, strlen(text), "test.scad", ".", opts, &tree,
+                                           err);
+    if (st == MCSG_OK)
+        st = mcsg_eval(tree, opts, out, NULL, stats, err);
+    mcsg_tree_free(tree);
+    return st;
 }
 
 typedef struct directed_edge {

@@ -104,6 +104,9 @@ bool test_read_string(const char *text, mcsg_format format, mcsg_mesh *out, mcsg
 
 /* Signed volume of a triangle mesh (positive when outward); 0 for NULL. */
 double test_signed_volume(const mcsg_mesh *m);
+/* Parse CSG text (mcsg_scad_read_memory, imports relative to ".") and evaluate it. */
+mcsg_status test_eval_scad(const char *text, const mcsg_options *opts, mcsg_mesh *out,
+                           mcsg_eval_stats *stats, mcsg_error *err);
 /* Edges (undirected vertex-index pairs, vertices NOT identified by coordinates) that are
  * not used exactly once in each direction, plus vertices whose triangles do not form a
  * single umbrella: 0 for an index-manifold closed oriented mesh. */

@@ -1,0 +1,202 @@
+/*
+ * Degenerate-case corpus (issue 6 item 1), first part: scenes built to hit the special
+ * cases of exact CSG, each with its expected volume (exact where the geometry allows,
+ * otherwise an identity that must hold: |A u B| + |A n B| = |A| + |B|, independence of
+ * operand order, scaling by s^3). Every output must be closed, consistently oriented,
+ * free of zero-area triangles and manifold by vertex index.
+ */
+#include "testlib.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+typedef struct outcome {
+    mcsg_mesh mesh;
+    mcsg_check_report report;
+    mcsg_eval_stats stats;
+    double volume;
+} outcome;
+
+/* Evaluate and check topology; `touching` allows edges shared by touching parts. */
+static bool solid(const char *text, bool touching, outcome *o)
+{
+    mcsg_error err;
+    mcsg_status st = test_eval_scad(text, NULL, &o->mesh, &o->stats, &err);
+    CHECK_MSG(st == MCSG_OK, "%s: %s", text, err.message);
+    if (st != MCSG_OK)
+        return false;
+    CHECK_OK(mcsg_mesh_check(&o->mesh, NULL, &o->report, &err), &err);
+    o->volume = test_signed_volume(&o->mesh);
+    CHECK_MSG(o->report.boundary_edges == 0 && o->report.inconsistent_edges == 0 &&
+                  o->report.degenerate_triangles == 0 && o->report.duplicate_triangles == 0 &&
+                  (touching || o->report.nonmanifold_edges == 0),
+              "%s: %zu boundary, %zu inconsistent, %zu non-manifold edges, %zu degenerate, "
+              "%zu duplicate triangles", text, o->report.boundary_edges,
+              o->report.inconsistent_edges, o->report.nonmanifold_edges,
+              o->report.degenerate_triangles, o->report.duplicate_triangles);
+    CHECK_MSG(test_index_manifold_defects(&o->mesh) == 0 || o->report.nonmanifold_edges > 0,
+              "%s: not manifold by index", text);
+    return true;
+}
+
+static double volume_of(const char *text)
+{
+    outcome o;
+    double v = NAN;
+    if (solid(text, false, &o)) {
+        v = o.volume;
+        mcsg_mesh_free(&o.mesh, NULL);
+    }
+    return v;
+}
+
+static void expect_volume(const char *text, double expected, double rel)
+{
+    double v = volume_of(text);
+    CHECK_MSG(fabs(v - expected) <= rel * fabs(expected) + 1e-300, "%s: volume %.17g, expected "
+              "%.17g", text, v, expected);
+}
+
+/* |A u B| + |A n B| = |A| + |B| for two operand texts. */
+static void expect_identity(const char *a, const char *b, double rel)
+{
+    char u[4096], n[4096];
+    double va = volume_of(a), vb = volume_of(b), vu, vn;
+    snprintf(u, sizeof u, "union() { %s %s }", a, b);
+    snprintf(n, sizeof n, "intersection() { %s %s }", a, b);
+    vu = volume_of(u);
+    vn = volume_of(n);
+    CHECK_MSG(fabs(vu + vn - va - vb) <= rel * (va + vb), "%s | %s: %.17g + %.17g vs %.17g + "
+              "%.17g", a, b, vu, vn, va, vb);
+}
+
+TEST(coplanar_faces_stacked_and_offset)
+{
+    expect_volume("union() { cube(1); translate([0,0,1]) cube(1); translate([0,0,2]) cube(1); }",
+                  3, 1e-15);
+    expect_volume("union() { cube(2); translate([1,0,0]) cube(2); }", 12, 1e-15);
+    expect_volume("union() { cube(2); translate([1,1,0]) cube(2); translate([0.5,0.5,2])"
+                  " cube(2); }", 22, 1e-15);
+    expect_volume("difference() { cube(2); translate([1,0,0]) cube(2); }", 4, 1e-15);
+    expect_volume("intersection() { cube(2); translate([1,1,0]) cube(2); }", 2, 1e-15);
+    /* A face offset by half a face on the top of another. */
+    expect_volume("union() { cube([2,2,1]); translate([1,1,1]) cube([2,2,1]); }", 8, 1e-15);
+}
+
+TEST(identical_operands_three_times)
+{
+    const char *s = "sphere(1, $fn=24);";
+    double v = volume_of(s);
+    char text[512];
+    snprintf(text, sizeof text, "union() { %s %s %s }", s, s, s);
+    expect_volume(text, v, 1e-15);
+    snprintf(text, sizeof text, "intersection() { %s %s %s }", s, s, s);
+    expect_volume(text, v, 1e-15);
+    snprintf(text, sizeof text, "difference() { %s %s %s }", s, s, s);
+    expect_volume(text, 0, 0);
+    snprintf(text, sizeof text, "difference() { union() { %s %s } %s }", s, s, s);
+    expect_volume(text, 0, 0);
+}
+
+TEST(copies_moved_by_an_ulp_or_rotated_by_1e_7)
+{
+    char text[512];
+    double ulp = DBL_EPSILON; /* one ulp at 1: the box [eps, 1 + eps] */
+    snprintf(text, sizeof text, "difference() { cube(1); translate([%.17g,0,0]) cube(1); }", ulp);
+    expect_volume(text, ulp, 1e-9);
+    snprintf(text, sizeof text, "union() { cube(1); translate([%.17g,0,0]) cube(1); }", ulp);
+    expect_volume(text, 1 + ulp, 1e-15);
+    /* Rotated by 1e-7 rad (5.73e-6 degrees) about a skew axis: thin wedges everywhere. */
+    expect_identity("sphere(1, $fn=16);",
+                    "rotate(a=5.729577951308232e-6, v=[1,2,3]) sphere(1, $fn=16);", 1e-12);
+    expect_identity("cube(1, center=true);",
+                    "rotate(a=5.729577951308232e-6, v=[0,0,1]) cube(1, center=true);", 1e-12);
+}
+
+TEST(needles_and_slivers)
+{
+    /* A needle cylinder (radius 1e-6) through a box, and a sliver box 1e-9 thick. */
+    expect_identity("cube(2, center=true);", "cylinder(h=3, r=1e-6, center=true, $fn=5);", 1e-12);
+    expect_identity("cube(2, center=true);",
+                    "translate([0,0,1-1e-9]) cube([1,1,1], center=false);", 1e-12);
+    expect_volume("difference() { cube(1); translate([-1,-1,1e-9]) cube(3); }", 1e-9, 1e-6);
+}
+
+TEST(fans_of_cylinders_through_one_axis)
+{
+    char text[4096];
+    size_t n = 0;
+    double forward, backward;
+    n += (size_t)snprintf(text + n, sizeof text - n, "union() {");
+    for (int i = 0; i < 12; i++)
+        n += (size_t)snprintf(text + n, sizeof text - n,
+                              " rotate([0,0,%d]) rotate([0,90,0]) cylinder(h=4, r=0.5,"
+                              " center=true, $fn=12);", 15 * i);
+    snprintf(text + n, sizeof text - n, " }");
+    forward = volume_of(text);
+    n = 0;
+    n += (size_t)snprintf(text + n, sizeof text - n, "union() {");
+    for (int i = 11; i >= 0; i--)
+        n += (size_t)snprintf(text + n, sizeof text - n,
+                              " rotate([0,0,%d]) rotate([0,90,0]) cylinder(h=4, r=0.5,"
+                              " center=true, $fn=12);", 15 * i);
+    snprintf(text + n, sizeof text - n, " }");
+    backward = volume_of(text);
+    CHECK_MSG(fabs(forward - backward) <= 1e-12 * forward, "%.17g vs %.17g", forward,
+              backward);
+    CHECK(forward > 0 && forward < 12 * 4 * 3.1416 * 0.25);
+}
+
+TEST(scales_and_far_from_the_origin)
+{
+    const char *pattern =
+        "translate([%.17g,%.17g,%.17g]) scale(%.17g) difference() { union() { cube(2);"
+        " translate([1,1,1]) sphere(1, $fn=12); } rotate([10,20,30]) cylinder(h=5,"
+        " r=0.4, center=true, $fn=9); }";
+    double scales[3] = {1e-4, 1, 1e5}, base = 0;
+    char text[1024];
+    for (int i = 0; i < 3; i++) {
+        double v;
+        snprintf(text, sizeof text, pattern, 0.0, 0.0, 0.0, scales[i]);
+        v = volume_of(text) / (scales[i] * scales[i] * scales[i]);
+        if (i == 0)
+            base = v;
+        CHECK_MSG(fabs(v - base) <= 1e-9 * base, "scale %g: %.17g vs %.17g", scales[i], v,
+                  base);
+    }
+    snprintf(text, sizeof text, pattern, 1e6, 1e6, 1e6, 1.0);
+    CHECK_MSG(fabs(volume_of(text) - base) <= 1e-6 * base, "centre at 1e6: %.17g vs %.17g",
+              volume_of(text), base);
+}
+
+TEST(union_of_many_overlapping_spheres)
+{
+    static char text[65536];
+    size_t n = 0;
+    outcome o;
+    n += (size_t)snprintf(text + n, sizeof text - n, "union() {");
+    for (int i = 0; i < 150; i++) /* a helix of spheres, each crossing several others */
+        n += (size_t)snprintf(text + n, sizeof text - n,
+                              " translate([%.17g,%.17g,%.17g]) sphere(1, $fn=10);",
+                              3 * cos(i * 0.3), 3 * sin(i * 0.3), i * 0.05);
+    snprintf(text + n, sizeof text - n, " }");
+    if (solid(text, false, &o)) {
+        CHECK(o.volume > 4.0 / 3 * 3.1 && o.volume < 150 * 4.2);
+        CHECK(o.report.components == 1);
+        mcsg_mesh_free(&o.mesh, NULL);
+    }
+}
+
+int main(void)
+{
+    RUN(coplanar_faces_stacked_and_offset);
+    RUN(identical_operands_three_times);
+    RUN(copies_moved_by_an_ulp_or_rotated_by_1e_7);
+    RUN(needles_and_slivers);
+    RUN(fans_of_cylinders_through_one_axis);
+    RUN(scales_and_far_from_the_origin);
+    RUN(union_of_many_overlapping_spheres);
+    return test_summary();
+}
