@@ -184,6 +184,15 @@ static void free_rounded(const mci_ctx *ctx, rounded *r)
     mci_free(ctx, r->canon);
 }
 
+/* Whether rounding joined distinct exact vertices. */
+static bool any_joined(const rounded *r)
+{
+    for (size_t v = 0; v < r->count; v++)
+        if (r->canon[v] != v)
+            return true;
+    return false;
+}
+
 /* Drop the vertices no triangle uses any more (after cancelled triangles), keeping the
  * others in order: new ids never exceed old ones, so the move can be done in place. */
 static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
@@ -203,22 +212,27 @@ static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
     m->vertex_count = nv;
 }
 
-/* See rounding_repair.h. Splitting a flat triangle can fold a sliver next to it onto an
- * opposite twin, and cancelling twins can expose flat triangles: repeat while either
- * changes something. `map` has room for every vertex of out. */
+/* See rounding_repair.h. Opposite twins only appear where rounding joined vertices
+ * (`joined`) or a flat triangle was split; splitting can fold a sliver next to it and
+ * cancelling twins can expose flat triangles, so repeat while either changes something.
+ * `map` has room for every vertex of out. */
 static mcsg_status repair_rounding(eval_state *e, mcsg_mesh *out, uint32_t *which,
-                                   uint32_t *map, mcsg_error *err)
+                                   uint32_t *map, bool joined, mcsg_error *err)
 {
     mci_flat_repair repair = {0, 0};
-    size_t cancelled = 1, split = 0, total_cancelled = 0;
-    for (int round = 0; round < 8 && (cancelled > 0 || repair.split > 0); round++) {
-        if (!mci_cancel_opposite_triangles(&e->ctx, out->triangles, which,
-                                           &out->triangle_count, &cancelled) ||
+    size_t split = 0, total_cancelled = 0;
+    for (int round = 0; round < 8; round++) {
+        size_t cancelled = 0;
+        if ((joined && !mci_cancel_opposite_triangles(&e->ctx, out->triangles, which,
+                                                      &out->triangle_count, &cancelled)) ||
             !mci_split_flat_triangles(&e->ctx, out->vertices, out->triangles, which,
                                       out->triangle_count, &repair))
             return mci_fail_nomem(err, "assembling the result");
         total_cancelled += cancelled;
         split += repair.split;
+        if (cancelled == 0 && repair.split == 0)
+            break;
+        joined = true;
     }
     if (total_cancelled > 0)
         drop_unused_vertices(out, map);
@@ -263,7 +277,7 @@ static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
         memcpy(out->triangles, tris, 3 * nt * sizeof *tris);
     e->stats.rounding_dropped_triangles = e->kept.count - nt;
     if (st == MCSG_OK)
-        st = repair_rounding(e, out, which, final, err);
+        st = repair_rounding(e, out, which, final, any_joined(r), err);
     mci_free(&e->ctx, final);
     mci_free(&e->ctx, tris);
     if (st == MCSG_OK)

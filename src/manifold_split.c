@@ -26,6 +26,8 @@ typedef struct splitter {
     const mci_ctx *ctx;
     mcsg_mesh *m;
     uint32_t *mate; /* per edge slot 3t + i (corner i -> i + 1): the paired slot */
+    uint32_t *start, *corner; /* corners (= outgoing edge slots) of vertex v:
+                                 corner[start[v] .. start[v + 1]) */
     size_t bad_edges;
 } splitter;
 
@@ -119,37 +121,6 @@ static bool pair_around_edge(splitter *sp, uint32_t *slots, size_t n)
     return true;
 }
 
-static bool pair_edges(splitter *sp)
-{
-    const mcsg_mesh *m = sp->m;
-    size_t n = 3 * m->triangle_count;
-    mci_keyed *half = mci_malloc_array(sp->ctx, n + 1, sizeof *half);
-    uint32_t *slots = mci_malloc_array(sp->ctx, n + 1, sizeof *slots);
-    bool ok = half && slots;
-    for (size_t s = 0; ok && s < n; s++) {
-        half[s].key = mci_edge_key(slot_from(m, (uint32_t)s), slot_to(m, (uint32_t)s));
-        half[s].ref = (uint32_t)s;
-        sp->mate[s] = MCI_NONE;
-    }
-    if (ok)
-        mci_sort_keyed(half, n);
-    for (size_t i = 0, j; ok && i < n; i = j) {
-        for (j = i + 1; j < n && half[j].key == half[i].key; j++)
-            ;
-        for (size_t k = i; k < j; k++)
-            slots[k - i] = half[k].ref;
-        if (j - i == 2 && slot_from(m, slots[0]) == slot_to(m, slots[1])) {
-            sp->mate[slots[0]] = slots[1];
-            sp->mate[slots[1]] = slots[0];
-        } else if ((j - i) % 2 != 0 || !pair_around_edge(sp, slots, j - i)) {
-            sp->bad_edges++;
-        }
-    }
-    mci_free(sp->ctx, half);
-    mci_free(sp->ctx, slots);
-    return ok;
-}
-
 static uint32_t find(uint32_t *parent, uint32_t x)
 {
     while (parent[x] != x)
@@ -157,27 +128,71 @@ static uint32_t find(uint32_t *parent, uint32_t x)
     return x;
 }
 
-/* Corners (3t + i) grouped by vertex in CSR form: corners of v are
- * corner[start[v] .. start[v + 1]). */
-static bool corners_by_vertex(const splitter *sp, uint32_t **start_out, uint32_t **corner_out)
+/* Corners (3t + i) grouped by vertex in CSR form. Corner 3t + i is also the edge slot
+ * leaving its vertex, so this lists each vertex's outgoing edges. */
+static bool corners_by_vertex(splitter *sp)
 {
     const mcsg_mesh *m = sp->m;
     size_t n = 3 * m->triangle_count;
     uint32_t *start = mci_calloc_array(sp->ctx, m->vertex_count + 2, sizeof *start);
     uint32_t *corner = mci_malloc_array(sp->ctx, n + 1, sizeof *corner);
-    if (!start || !corner) {
-        mci_free(sp->ctx, start);
-        mci_free(sp->ctx, corner);
+    sp->start = start;
+    sp->corner = corner;
+    if (!start || !corner)
         return false;
-    }
     for (size_t c = 0; c < n; c++)
         start[m->triangles[c] + 2]++;
     for (size_t v = 2; v < m->vertex_count + 2; v++)
         start[v] += start[v - 1];
     for (size_t c = 0; c < n; c++)
         corner[start[m->triangles[c] + 1]++] = (uint32_t)c;
-    *start_out = start;
-    *corner_out = corner;
+    return true;
+}
+
+/* Append the slots from u to v to slots[*n]; returns how many there were. */
+static size_t slots_between(const splitter *sp, uint32_t u, uint32_t v, uint32_t *slots,
+                            size_t *n, size_t room)
+{
+    size_t found = 0;
+    for (uint32_t k = sp->start[u]; k < sp->start[u + 1]; k++)
+        if (slot_to(sp->m, sp->corner[k]) == v) {
+            if (*n < room)
+                slots[(*n)++] = sp->corner[k];
+            found++;
+        }
+    return found;
+}
+
+/* Pair every edge's slots: the two opposite ones of a manifold edge directly, the 2k
+ * of a non-manifold edge by angle. Each edge is handled once, from the first slot that
+ * leaves its smaller vertex. */
+static bool pair_edges(splitter *sp)
+{
+    const mcsg_mesh *m = sp->m;
+    size_t room = 64;
+    uint32_t *slots = mci_malloc_array(sp->ctx, room, sizeof *slots);
+    if (!slots)
+        return false;
+    for (size_t s = 0; s < 3 * m->triangle_count; s++)
+        sp->mate[s] = MCI_NONE;
+    for (uint32_t u = 0; u < m->vertex_count; u++)
+        for (uint32_t k = sp->start[u]; k < sp->start[u + 1]; k++) {
+            uint32_t s = sp->corner[k], v = slot_to(m, s);
+            size_t n = 0, ahead, back;
+            if (v < u || sp->mate[s] != MCI_NONE)
+                continue;
+            ahead = slots_between(sp, u, v, slots, &n, room);
+            if (slots[0] != s)
+                continue; /* handled from the first slot u -> v */
+            back = slots_between(sp, v, u, slots, &n, room);
+            if (ahead == 1 && back == 1) {
+                sp->mate[slots[0]] = slots[1];
+                sp->mate[slots[1]] = slots[0];
+            } else if (ahead != back || ahead + back > room || !pair_around_edge(sp, slots, n)) {
+                sp->bad_edges++;
+            }
+        }
+    mci_free(sp->ctx, slots);
     return true;
 }
 
@@ -216,9 +231,10 @@ static bool split_vertices(splitter *sp, size_t *added)
 {
     mcsg_mesh *m = sp->m;
     size_t n = 3 * m->triangle_count, nv = m->vertex_count, extra = 0;
-    uint32_t *start, *corner, *parent = mci_malloc_array(sp->ctx, n + 1, sizeof *parent);
+    const uint32_t *start = sp->start, *corner = sp->corner;
+    uint32_t *parent = mci_malloc_array(sp->ctx, n + 1, sizeof *parent);
     uint32_t *copy = mci_malloc_array(sp->ctx, n + 1, sizeof *copy);
-    bool ok = parent && copy && corners_by_vertex(sp, &start, &corner);
+    bool ok = parent && copy;
     if (!ok) {
         mci_free(sp->ctx, parent);
         mci_free(sp->ctx, copy);
@@ -254,8 +270,6 @@ static bool split_vertices(splitter *sp, size_t *added)
         }
     }
     *added = extra;
-    mci_free(sp->ctx, start);
-    mci_free(sp->ctx, corner);
     mci_free(sp->ctx, parent);
     mci_free(sp->ctx, copy);
     return ok;
@@ -263,14 +277,17 @@ static bool split_vertices(splitter *sp, size_t *added)
 
 bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *result)
 {
-    splitter sp = {ctx, m, NULL, 0};
+    splitter sp = {ctx, m, NULL, NULL, NULL, 0};
     bool ok;
     memset(result, 0, sizeof *result);
     if (m->triangle_count == 0)
         return true;
     sp.mate = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *sp.mate);
-    ok = sp.mate && pair_edges(&sp) && split_vertices(&sp, &result->new_vertices);
+    ok = sp.mate && corners_by_vertex(&sp) && pair_edges(&sp) &&
+         split_vertices(&sp, &result->new_vertices);
     result->unpaired_edges = sp.bad_edges;
     mci_free(ctx, sp.mate);
+    mci_free(ctx, sp.start);
+    mci_free(ctx, sp.corner);
     return ok;
 }
