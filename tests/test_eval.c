@@ -30,21 +30,15 @@ static mcsg_tree *parse(const char *text)
 /* Evaluate and check the output's topology (closed, oriented, edge-manifold). */
 static bool eval_text(const char *text, result *r)
 {
-    mcsg_tree *tree = parse(text);
     mcsg_error err;
     mcsg_status st;
-    bool ok = false;
     memset(r, 0, sizeof *r);
-    if (!tree)
-        return false;
-    st = mcsg_eval(tree, NULL, &r->mesh, NULL, &r->stats, &err);
+    st = test_eval_scad(text, NULL, &r->mesh, &r->stats, &err);
     CHECK_MSG(st == MCSG_OK, "%s: %s", text, err.message);
-    if (st == MCSG_OK) {
-        CHECK_OK(mcsg_mesh_check(&r->mesh, NULL, &r->report, &err), &err);
-        ok = true;
-    }
-    mcsg_tree_free(tree);
-    return ok;
+    if (st != MCSG_OK)
+        return false;
+    CHECK_OK(mcsg_mesh_check(&r->mesh, NULL, &r->report, &err), &err);
+    return true;
 }
 
 static void expect_solid(const char *text, double volume, size_t components)
