@@ -415,6 +415,7 @@ typedef struct mcsg_eval_stats {
                                         output is edge- and vertex-manifold */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
+    double seconds_check;       /* checking the leaves against the input contract */
     double seconds_triangulate; /* tessellating the split faces */
     double seconds_classify;    /* regions, labels and selection */
     double seconds_assemble;    /* welding and rounding the output */
@@ -423,8 +424,16 @@ typedef struct mcsg_eval_stats {
 
 /* Evaluate the CSG tree exactly: the boundary of the regularized result as a closed,
  * consistently oriented, edge-manifold triangle mesh whose vertices are the exact result
- * vertices rounded to double (only at the end). Leaves must be closed and edge-manifold
- * (see mcsg_mesh_check). An empty result gives a mesh with no triangles.
+ * vertices rounded to double (only at the end). An empty result gives a mesh with no
+ * triangles.
+ * Input contract: every non-empty leaf the root reaches must pass mcsg_mesh_check
+ * (mcsg_check_report_is_valid, and not inverted): closed, consistently oriented outward,
+ * edge-manifold, finite, without zero-area or repeated triangles. This is checked first;
+ * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
+ * (its label: file or primitive, and position in the CSG text) and an example of the
+ * problem. Leaves must also not intersect themselves; that is not checked here (it costs
+ * as much as an evaluation: see mcsg_mesh_self_intersections), and a self-intersecting
+ * leaf gives an unspecified but valid mesh or MCSG_ERR_INVALID_MESH.
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,

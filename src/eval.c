@@ -6,6 +6,7 @@
  * rounded to double only here.
  */
 #include "classify.h"
+#include "leaf_check.h"
 #include "manifold_split.h"
 #include "rounding_repair.h"
 
@@ -123,7 +124,7 @@ static void vertex_coordinates(const eval_state *e, const uint64_t *rep, uint32_
         memcpy(out, e->cl.new_vertex[id - s->point_count], 3 * sizeof *out);
         return;
     }
-    mci_point_approx(&s->arrs[rep[id] >> 32].points[(uint32_t)rep[id]], out);
+    mci_point_round(&s->arrs[rep[id] >> 32].points[(uint32_t)rep[id]], out);
 }
 
 static uint64_t *point_representatives(const eval_state *e)
@@ -371,6 +372,11 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     count_faces(&e->tree, &e->stats);
     if (e->tree.leaf_count == 0)
         return mci_mesh_alloc(&e->ctx, out, 0, 0, err);
+    t0 = mci_seconds_now();
+    st = mci_check_leaves(&e->ctx, tree, &e->tree, err);
+    e->stats.seconds_check = mci_seconds_now() - t0;
+    if (st != MCSG_OK)
+        return st;
     st = step(e, "intersect", intersect_step, err);
     if (st == MCSG_OK)
         st = step(e, "triangulate", triangulate_all, err);

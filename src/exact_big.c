@@ -330,3 +330,86 @@ int mci_det3_sign(const double a[3], const double b[3], const double c[3])
         return det > 0 ? 1 : -1;
     return det3_exact(a, b, c);
 }
+
+/* |a| shifted left by `shift` bits into limbs (room for abs_size(a) + shift/64 + 1). */
+static int shifted_magnitude(mp_limb_t *out, const mci_big *a, int shift)
+{
+    int n = abs_size(a), words = shift / GMP_NUMB_BITS, bits = shift % GMP_NUMB_BITS;
+    memset(out, 0, (size_t)words * sizeof *out);
+    if (bits) {
+        out[words + n] = mpn_lshift(out + words, a->limb, n, (unsigned)bits);
+        n++;
+    } else {
+        memcpy(out + words, a->limb, (size_t)n * sizeof *out);
+    }
+    n += words;
+    while (n > 0 && out[n - 1] == 0)
+        n--;
+    return n;
+}
+
+/* q = floor(|num| 2^shift / |den|) (callers choose shift so that it fits two limbs), r
+ * the remainder in *rn limbs; returns whether the remainder is nonzero. */
+static int divide_shifted(const mci_big *num, const mci_big *den, int shift, mp_limb_t *q,
+                          mp_limb_t *r, int *rn)
+{
+    static _Thread_local mp_limb_t n[MCI_BIG_LIMBS + 3], d[MCI_BIG_LIMBS + 3];
+    int nn = shifted_magnitude(n, num, shift > 0 ? shift : 0);
+    int dn = shifted_magnitude(d, den, shift < 0 ? -shift : 0);
+    if (nn < dn) {
+        q[0] = 0;
+        memcpy(r, n, (size_t)nn * sizeof *r);
+        memset(r + nn, 0, (size_t)(dn - nn) * sizeof *r);
+    } else {
+        mpn_tdiv_qr(q, r, 0, n, nn, d, dn);
+    }
+    *rn = dn;
+    return !mpn_zero_p(r, dn);
+}
+
+double mci_big_ratio_to_double(const mci_big *num, const mci_big *den, int exp2)
+{
+    static _Thread_local mp_limb_t q[MCI_BIG_LIMBS + 3], r[MCI_BIG_LIMBS + 3];
+    int nn = abs_size(num), dn = abs_size(den), shift, negative, rn;
+    long nbits, dbits;
+    uint64_t top;
+    double x;
+    if (nn == 0 || dn == 0)
+        return 0;
+    negative = (num->size < 0) != (den->size < 0);
+    nbits = (long)mpn_sizeinbase(num->limb, (mp_size_t)nn, 2);
+    dbits = (long)mpn_sizeinbase(den->limb, (mp_size_t)dn, 2);
+    /* q = floor(N 2^shift / D) then lies in [2^62, 2^64): 9 or more bits below the
+     * 53 kept, the lowest of which becomes a sticky bit for the remainder. */
+    shift = (int)(63 - (nbits - dbits));
+    if (exp2 - shift + 62 < -1022) {
+        /* The result is below 2^-1021, where the unit is 2^-1074: round N/D 2^(exp2+1074)
+         * to an integer directly (ties to even) instead of rounding twice. */
+        shift = exp2 + 1074;
+        if (shift < -(int)(MCI_BIG_LIMBS * GMP_NUMB_BITS))
+            return negative ? -0.0 : 0.0;
+        int inexact = divide_shifted(num, den, shift, q, r, &rn);
+        top = (uint64_t)q[0];
+        if (inexact) {
+            /* Compare 2r with D: above half rounds up, exactly half rounds to even. */
+            mci_big twice_r, d_abs;
+            twice_r.size = rn;
+            memcpy(twice_r.limb, r, (size_t)rn * sizeof *r);
+            while (twice_r.size > 0 && twice_r.limb[twice_r.size - 1] == 0)
+                twice_r.size--;
+            mci_big_add(&twice_r, &twice_r, &twice_r);
+            mci_big_copy(&d_abs, den);
+            if (d_abs.size < 0)
+                d_abs.size = -d_abs.size;
+            int c = compare_abs(&twice_r, &d_abs);
+            if (c > 0 || (c == 0 && (top & 1)))
+                top++;
+        }
+        x = ldexp((double)top, -1074);
+        return negative ? -x : x;
+    }
+    if (divide_shifted(num, den, shift, q, r, &rn))
+        q[0] |= 1;
+    top = (uint64_t)q[0];
+    return ldexp(negative ? -(double)top : (double)top, exp2 - shift);
+}

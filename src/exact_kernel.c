@@ -321,8 +321,62 @@ bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const
 
 void mci_point_approx(const mci_point *p, double out[3])
 {
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         out[k] = p->v[0][k] + p->y[k].v / p->w.v;
+        /* W's approximation can be 0 or of the wrong sign where the filter could not
+         * decide it (the exact sign is positive): then compute the point exactly. */
+        if (!isfinite(out[k]) || !(p->w.v > 0)) {
+            mci_point_round(p, out);
+            return;
+        }
+    }
+}
+
+/* Coordinate k of p correctly rounded, when the filter proves it: base + q is summed
+ * exactly as hi + lo (two-sum), q's error bound E is certified, and hi is the nearest
+ * double to every value within |lo| + E of it (strictly inside its rounding interval,
+ * whose half-width is half the smaller gap to a neighbouring double). */
+static bool round_filtered(const mci_point *p, int k, double *out)
+{
+    double base = p->v[0][k], y = p->y[k].v, w = p->w.v, wl = w - p->w.e, q, hi, lo, bv;
+    double err, gap;
+    /* Far from underflow only: the bound below would lose its own tiny terms there. */
+    if (!(wl >= 0x1p-900) || !isfinite(y) || !isfinite(p->y[k].e) || !isfinite(p->w.e))
+        return false;
+    q = y / w;
+    err = fabs(q) * (p->w.e / wl) + p->y[k].e / wl + fabs(q) * 0x1p-53;
+    err = err * (1 + 0x1p-40) + 0x1p-1060; /* the rounding of this bound itself */
+    hi = base + q;
+    bv = hi - base;
+    lo = (base - (hi - bv)) + (q - bv);
+    gap = fmin(nextafter(hi, INFINITY) - hi, hi - nextafter(hi, -INFINITY)) / 2;
+    if (!isfinite(hi) || !(fabs(hi) >= 0x1p-900) || !((fabs(lo) + err) * (1 + 0x1p-50) < gap))
+        return false;
+    *out = hi;
+    return true;
+}
+
+void mci_point_round(const mci_point *p, double out[3])
+{
+    static const double zero[3] = {0, 0, 0};
+    big_point exact;
+    input_scale s;
+    bool computed = false;
+    for (int k = 0; k < 3; k++) {
+        if (p->kind == MCI_POINT_EXPLICIT) {
+            out[k] = p->v[0][k];
+            continue;
+        }
+        if (round_filtered(p, k, &out[k]))
+            continue;
+        /* X / W is the point in units of 2^e0 once X is measured from the origin. */
+        if (!computed) {
+            s = scale_of(&p, 1, NULL, 0);
+            big_point_at(&exact, p, zero, s.e0);
+            computed = true;
+        }
+        out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
+    }
 }
 
 void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])

@@ -149,6 +149,10 @@ mci_containment mci_point_in_triangle(const mci_point *p, const mci_plane *trian
  * output only after rounding decisions elsewhere, and for display). */
 void mci_point_approx(const mci_point *p, double out[3]);
 
+/* The point's coordinates correctly rounded: each is the double nearest to the exact
+ * coordinate (ties to even), computed exactly (output vertices). */
+void mci_point_round(const mci_point *p, double out[3]);
+
 /* A box certainly containing the point (possibly infinite when the cached W is too
  * uncertain). For culling only: decisions stay with the predicates. */
 void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);

@@ -60,6 +60,10 @@ mcsg_status mci_parallel_for(const mci_ctx *ctx, size_t count, mci_task_fn fn, v
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 
+/* mcsg_mesh_check with the context's allocator; the mesh's counts must fit uint32_t. */
+mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
+                           mcsg_check_report *report, mcsg_error *err);
+
 /* Wall-clock seconds since some fixed point (for step timings). */
 double mci_seconds_now(void);
 

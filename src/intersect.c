@@ -728,7 +728,7 @@ static mcsg_status export_curves(const mci_ctx *ctx, const mci_scene *s, mcsg_cu
         for (size_t p = 0; p < s->arrs[k].point_count; p++) {
             uint32_t id = new_id[s->gid[s->gid_start[k] + p]];
             if (id != MCI_NONE)
-                mci_point_approx(&s->arrs[k].points[p], out->points + 3 * (size_t)id);
+                mci_point_round(&s->arrs[k].points[p], out->points + 3 * (size_t)id);
         }
     for (size_t i = 0; i < count; i++) {
         out->segments[2 * i] = new_id[keys[i] >> 32];

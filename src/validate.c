@@ -411,14 +411,21 @@ mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
                             mcsg_check_report *report, mcsg_error *err)
 {
     mci_ctx ctx;
-    check_state s;
-    bool ok;
     if (!mesh || !report || (mesh->vertex_count && !mesh->vertices) ||
         (mesh->triangle_count && !mesh->triangles))
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_mesh_check: NULL argument");
     if (mesh->vertex_count > UINT32_MAX || mesh->triangle_count > UINT32_MAX)
         return mci_fail(err, MCSG_ERR_LIMIT, "mesh too large to check");
     mci_ctx_init(&ctx, opts);
+    return mci_mesh_check(&ctx, mesh, report, err);
+}
+
+mcsg_status mci_mesh_check(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
+                           mcsg_check_report *report, mcsg_error *err)
+{
+    const mci_ctx ctx = *ctx_in;
+    check_state s;
+    bool ok;
     report_init(report, mesh);
     memset(&s, 0, sizeof s);
     s.ctx = &ctx;

@@ -902,6 +902,49 @@ static void check_point_box(const scenario *s, int i)
     }
 }
 
+/* ---------------------------------------------------------------- correct rounding */
+
+static long rounded_coordinates;
+
+/* r is a nearest double to x: x lies between the midpoints to r's neighbours. */
+static bool is_nearest_double(double r, mpq_srcptr x)
+{
+    double below = nextafter(r, -INFINITY), above = nextafter(r, INFINITY);
+    mpq_t lo, hi, t;
+    bool ok;
+    if (!isfinite(r))
+        return false;
+    mpq_inits(lo, hi, t, NULL);
+    mpq_set_d(lo, r);
+    mpq_set_d(t, below);
+    mpq_add(lo, lo, t);
+    mpq_div_2exp(lo, lo, 1);
+    mpq_set_d(hi, r);
+    mpq_set_d(t, above);
+    mpq_add(hi, hi, t);
+    mpq_div_2exp(hi, hi, 1);
+    ok = (!isfinite(below) || mpq_cmp(lo, x) <= 0) && (!isfinite(above) || mpq_cmp(x, hi) <= 0);
+    mpq_clears(lo, hi, t, NULL);
+    return ok;
+}
+
+/* mci_point_round gives the nearest double on every axis; mci_point_approx is finite. */
+static void check_point_round(const scenario *s, int i)
+{
+    double r[3], a[3];
+    mci_point_round(&ws.kpt[i], r);
+    mci_point_approx(&ws.kpt[i], a);
+    for (int k = 0; k < 3; k++) {
+        if (fabs(mpq_get_d(ws.rx[i].c[k])) > 0x1p1020)
+            continue; /* near or beyond the double range: not a point of any mesh */
+        CHECK_MSG(is_nearest_double(r[k], ws.rx[i].c[k]), "mci_point_round (%s) axis %d: "
+                  "%a, exact %a", class_names[s->cls], k, r[k], mpq_get_d(ws.rx[i].c[k]));
+        CHECK_MSG(isfinite(a[k]), "mci_point_approx (%s) axis %d: %a", class_names[s->cls],
+                  k, a[k]);
+        rounded_coordinates++;
+    }
+}
+
 /* ---------------------------------------------------------------- building a scenario */
 
 static void build_point(const scenario *s, int i)
@@ -933,6 +976,7 @@ static void build_point(const scenario *s, int i)
     if (d->kind != MCI_POINT_EXPLICIT)
         check_point_bounds(s, i);
     check_point_box(s, i);
+    check_point_round(s, i);
 }
 
 static void build(const scenario *s)
@@ -1730,6 +1774,7 @@ static void print_predicate_table(void)
     }
     printf("total cases: %ld; cached values with an uninformative bound (inf/NaN): %ld\n",
            total, uninformative_bounds);
+    printf("coordinates rounded by mci_point_round (checked nearest): %ld\n", rounded_coordinates);
     printf("implicit point boxes: %ld, infinite %ld, tight (1e-10) %ld\n\n", box_points,
            box_infinite, box_tight);
 }

@@ -556,6 +556,7 @@ static void print_eval_stats(const mcsg_eval_stats *s)
     printf("primitives %zu, faces %zu (min %zu, max %zu per primitive)\n", s->primitives,
            s->faces, s->faces_min, s->faces_max);
     printf("  positive tree    %8.3f s\n", s->seconds_tree);
+    printf("  input check      %8.3f s\n", s->seconds_check);
     printf("  octree           %8.3f s  (%zu cells)\n", x->seconds_octree, x->cells);
     printf("  candidate pairs  %8.3f s  (%zu)\n", x->seconds_pairs, x->candidate_pairs);
     printf("  intersect        %8.3f s  (%zu crossing, %zu coplanar pairs)\n",
