@@ -210,6 +210,9 @@ typedef struct mcsg_check_report {
     double volume;                /* signed volume, rounded (meaningful when closed) */
     int inverted;                 /* 1: closed, consistent, and the exact volume sign is
                                      negative: every triangle faces inward */
+    int volume_sign;              /* exact sign of the volume (+1, -1, or 0) when closed
+                                     and consistent; 0 otherwise. A closed mesh with
+                                     volume 0 encloses nothing: it folds onto itself */
     uint32_t example_out_of_range_triangle;
     uint32_t example_nonfinite_vertex;
     uint32_t example_degenerate_triangle;
@@ -228,6 +231,18 @@ mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
  * finite coordinates, valid indices and no degenerate or duplicate triangles (it may be
  * inverted: flipping fixes that), 0 otherwise. */
 int mcsg_check_report_is_valid(const mcsg_check_report *report);
+
+/* Exact self-intersection test: *pairs receives the number of pairs of triangles whose
+ * closed sets meet other than in the vertices and the edge they share (vertices are
+ * identified by coordinates; touching at a point, crossing, overlapping in one plane,
+ * folding onto a neighbour and repeated triangles all count), and example[2], if not
+ * NULL, the first such pair found (or MCSG_NO_INDEX). Zero-area triangles are skipped
+ * (mcsg_mesh_check reports them). Exact predicates on the doubles as given: this is the
+ * test for outputs after rounding, and for leaves (`meshcsg eval --check-inputs`).
+ * Fails on NaN or infinite coordinates, indices out of range, or allocation failure.
+ * Cost: an octree over the mesh and an exact test per pair of nearby triangles. */
+mcsg_status mcsg_mesh_self_intersections(const mcsg_mesh *mesh, const mcsg_options *opts,
+                                         size_t *pairs, uint32_t example[2], mcsg_error *err);
 
 /* ------------------------------------------------------------------------------------ */
 /* Primitives, tessellated exactly as OpenSCAD does                                      */

@@ -387,6 +387,8 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
         st = assemble(e, out, provenance, err);
         mci_progress(&e->ctx, "assemble", 1);
     }
+    if (st == MCSG_ERR_INTERNAL)
+        st = mci_explain_internal_error(&e->ctx, tree, &e->tree, err);
     return st;
 }
 

@@ -4,12 +4,15 @@
  * zero-area triangles (they have no plane) and facing outward. A leaf that breaks it is
  * named in a one-line message (its label says which file or primitive it came from, and
  * where in the CSG text) with the first offending edge, triangle or vertex, so that the
- * user can find it; nothing is evaluated. Self-intersecting leaves are not detected here
- * (that costs an intersection pass of its own: see mcsg_mesh_self_intersections).
+ * user can find it; nothing is evaluated. Self-intersecting leaves are not looked for up
+ * front (that costs an intersection pass of its own); but when evaluation stops on an
+ * internal consistency check, which a self-intersecting leaf can trip, the leaves are
+ * tested then, and a leaf that intersects itself is named instead of reporting a bug.
  */
 #include "leaf_check.h"
 
 #include <stdio.h>
+#include <string.h>
 
 typedef struct leaf_check_job {
     const mcsg_tree *tree;
@@ -55,6 +58,9 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
     } else if (r->duplicate_triangles) {
         snprintf(out, size, "%zu triangles repeat the three vertices of another, e.g. "
                  "triangle %u", r->duplicate_triangles, r->example_duplicate_triangle);
+    } else if (r->volume_sign == 0) {
+        snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
+                 "other, e.g. all in one plane)");
     } else if (r->inverted) {
         snprintf(out, size, "the mesh is inside out (every triangle faces inward; "
                  "`meshcsg check -o FIXED` flips it)");
@@ -85,3 +91,47 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mc
     leaf_check_job job = {tree, ptree, ctx};
     return mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
 }
+
+/* The first primitive that intersects itself, as an INVALID_MESH error; MCSG_OK if none
+ * does (or an allocation failure). */
+static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
+                                          const mci_ptree *ptree, mcsg_error *err)
+{
+    mcsg_options opts;
+    memset(&opts, 0, sizeof opts);
+    opts.allocator = ctx->alloc;
+    for (size_t k = 0; k < ptree->leaf_count; k++) {
+        mcsg_node_id node = ptree->leaf_source[k];
+        const char *label = mcsg_tree_node_label(tree, node);
+        size_t pairs;
+        uint32_t example[2];
+        mcsg_status st = mcsg_mesh_self_intersections(ptree->leaf_mesh[k], &opts, &pairs,
+                                                      example, err);
+        if (st != MCSG_OK)
+            return st;
+        if (pairs > 0)
+            return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s intersects itself: %zu "
+                            "pairs of its triangles cross or overlap, e.g. triangles %u and %u",
+                            node, label[0] ? ", " : "", label, pairs, example[0], example[1]);
+    }
+    return MCSG_OK;
+}
+
+mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
+                                       const mci_ptree *ptree, mcsg_error *err)
+{
+    mcsg_error saved, probe;
+    mcsg_status st;
+    if (err)
+        saved = *err;
+    st = find_self_intersecting(ctx, tree, ptree, &probe);
+    if (st == MCSG_ERR_INVALID_MESH) {
+        if (err)
+            *err = probe;
+        return st;
+    }
+    if (err)
+        *err = saved;
+    return MCSG_ERR_INTERNAL;
+}
+

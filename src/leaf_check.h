@@ -11,4 +11,11 @@
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mci_ptree *ptree,
                              mcsg_error *err);
 
+/* Called when evaluation failed with MCSG_ERR_INTERNAL: if a primitive intersects
+ * itself (a broken input contract that the stages cannot always notice), returns
+ * MCSG_ERR_INVALID_MESH with a message naming it; otherwise MCSG_ERR_INTERNAL with *err
+ * unchanged. */
+mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
+                                       const mci_ptree *ptree, mcsg_error *err);
+
 #endif

@@ -374,6 +374,7 @@ static void compute_volume(check_state *s)
     else
         sign = exact_volume_sign(s);
     s->report->inverted = sign < 0;
+    s->report->volume_sign = sign;
 }
 
 static void report_init(mcsg_check_report *r, const mcsg_mesh *m)

@@ -1,7 +1,8 @@
 /*
  * meshcsg command-line tool: a thin client of the public API (include/meshcsg.h).
  *
- *   meshcsg check [-o FIXED] FILE...     validate meshes (or every leaf of a .scad file)
+ *   meshcsg check [--self-intersections] [-o FIXED] FILE...
+ *                                        validate meshes (or every leaf of a .scad file)
  *   meshcsg tree FILE.scad               print the parsed CSG tree
  *   meshcsg convert IN OUT [--format F]  convert between mesh formats
  *   meshcsg intersect FILE.scad [-o C]   intersection curves of all leaves, as OBJ lines
@@ -118,7 +119,27 @@ static void print_problems(const char *name, const mcsg_mesh *m, const mcsg_chec
 
 /* Check one mesh; flips it in place when it is consistently inverted. Returns 1 when
  * the mesh is valid. */
-static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts)
+/* With --self-intersections: 1 when no two triangles intersect (exactly). */
+static int check_self_intersections(const char *name, const mcsg_mesh *m,
+                                    const mcsg_options *opts)
+{
+    size_t pairs;
+    uint32_t example[2];
+    mcsg_error err;
+    if (mcsg_mesh_self_intersections(m, opts, &pairs, example, &err) != MCSG_OK) {
+        fail_line(&err);
+        return 0;
+    }
+    if (pairs == 0) {
+        printf("%s: ok: no self-intersections\n", name);
+        return 1;
+    }
+    printf("%s: error: %zu pairs of triangles intersect each other, e.g. triangles %u and %u\n",
+           name, pairs, example[0], example[1]);
+    return 0;
+}
+
+static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts, int self)
 {
     mcsg_check_report r;
     mcsg_error err;
@@ -128,6 +149,11 @@ static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts)
     }
     if (!mcsg_check_report_is_valid(&r)) {
         print_problems(name, m, &r);
+        return 0;
+    }
+    if (r.volume_sign == 0) {
+        printf("%s: error: the mesh encloses no volume (its triangles fold onto each other)\n",
+               name);
         return 0;
     }
     if (r.inverted) {
@@ -144,10 +170,10 @@ static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts)
                r.duplicate_vertices);
     if (r.unused_vertices)
         printf("%s: note: %zu vertices are used by no triangle\n", name, r.unused_vertices);
-    return 1;
+    return !self || check_self_intersections(name, m, opts);
 }
 
-static int check_csg_file(const char *path, const mcsg_options *opts)
+static int check_csg_file(const char *path, const mcsg_options *opts, int self)
 {
     mcsg_tree *tree;
     mcsg_error err;
@@ -168,14 +194,15 @@ static int check_csg_file(const char *path, const mcsg_options *opts)
             valid = 0;
             break;
         }
-        valid &= check_mesh(name, &copy, opts);
+        valid &= check_mesh(name, &copy, opts, self);
         mcsg_mesh_free(&copy, opts);
     }
     mcsg_tree_free(tree);
     return valid;
 }
 
-static int check_mesh_file(const char *path, const char *fixed_out, const mcsg_options *opts)
+static int check_mesh_file(const char *path, const char *fixed_out, const mcsg_options *opts,
+                           int self)
 {
     mcsg_mesh mesh;
     mcsg_error err;
@@ -184,7 +211,7 @@ static int check_mesh_file(const char *path, const char *fixed_out, const mcsg_o
         fail_line(&err);
         return 0;
     }
-    valid = check_mesh(path, &mesh, opts);
+    valid = check_mesh(path, &mesh, opts, self);
     if (valid && fixed_out &&
         mcsg_mesh_write(fixed_out, MCSG_FORMAT_AUTO, &mesh, opts, &err) != MCSG_OK) {
         fail_line(&err);
@@ -198,16 +225,21 @@ static int cmd_check(int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     const char *fixed_out = NULL;
-    int files = 0, all_valid = 1;
+    int files = 0, all_valid = 1, self = 0;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
             fixed_out = argv[++i];
             continue;
         }
+        if (strcmp(argv[i], "--self-intersections") == 0) {
+            self = 1;
+            continue;
+        }
         files++;
     }
     if (files == 0 || (fixed_out && files != 1)) {
-        fprintf(stderr, "usage: meshcsg check [-o FIXED] FILE...  (-o takes one input)\n");
+        fprintf(stderr, "usage: meshcsg check [--self-intersections] [-o FIXED] FILE...  "
+                "(-o takes one input)\n");
         return EXIT_USAGE;
     }
     for (int i = 0; i < argc; i++) {
@@ -215,8 +247,10 @@ static int cmd_check(int argc, char **argv)
             i++;
             continue;
         }
-        all_valid &= is_csg_file(argv[i]) ? check_csg_file(argv[i], &opts)
-                                          : check_mesh_file(argv[i], fixed_out, &opts);
+        if (strcmp(argv[i], "--self-intersections") == 0)
+            continue;
+        all_valid &= is_csg_file(argv[i]) ? check_csg_file(argv[i], &opts, self)
+                                          : check_mesh_file(argv[i], fixed_out, &opts, self);
     }
     return all_valid ? 0 : EXIT_PROBLEM;
 }
@@ -580,11 +614,36 @@ static void print_eval_stats(const mcsg_eval_stats *s)
     printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
 }
 
+/* --check-inputs: every leaf is tested for self-intersections before evaluation. */
+static int leaves_do_not_intersect_themselves(const mcsg_tree *tree, const mcsg_options *opts)
+{
+    for (mcsg_node_id id = 0; id < mcsg_tree_node_count(tree); id++) {
+        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, id);
+        size_t pairs;
+        uint32_t example[2];
+        mcsg_error err;
+        if (!leaf || leaf->triangle_count == 0)
+            continue;
+        if (mcsg_mesh_self_intersections(leaf, opts, &pairs, example, &err) != MCSG_OK) {
+            fprintf(stderr, "meshcsg: leaf %u, %s: %s\n", id, mcsg_tree_node_label(tree, id),
+                    err.message);
+            return 0;
+        }
+        if (pairs > 0) {
+            fprintf(stderr, "meshcsg: leaf %u, %s intersects itself: %zu pairs of its "
+                    "triangles cross or overlap, e.g. triangles %u and %u\n", id,
+                    mcsg_tree_node_label(tree, id), pairs, example[0], example[1]);
+            return 0;
+        }
+    }
+    return 1;
+}
+
 static int cmd_eval(int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     const char *in = NULL, *out = NULL;
-    int show_stats = 0, ok;
+    int show_stats = 0, check_inputs = 0, ok;
     mcsg_status st;
     mcsg_tree *tree;
     mcsg_mesh result;
@@ -595,17 +654,24 @@ static int cmd_eval(int argc, char **argv)
             out = argv[++i];
         else if (strcmp(argv[i], "--stats") == 0)
             show_stats = 1;
+        else if (strcmp(argv[i], "--check-inputs") == 0)
+            check_inputs = 1;
         else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc && atoi(argv[i + 1]) > 0)
             opts.threads = atoi(argv[++i]);
         else
             in = in || argv[i][0] == '-' ? NULL : argv[i];
     }
     if (!in) {
-        fprintf(stderr, "usage: meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N]\n");
+        fprintf(stderr, "usage: meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N] "
+                "[--check-inputs]\n");
         return EXIT_USAGE;
     }
     if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    if (check_inputs && !leaves_do_not_intersect_themselves(tree, &opts)) {
+        mcsg_tree_free(tree);
         return EXIT_PROBLEM;
     }
     start_progress(&opts);
@@ -755,14 +821,18 @@ static void usage(FILE *out)
     fprintf(out,
             "meshcsg %d.%d.%d - exact CSG on closed triangle meshes\n"
             "usage:\n"
-            "  meshcsg check [-o FIXED] FILE...    validate meshes (.off .obj .stl .ply) or\n"
+            "  meshcsg check [--self-intersections] [-o FIXED] FILE...\n"
+            "                                      validate meshes (.off .obj .stl .ply) or\n"
             "                                      every leaf of a CSG file (.scad .csg);\n"
-            "                                      -o writes the (re-oriented) mesh\n"
+            "                                      -o writes the (re-oriented) mesh;\n"
+            "                                      --self-intersections: exact test too\n"
             "  meshcsg tree FILE.scad              print the parsed CSG tree\n"
             "  meshcsg convert IN OUT [--format F] convert between mesh formats\n"
             "  meshcsg intersect FILE.scad [-o C.obj] intersection curves of the leaves\n"
-            "  meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N]\n"
-            "                                      evaluate the CSG tree, write the result\n"
+            "  meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N] [--check-inputs]\n"
+            "                                      evaluate the CSG tree, write the result;\n"
+            "                                      --check-inputs: first test every leaf\n"
+            "                                      for self-intersections (exact)\n"
             "  meshcsg demo [-n SPHERES] [-o OUT]  evaluate the built-in scene (the paper's\n"
             "                                      ring with 200 spheres), print timings\n"
             "exit status: 0 ok, 1 a problem was found or an operation failed, 2 usage error\n",

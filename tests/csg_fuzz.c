@@ -1,0 +1,1130 @@
+/*
+ * Random CSG trees against an independent membership oracle (see csg_fuzz.h).
+ *
+ * Each case is a random tree of 5..100 leaves and depth at most 12 drawn from one 64-bit
+ * seed, of one of three families:
+ *  - free: cubes, spheres, cylinders and cones of low resolution under random rotations
+ *    and translations in a region of a few units, sometimes one shared model; some
+ *    leaves are exact copies of an earlier leaf, and some take an earlier leaf's exact
+ *    placement with another shape (shared vertices, near-coplanar faces);
+ *  - grid: axis-aligned boxes with small-integer corners under signed axis permutations
+ *    (mirrors included), a few axis-aligned cylinders and spheres on the grid, and exact
+ *    copies: coplanar faces, shared edges and vertices everywhere;
+ *  - tilted: grid leaves, each under one of a few integer similarity transforms (an
+ *    integer quaternion's rotation scaled by its squared norm, 9 or 3): all vertices are
+ *    integers, so faces of different leaves in general directions are exactly coplanar.
+ * Inner nodes are unions, intersections and differences of 2..4 children.
+ *
+ * The oracle never looks at the library's geometry code. At a few hundred sample points
+ * (uniform in the scene's box, uniform in the result's box, and just off random leaf
+ * faces) it computes the generalized winding number of every leaf and of the output mesh
+ * (solid angles by van Oosterom and Strackee, in double). A leaf contains the point when
+ * its winding number exceeds 1/2; the tree's booleans then say whether the result must
+ * contain it, and the output's winding number must be exactly that 0 or 1. Points where
+ * any winding number is not within 1e-3 of an integer are too close to a surface for
+ * double precision and are skipped; at least half of all points must be checked.
+ *
+ * Besides: mcsg_eval returns MCSG_OK; the output is a valid closed, oriented,
+ * edge-manifold mesh (mcsg_mesh_check) or empty, manifold by vertex index too; its
+ * volume is not negative and roughly matches the Monte Carlo estimate; its vertices lie
+ * in the scene's box; the provenance of every output triangle names a leaf and a face of
+ * it whose plane holds the triangle, with the face's orientation reversed exactly when
+ * the leaf is subtracted an odd number of times. A result may be edge-non-manifold only
+ * where two parts of it can touch exactly along an edge: in grid and tilted trees, and in
+ * trees with two copies of a leaf ((A | B) - (A & B) touches itself along the curve where
+ * the surfaces of A and B cross). Then every edge must still be used as often in each
+ * direction (closed and oriented).
+ *
+ * A failing case is shrunk (a subtree as the whole tree, a child removed, an operation
+ * replaced by one of its children) while it still fails, and printed as a CSG file.
+ */
+#include "csg_fuzz.h"
+#include "testlib.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define POINTS_PER_TREE 300
+#define NEAR_INTEGER 1e-3
+
+static const double PI = 3.14159265358979323846;
+
+/* ---------------------------------------------------------------------------------- */
+/* Random numbers                                                                      */
+
+static double uniform(uint64_t *rng) { return (double)(test_xorshift(rng) >> 11) * 0x1p-53; }
+
+static double uniform_in(uint64_t *rng, double lo, double hi)
+{
+    return lo + (hi - lo) * uniform(rng);
+}
+
+/* splitmix64: well-spread, nonzero xorshift states from consecutive case numbers. */
+uint64_t csg_mix_seed(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15u;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9u;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebu;
+    x ^= x >> 31;
+    return x ? x : 1;
+}
+
+double csg_now(void)
+{
+    struct timespec ts;
+    timespec_get(&ts, TIME_UTC);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Models                                                                              */
+
+typedef struct model {
+    const char *name;
+    mcsg_mesh mesh;
+    double center[3], radius; /* of its bounding box */
+} model;
+
+static model models[] = {{"cube.obj", {0}, {0}, 0},
+                         {"sphere1.obj", {0}, {0}, 0},
+                         {"cow.obj", {0}, {0}, 0}};
+#define MODEL_COUNT ((int)(sizeof models / sizeof models[0]))
+static bool models_loaded;
+
+static bool load_model(model *md)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    mcsg_error err;
+    if (mcsg_mesh_read(test_shared_model(md->name), MCSG_FORMAT_AUTO, NULL, &md->mesh,
+                       &err) != MCSG_OK || md->mesh.vertex_count == 0)
+        return false;
+    for (size_t v = 0; v < md->mesh.vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = md->mesh.vertices[3 * v + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
+        }
+    md->radius = 0;
+    for (int k = 0; k < 3; k++) {
+        md->center[k] = (lo[k] + hi[k]) / 2;
+        md->radius += (hi[k] - lo[k]) * (hi[k] - lo[k]) / 4;
+    }
+    md->radius = sqrt(md->radius);
+    return true;
+}
+
+bool csg_load_models(void)
+{
+    models_loaded = true;
+    for (int i = 0; i < MODEL_COUNT; i++)
+        models_loaded &= load_model(&models[i]);
+    return models_loaded;
+}
+
+void csg_free_models(void)
+{
+    for (int i = 0; i < MODEL_COUNT; i++)
+        mcsg_mesh_free(&models[i].mesh, NULL);
+    models_loaded = false;
+}
+
+const char *csg_model_name(int index) { return models[index].name; }
+
+/* ---------------------------------------------------------------------------------- */
+/* Random trees                                                                        */
+
+/* A uniformly random rotation (from a random unit quaternion) into m's 3x3 part. */
+static void random_rotation(uint64_t *rng, double m[12])
+{
+    double u1 = uniform(rng), u2 = 2 * PI * uniform(rng), u3 = 2 * PI * uniform(rng);
+    double x = sqrt(1 - u1) * sin(u2), y = sqrt(1 - u1) * cos(u2);
+    double z = sqrt(u1) * sin(u3), w = sqrt(u1) * cos(u3);
+    m[0] = 1 - 2 * (y * y + z * z), m[1] = 2 * (x * y - z * w), m[2] = 2 * (x * z + y * w);
+    m[4] = 2 * (x * y + z * w), m[5] = 1 - 2 * (x * x + z * z), m[6] = 2 * (y * z - x * w);
+    m[8] = 2 * (x * z - y * w), m[9] = 2 * (y * z + x * w), m[10] = 1 - 2 * (x * x + y * y);
+}
+
+/* A random signed permutation matrix (rotations and mirrors of the axes). */
+static void random_axis_map(uint64_t *rng, double m[12])
+{
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                    {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    const int *p = perms[test_random_int(rng, 0, 5)];
+    memset(m, 0, 12 * sizeof *m);
+    for (int row = 0; row < 3; row++)
+        m[4 * row + p[row]] = test_random_int(rng, 0, 1) ? 1 : -1;
+}
+
+static void place_model(uint64_t *rng, csg_leaf_spec *l)
+{
+    const model *md = &models[test_random_int(rng, 0, MODEL_COUNT - 1)];
+    double s = uniform_in(rng, 1.0, 2.0) / md->radius, c[3];
+    l->shape = CSG_MODEL;
+    l->model = (int)(md - models);
+    for (int row = 0; row < 3; row++) {
+        for (int k = 0; k < 3; k++)
+            l->m[4 * row + k] *= s;
+        c[row] = 0;
+    }
+    for (int row = 0; row < 3; row++)
+        for (int k = 0; k < 3; k++)
+            c[row] += l->m[4 * row + k] * md->center[k];
+    for (int row = 0; row < 3; row++)
+        l->m[4 * row + 3] -= c[row];
+}
+
+static void free_shape(uint64_t *rng, csg_leaf_spec *l)
+{
+    int pick = test_random_int(rng, 0, 99);
+    if (pick < 35) {
+        l->shape = CSG_CUBE;
+        for (int k = 0; k < 3; k++)
+            l->size[k] = uniform_in(rng, 0.5, 3.0);
+        l->center = test_random_int(rng, 0, 1);
+    } else if (pick < 65) {
+        l->shape = CSG_SPHERE;
+        l->r1 = uniform_in(rng, 0.5, 2.0);
+        l->fn = test_random_int(rng, 6, 12);
+    } else {
+        int cone = test_random_int(rng, 0, 9);
+        l->shape = CSG_CYLINDER;
+        l->h = uniform_in(rng, 0.5, 3.0);
+        l->r1 = uniform_in(rng, 0.3, 1.5);
+        l->r2 = cone < 2 ? 0 : cone < 4 ? l->r1 : uniform_in(rng, 0.3, 1.5);
+        if (cone == 9) /* upside-down cone */
+            l->r2 = l->r1, l->r1 = 0;
+        l->center = test_random_int(rng, 0, 1);
+        l->fn = test_random_int(rng, 3, 12);
+    }
+}
+
+void csg_free_leaf(uint64_t *rng, csg_leaf_spec *l)
+{
+    memset(l, 0, sizeof *l);
+    random_rotation(rng, l->m);
+    for (int k = 0; k < 3; k++)
+        l->m[4 * k + 3] = uniform_in(rng, -1.5, 1.5);
+    free_shape(rng, l);
+}
+
+/* Axis-aligned leaves with integer (or half-integer) coordinates in [0, 6]^3. */
+static void grid_leaf(uint64_t *rng, csg_leaf_spec *l)
+{
+    int pick = test_random_int(rng, 0, 99);
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    int corner[3];
+    memset(l, 0, sizeof *l);
+    random_axis_map(rng, l->m);
+    for (int k = 0; k < 3; k++)
+        corner[k] = test_random_int(rng, 0, 3);
+    if (pick < 75) {
+        l->shape = CSG_CUBE;
+        for (int k = 0; k < 3; k++)
+            l->size[k] = test_random_int(rng, 1, 3);
+        /* Move the mapped box's lowest corner to `corner`. */
+        for (int row = 0; row < 3; row++) {
+            lo[row] = 0;
+            for (int k = 0; k < 3; k++)
+                if (l->m[4 * row + k] < 0)
+                    lo[row] -= l->size[k];
+            l->m[4 * row + 3] = corner[row] - lo[row];
+        }
+        return;
+    }
+    if (pick < 90) {
+        static const int fns[] = {3, 4, 4, 6, 8, 12};
+        l->shape = CSG_CYLINDER;
+        l->h = test_random_int(rng, 1, 3);
+        l->r1 = 0.5 * test_random_int(rng, 1, 4);
+        l->r2 = test_random_int(rng, 0, 3) == 0 ? 0 : l->r1;
+        l->center = test_random_int(rng, 0, 1);
+        l->fn = fns[test_random_int(rng, 0, 5)];
+    } else {
+        l->shape = CSG_SPHERE;
+        l->r1 = 0.5 * test_random_int(rng, 2, 4);
+        l->fn = 4 + 2 * test_random_int(rng, 0, 2);
+    }
+    for (int row = 0; row < 3; row++)
+        l->m[4 * row + 3] = corner[row] + 1;
+}
+
+/* The rotation of the integer quaternion (w, x, y, z) scaled by w^2 + x^2 + y^2 + z^2:
+ * an integer matrix, exact in doubles. */
+static void integer_rotation(const int q[4], double r[9])
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    r[0] = w * w + x * x - y * y - z * z, r[1] = 2 * (x * y - w * z), r[2] = 2 * (x * z + w * y);
+    r[3] = 2 * (x * y + w * z), r[4] = w * w - x * x + y * y - z * z, r[5] = 2 * (y * z - w * x);
+    r[6] = 2 * (x * z - w * y), r[7] = 2 * (y * z + w * x), r[8] = w * w - x * x - y * y + z * z;
+}
+
+/* A grid leaf mapped by an integer similarity (norm 9: (1,2,2,0) and its relatives, or
+ * norm 3: (1,1,1,0)). Grid coordinates are multiples of 1/2 and the matrix entries are
+ * integers, so every vertex is exact and shared planes stay shared. */
+static void tilted_leaf(uint64_t *rng, csg_leaf_spec *l, int family_choice)
+{
+    static const int quats[2][3][4] = {{{1, 2, 2, 0}, {2, 1, 0, 2}, {0, 2, 1, 2}},
+                                       {{1, 1, 1, 0}, {1, 0, 1, 1}, {0, 1, 1, 1}}};
+    double r[9], m[12];
+    grid_leaf(rng, l);
+    integer_rotation(quats[family_choice][test_random_int(rng, 0, 2)], r);
+    memcpy(m, l->m, sizeof m);
+    for (int row = 0; row < 3; row++)
+        for (int col = 0; col < 4; col++)
+            l->m[4 * row + col] = r[3 * row] * m[col] + r[3 * row + 1] * m[4 + col] +
+                                  r[3 * row + 2] * m[8 + col];
+}
+
+static void random_leaves(csg_tree_spec *t, uint64_t *rng)
+{
+    int model_leaf = -1, tilt = test_random_int(rng, 0, 1);
+    if (t->family == CSG_FREE && models_loaded && test_random_int(rng, 0, 2) == 0)
+        model_leaf = test_random_int(rng, 0, t->leaf_count - 1);
+    for (int i = 0; i < t->leaf_count; i++) {
+        csg_leaf_spec *l = &t->leaves[i];
+        int copy = i > 0 ? test_random_int(rng, 0, 9) : 9;
+        if (i != model_leaf && copy == 0) {
+            *l = t->leaves[test_random_int(rng, 0, i - 1)]; /* an exact copy */
+        } else if (t->family == CSG_GRID) {
+            grid_leaf(rng, l);
+        } else if (t->family == CSG_TILTED) {
+            tilted_leaf(rng, l, tilt);
+        } else if (i == model_leaf) {
+            csg_free_leaf(rng, l);
+            place_model(rng, l);
+        } else if (copy == 1 && t->leaves[i - 1].shape != CSG_MODEL) {
+            /* Another shape at the previous leaf's exact placement. */
+            *l = t->leaves[i - 1];
+            free_shape(rng, l);
+        } else {
+            csg_free_leaf(rng, l);
+        }
+        t->nodes[i].kind = MCSG_NODE_LEAF;
+        t->nodes[i].leaf = i;
+    }
+}
+
+/* Joins the pending nodes into operations until one is left. Left-deep chains (take
+ * the first pending nodes) or random groups; a group that would exceed the depth limit
+ * is taken from the shallowest pending nodes instead. */
+static void random_operations(csg_tree_spec *t, uint64_t *rng)
+{
+    int pending[CSG_MAX_LEAVES], depth[CSG_MAX_NODES] = {0}, count = t->leaf_count;
+    bool chain = test_random_int(rng, 0, 3) == 0;
+    for (int i = 0; i < count; i++)
+        pending[i] = i;
+    t->node_count = t->leaf_count;
+    while (count > 1) {
+        int take = test_random_int(rng, 2, count < CSG_MAX_CHILDREN ? count : CSG_MAX_CHILDREN);
+        int op = test_random_int(rng, 0, 99), at, deepest = 0;
+        csg_node_spec *n = &t->nodes[t->node_count];
+        n->kind = op < 50   ? MCSG_NODE_UNION
+                  : op < 75 ? MCSG_NODE_DIFFERENCE
+                            : MCSG_NODE_INTERSECTION;
+        /* Mostly two operands for the shrinking operations, or little would be left. */
+        if (n->kind != MCSG_NODE_UNION && test_random_int(rng, 0, 3) != 0)
+            take = 2;
+        at = chain ? 0 : test_random_int(rng, 0, count - take);
+        for (int c = 0; c < take; c++)
+            deepest = depth[pending[at + c]] > deepest ? depth[pending[at + c]] : deepest;
+        if (deepest + 1 > CSG_MAX_DEPTH) {
+            /* The window of `take` pending nodes with the smallest maximal depth. */
+            int best = INT32_MAX;
+            for (int a = 0; a + take <= count; a++) {
+                int d = 0;
+                for (int c = 0; c < take; c++)
+                    d = depth[pending[a + c]] > d ? depth[pending[a + c]] : d;
+                if (d < best)
+                    best = d, at = a;
+            }
+            deepest = best;
+        }
+        n->child_count = take;
+        memcpy(n->children, pending + at, (size_t)take * sizeof *pending);
+        depth[t->node_count] = deepest + 1;
+        pending[at] = t->node_count++;
+        memmove(pending + at + 1, pending + at + take,
+                (size_t)(count - at - take) * sizeof *pending);
+        count -= take - 1;
+    }
+    t->root = pending[0];
+}
+
+void csg_random_tree(csg_tree_spec *t, uint64_t seed)
+{
+    uint64_t rng = seed;
+    int family = test_random_int(&rng, 0, 5);
+    memset(t, 0, sizeof *t);
+    t->seed = seed;
+    t->family = family < 3 ? CSG_FREE : family < 5 ? CSG_GRID : CSG_TILTED;
+    /* 5..100 leaves, small trees more often than large ones (cost grows with size). */
+    t->leaf_count = 5 + (int)((CSG_MAX_LEAVES - 5 + 1) * pow(uniform(&rng), 3.0));
+    random_leaves(t, &rng);
+    random_operations(t, &rng);
+}
+
+/* reach[i]: node i is in the tree. */
+static void reachable(const csg_tree_spec *t, bool reach[CSG_MAX_NODES])
+{
+    memset(reach, 0, CSG_MAX_NODES * sizeof *reach);
+    reach[t->root] = true;
+    for (int i = t->root; i >= 0; i--)
+        if (reach[i])
+            for (int c = 0; c < t->nodes[i].child_count; c++)
+                reach[t->nodes[i].children[c]] = true;
+}
+
+int csg_reachable_leaves(const csg_tree_spec *t)
+{
+    bool reach[CSG_MAX_NODES];
+    int n = 0;
+    reachable(t, reach);
+    for (int i = 0; i < t->node_count; i++)
+        n += reach[i] && t->nodes[i].kind == MCSG_NODE_LEAF;
+    return n;
+}
+
+/* Whether two leaves of the tree are exact copies. Then the result may touch itself
+ * along edges even in general position: (A | B) - (A & B) is non-manifold along the
+ * curve where the surfaces of A and B cross. */
+static bool has_copies(const csg_tree_spec *t)
+{
+    bool reach[CSG_MAX_NODES];
+    reachable(t, reach);
+    for (int i = 0; i < t->node_count; i++)
+        for (int j = 0; j < i; j++)
+            if (reach[i] && reach[j] && t->nodes[i].kind == MCSG_NODE_LEAF &&
+                t->nodes[j].kind == MCSG_NODE_LEAF &&
+                memcmp(&t->leaves[t->nodes[i].leaf], &t->leaves[t->nodes[j].leaf],
+                       sizeof(csg_leaf_spec)) == 0)
+                return true;
+    return false;
+}
+
+static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
+{
+    mcsg_resolution res = {l->fn, 0, 0};
+    switch (l->shape) {
+    case CSG_CUBE:
+        return mcsg_make_cube(l->size, l->center, NULL, out, err);
+    case CSG_SPHERE:
+        return mcsg_make_sphere(l->r1, res, NULL, out, err);
+    case CSG_CYLINDER:
+        return mcsg_make_cylinder(l->h, l->r1, l->r2, l->center, res, NULL, out, err);
+    case CSG_MODEL:
+        break;
+    }
+    return mcsg_mesh_copy(&models[l->model].mesh, NULL, out, err);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Printing a case as a CSG file                                                       */
+
+static void print_indent(FILE *f, int depth)
+{
+    for (int i = 0; i < depth; i++)
+        fputs("  ", f);
+}
+
+static void print_leaf(FILE *f, const csg_leaf_spec *l)
+{
+    const double *m = l->m;
+    fprintf(f, "multmatrix([[%.17g, %.17g, %.17g, %.17g], [%.17g, %.17g, %.17g, %.17g], "
+               "[%.17g, %.17g, %.17g, %.17g], [0, 0, 0, 1]]) ",
+            m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]);
+    switch (l->shape) {
+    case CSG_CUBE:
+        fprintf(f, "cube([%.17g, %.17g, %.17g], center = %s);\n", l->size[0], l->size[1],
+                l->size[2], l->center ? "true" : "false");
+        break;
+    case CSG_SPHERE:
+        fprintf(f, "sphere(r = %.17g, $fn = %d);\n", l->r1, l->fn);
+        break;
+    case CSG_CYLINDER:
+        fprintf(f, "cylinder(h = %.17g, r1 = %.17g, r2 = %.17g, center = %s, $fn = %d);\n",
+                l->h, l->r1, l->r2, l->center ? "true" : "false", l->fn);
+        break;
+    case CSG_MODEL:
+        fprintf(f, "import(\"%s\");\n", models[l->model].name);
+        break;
+    }
+}
+
+static void print_node(FILE *f, const csg_tree_spec *t, int node, int depth)
+{
+    const csg_node_spec *n = &t->nodes[node];
+    print_indent(f, depth);
+    if (n->kind == MCSG_NODE_LEAF) {
+        print_leaf(f, &t->leaves[n->leaf]);
+        return;
+    }
+    fprintf(f, "%s() {\n", n->kind == MCSG_NODE_UNION          ? "union"
+                           : n->kind == MCSG_NODE_INTERSECTION ? "intersection"
+                                                               : "difference");
+    for (int c = 0; c < n->child_count; c++)
+        print_node(f, t, n->children[c], depth + 1);
+    print_indent(f, depth);
+    fputs("}\n", f);
+}
+
+static const char *const family_names[] = {"free", "grid", "tilted"};
+
+void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
+{
+    fprintf(f, "// fuzz-csg: seed 0x%016" PRIx64 " family %s touching %s provenance %s; "
+            "%d leaves\n", t->seed, family_names[t->family],
+            t->family != CSG_FREE || has_copies(t) ? "yes" : "no", with_provenance ? "yes" : "no",
+            csg_reachable_leaves(t));
+    print_node(f, t, t->root, 0);
+}
+
+bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance)
+{
+    char family[16], touch[8], prov[8];
+    if (sscanf(text, "// fuzz-csg: seed %" SCNx64 " family %15s touching %7s provenance %7[a-z]",
+               seed, family, touch, prov) != 4)
+        return false;
+    *touching = strcmp(touch, "yes") == 0;
+    *with_provenance = strcmp(prov, "yes") == 0;
+    return true;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Geometry for the oracle                                                             */
+
+typedef struct box {
+    double lo[3], hi[3];
+} box;
+
+static box empty_box(void)
+{
+    box b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    return b;
+}
+
+static void box_add_mesh(box *b, const mcsg_mesh *m)
+{
+    for (size_t v = 0; v < m->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            double x = m->vertices[3 * v + k];
+            b->lo[k] = x < b->lo[k] ? x : b->lo[k];
+            b->hi[k] = x > b->hi[k] ? x : b->hi[k];
+        }
+}
+
+static bool box_contains(const box *b, const double p[3])
+{
+    return p[0] >= b->lo[0] && p[0] <= b->hi[0] && p[1] >= b->lo[1] && p[1] <= b->hi[1] &&
+           p[2] >= b->lo[2] && p[2] <= b->hi[2];
+}
+
+static void box_sample(uint64_t *rng, const box *b, double p[3])
+{
+    for (int k = 0; k < 3; k++)
+        p[k] = uniform_in(rng, b->lo[k], b->hi[k]);
+}
+
+static double box_volume(const box *b)
+{
+    return (b->hi[0] - b->lo[0]) * (b->hi[1] - b->lo[1]) * (b->hi[2] - b->lo[2]);
+}
+
+/* Solid angle of triangle abc seen from p (van Oosterom and Strackee 1983). */
+static double solid_angle(const double *a, const double *b, const double *c, const double *p)
+{
+    double ax = a[0] - p[0], ay = a[1] - p[1], az = a[2] - p[2];
+    double bx = b[0] - p[0], by = b[1] - p[1], bz = b[2] - p[2];
+    double cx = c[0] - p[0], cy = c[1] - p[1], cz = c[2] - p[2];
+    double la = sqrt(ax * ax + ay * ay + az * az), lb = sqrt(bx * bx + by * by + bz * bz);
+    double lc = sqrt(cx * cx + cy * cy + cz * cz);
+    double det = ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx);
+    double den = la * lb * lc + (ax * bx + ay * by + az * bz) * lc +
+                 (ax * cx + ay * cy + az * cz) * lb + (bx * cx + by * cy + bz * cz) * la;
+    return 2 * atan2(det, den);
+}
+
+/* Generalized winding number of a mesh at p; exactly 0 outside its bounding box. */
+static double winding(const mcsg_mesh *m, const box *b, const double p[3])
+{
+    double sum = 0;
+    if (!box_contains(b, p))
+        return 0;
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *tri = m->triangles + 3 * t;
+        sum += solid_angle(m->vertices + 3 * tri[0], m->vertices + 3 * tri[1],
+                           m->vertices + 3 * tri[2], p);
+    }
+    return sum / (4 * PI);
+}
+
+static bool near_integer(double w) { return fabs(w - nearbyint(w)) < NEAR_INTEGER; }
+
+static void cross(const double u[3], const double v[3], double out[3])
+{
+    out[0] = u[1] * v[2] - u[2] * v[1];
+    out[1] = u[2] * v[0] - u[0] * v[2];
+    out[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+static double dot(const double u[3], const double v[3])
+{
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+static double norm(const double u[3]) { return sqrt(dot(u, u)); }
+
+static void sub(const double *u, const double *v, double out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = u[k] - v[k];
+}
+
+/* Area normal (twice the area, outward for a counter-clockwise triangle). */
+static void triangle_normal(const mcsg_mesh *m, size_t t, double n[3])
+{
+    const uint32_t *tri = m->triangles + 3 * t;
+    double u[3], v[3];
+    sub(m->vertices + 3 * tri[1], m->vertices + 3 * tri[0], u);
+    sub(m->vertices + 3 * tri[2], m->vertices + 3 * tri[0], v);
+    cross(u, v, n);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Edge balance: closed and oriented, allowing edges shared by four or more faces       */
+
+static const double *sort_coords;
+
+static int compare_vertices(const void *a, const void *b)
+{
+    const double *p = sort_coords + 3 * *(const uint32_t *)a;
+    const double *q = sort_coords + 3 * *(const uint32_t *)b;
+    for (int k = 0; k < 3; k++)
+        if (p[k] != q[k])
+            return p[k] < q[k] ? -1 : 1;
+    return 0;
+}
+
+typedef struct edge_key {
+    uint32_t lo, hi;
+    int dir;
+} edge_key;
+
+static int compare_edges(const void *a, const void *b)
+{
+    const edge_key *e = a, *f = b;
+    if (e->lo != f->lo)
+        return e->lo < f->lo ? -1 : 1;
+    if (e->hi != f->hi)
+        return e->hi < f->hi ? -1 : 1;
+    return 0;
+}
+
+/* Number of edges (vertices identified by coordinates) not used equally often in both
+ * directions; *shared receives the number used by more than two triangles. */
+static size_t unbalanced_edges(const mcsg_mesh *m, size_t *shared)
+{
+    size_t nv = m->vertex_count, ne = 3 * m->triangle_count, bad = 0;
+    uint32_t *order = malloc((nv + 1) * sizeof *order), *canon = malloc((nv + 1) * sizeof *canon);
+    edge_key *edges = malloc((ne + 1) * sizeof *edges);
+    *shared = 0;
+    for (uint32_t v = 0; v < nv; v++)
+        order[v] = v;
+    sort_coords = m->vertices;
+    qsort(order, nv, sizeof *order, compare_vertices);
+    for (size_t i = 0; i < nv; i++)
+        canon[order[i]] = i > 0 && compare_vertices(&order[i - 1], &order[i]) == 0
+                              ? canon[order[i - 1]]
+                              : order[i];
+    for (size_t t = 0; t < m->triangle_count; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = canon[m->triangles[3 * t + k]];
+            uint32_t b = canon[m->triangles[3 * t + (k + 1) % 3]];
+            edge_key *e = &edges[3 * t + (size_t)k];
+            e->lo = a < b ? a : b;
+            e->hi = a < b ? b : a;
+            e->dir = a < b ? 1 : -1;
+        }
+    qsort(edges, ne, sizeof *edges, compare_edges);
+    for (size_t i = 0, j; i < ne; i = j) {
+        int sum = 0;
+        for (j = i; j < ne && compare_edges(&edges[i], &edges[j]) == 0; j++)
+            sum += edges[j].dir;
+        bad += sum != 0;
+        *shared += j - i > 2;
+    }
+    free(order);
+    free(canon);
+    free(edges);
+    return bad;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* One case                                                                            */
+
+static bool fail(csg_result *r, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->why, sizeof r->why, fmt, ap);
+    va_end(ap);
+    return false;
+}
+
+/* What the oracle knows of a tree: per node, the bounding box of a leaf and whether the
+ * node is subtracted an odd number of times on the way from the root. */
+typedef struct tree_facts {
+    const mcsg_tree *tree;
+    size_t node_count;
+    box *leaf_box;
+    int *polarity;
+    bool *reach;
+} tree_facts;
+
+static void free_facts(tree_facts *f)
+{
+    free(f->leaf_box);
+    free(f->polarity);
+    free(f->reach);
+}
+
+static bool gather_facts(const mcsg_tree *tree, tree_facts *f)
+{
+    size_t n = mcsg_tree_node_count(tree);
+    f->tree = tree;
+    f->node_count = n;
+    f->leaf_box = calloc(n + 1, sizeof *f->leaf_box);
+    f->polarity = calloc(n + 1, sizeof *f->polarity);
+    f->reach = calloc(n + 1, sizeof *f->reach);
+    if (!f->leaf_box || !f->polarity || !f->reach)
+        return false;
+    f->reach[mcsg_tree_root(tree)] = true;
+    f->polarity[mcsg_tree_root(tree)] = 1;
+    /* Children are created before their parents: one pass from the root down. */
+    for (size_t i = n; i-- > 0;) {
+        mcsg_node_kind kind = mcsg_tree_node_kind(tree, (mcsg_node_id)i);
+        if (!f->reach[i])
+            continue;
+        if (kind == MCSG_NODE_LEAF) {
+            f->leaf_box[i] = empty_box();
+            box_add_mesh(&f->leaf_box[i], mcsg_tree_leaf_mesh(tree, (mcsg_node_id)i));
+        }
+        for (size_t c = 0; c < mcsg_tree_child_count(tree, (mcsg_node_id)i); c++) {
+            mcsg_node_id k = mcsg_tree_child(tree, (mcsg_node_id)i, c);
+            f->reach[k] = true;
+            f->polarity[k] =
+                kind == MCSG_NODE_DIFFERENCE && c > 0 ? -f->polarity[i] : f->polarity[i];
+        }
+    }
+    return true;
+}
+
+/* Membership in the solid of a node at one point. Leaves are evaluated only when their
+ * membership matters (operations short-circuit), so that points near the surface of a
+ * leaf that does not matter there are not skipped. */
+typedef struct point_query {
+    const tree_facts *f;
+    const double *p;
+    bool clear; /* every winding number used was within NEAR_INTEGER of an integer */
+} point_query;
+
+static bool member(point_query *q, mcsg_node_id node)
+{
+    const mcsg_tree *t = q->f->tree;
+    size_t n = mcsg_tree_child_count(t, node);
+    switch (mcsg_tree_node_kind(t, node)) {
+    case MCSG_NODE_LEAF: {
+        const mcsg_mesh *m = mcsg_tree_leaf_mesh(t, node);
+        double w = m ? winding(m, &q->f->leaf_box[node], q->p) : 0;
+        q->clear = q->clear && near_integer(w);
+        return w > 0.5;
+    }
+    case MCSG_NODE_UNION:
+        for (size_t c = 0; c < n; c++)
+            if (member(q, mcsg_tree_child(t, node, c)))
+                return true;
+        return false;
+    case MCSG_NODE_INTERSECTION:
+        for (size_t c = 0; c < n; c++)
+            if (!member(q, mcsg_tree_child(t, node, c)))
+                return false;
+        return n > 0;
+    case MCSG_NODE_DIFFERENCE:
+        if (n == 0 || !member(q, mcsg_tree_child(t, node, 0)))
+            return false;
+        for (size_t c = 1; c < n; c++)
+            if (member(q, mcsg_tree_child(t, node, c)))
+                return false;
+        return true;
+    }
+    return false;
+}
+
+/* Provenance: a leaf of the tree, a face of it, the triangle in the face's plane, facing
+ * the face's way (reversed for subtracted leaves). */
+static bool check_provenance(const tree_facts *f, const mcsg_mesh *out,
+                             const mcsg_provenance *prov, double scale, csg_result *r)
+{
+    for (size_t k = 0; k < out->triangle_count; k++) {
+        const mcsg_provenance *p = &prov[k];
+        const mcsg_mesh *leaf;
+        const uint32_t *tri, *face;
+        double fn[3], on[3], longest = 0, fnorm, onorm;
+        if (p->leaf >= f->node_count ||
+            mcsg_tree_node_kind(f->tree, p->leaf) != MCSG_NODE_LEAF)
+            return fail(r, "triangle %zu: provenance leaf %" PRIu32 " is not a leaf", k,
+                        p->leaf);
+        leaf = mcsg_tree_leaf_mesh(f->tree, p->leaf);
+        if (!leaf || p->face >= leaf->triangle_count)
+            return fail(r, "triangle %zu: provenance face %" PRIu32 " of leaf %" PRIu32
+                        " out of range", k, p->face, p->leaf);
+        tri = out->triangles + 3 * k;
+        face = leaf->triangles + 3 * p->face;
+        triangle_normal(leaf, p->face, fn);
+        fnorm = norm(fn);
+        for (int c = 0; c < 3; c++) {
+            double d[3], e[3];
+            const double *v = out->vertices + 3 * tri[c];
+            sub(v, leaf->vertices + 3 * face[0], d);
+            if (fabs(dot(d, fn)) / fnorm > 1e-9 * scale)
+                return fail(r, "triangle %zu (%.17g %.17g %.17g ...) is %g off the plane of its "
+                            "provenance, face %" PRIu32 " of leaf %" PRIu32, k, v[0], v[1],
+                            v[2], fabs(dot(d, fn)) / fnorm, p->face, p->leaf);
+            sub(out->vertices + 3 * tri[(c + 1) % 3], v, e);
+            longest = norm(e) > longest ? norm(e) : longest;
+        }
+        /* Orientation, where rounding cannot have turned the triangle. */
+        triangle_normal(out, k, on);
+        onorm = norm(on);
+        if (onorm > 1e-9 * scale * longest &&
+            dot(on, fn) * f->polarity[p->leaf] <= 0.5 * onorm * fnorm)
+            return fail(r, "triangle %zu faces %s its provenance, face %" PRIu32
+                        " of leaf %" PRIu32 " (subtracted: %s)", k,
+                        dot(on, fn) > 0 ? "like" : "against", p->face, p->leaf,
+                        f->polarity[p->leaf] < 0 ? "yes" : "no");
+    }
+    return true;
+}
+
+/* The output mesh on its own: valid (closed, oriented, manifold by index where it is
+ * manifold by coordinates), touching only where allowed, not inverted, inside the box. */
+static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
+                       bool allow_touching, const box *scene, double scale, csg_result *r)
+{
+    mcsg_check_report report;
+    mcsg_error err;
+    box outbox = empty_box();
+    size_t defects;
+    if (out->triangle_count == 0)
+        return true;
+    if (mcsg_mesh_check(out, NULL, &report, &err) != MCSG_OK)
+        return fail(r, "mcsg_mesh_check: %s", err.message);
+    defects = test_index_manifold_defects(out);
+    /* Parts touching at a point or along an edge get their own vertex copies, so a
+     * geometrically valid output must be manifold by index too. (An edge where two
+     * wedges touch and whose ends each have a single umbrella cannot be split by copying
+     * vertices: such outputs fall under the shared-edge rule below.) */
+    if (defects > 0 && report.nonmanifold_edges == 0)
+        return fail(r, "output is not manifold by vertex index: %zu defects (edges not "
+                    "used once each way, vertices with several umbrellas)", defects);
+    if (!mcsg_check_report_is_valid(&report)) {
+        size_t shared, unbalanced = unbalanced_edges(out, &shared);
+        bool only_shared_edges =
+            report.nonmanifold_edges > 0 && report.boundary_edges == 0 &&
+            report.inconsistent_edges == 0 && report.degenerate_triangles == 0 &&
+            report.duplicate_triangles == 0 && report.out_of_range_indices == 0 &&
+            report.nonfinite_vertices == 0;
+        /* Rounding to doubles can flatten a thin exact triangle (zero area). The
+         * evaluator splits such triangles away and counts the few it cannot (both sides
+         * of an edge flat); only those are tolerated, if still closed and oriented. */
+        bool rounding_only = report.degenerate_triangles > 0 &&
+                             report.degenerate_triangles <= stats->rounding_flat_triangles &&
+                             report.boundary_edges == 0 && report.inconsistent_edges == 0 &&
+                             unbalanced == 0;
+        if (rounding_only)
+            r->rounding_artifacts = true;
+        else if (!allow_touching || !only_shared_edges || unbalanced > 0)
+            return fail(r, "invalid output (%zu triangles): %zu boundary, %zu non-manifold, "
+                        "%zu inconsistent, %zu unbalanced edges; %zu degenerate, %zu "
+                        "duplicate triangles; %zu non-finite vertices", out->triangle_count,
+                        report.boundary_edges, report.nonmanifold_edges,
+                        report.inconsistent_edges, unbalanced, report.degenerate_triangles,
+                        report.duplicate_triangles, report.nonfinite_vertices);
+        else
+            r->touching = true;
+    }
+    if (report.inverted)
+        return fail(r, "output is inverted (volume %g)", report.volume);
+    box_add_mesh(&outbox, out);
+    for (int k = 0; k < 3; k++)
+        if (outbox.lo[k] < scene->lo[k] - 1e-9 * scale ||
+            outbox.hi[k] > scene->hi[k] + 1e-9 * scale)
+            return fail(r, "output reaches out of the leaves' box along axis %d: [%.17g, "
+                        "%.17g] vs [%.17g, %.17g]", k, outbox.lo[k], outbox.hi[k],
+                        scene->lo[k], scene->hi[k]);
+    if (csg_self_check && out->triangle_count > 0) {
+        size_t pairs = 0;
+        mcsg_status st = mcsg_mesh_self_intersections(out, NULL, &pairs, NULL, &err);
+        if (st != MCSG_OK)
+            return fail(r, "mcsg_mesh_self_intersections: %s", err.message);
+        r->self_intersecting = pairs > 0;
+    }
+    return true;
+}
+
+/* A point for the oracle: uniform in the scene's box, in the result's box, or just off a
+ * random face of a random leaf, on either side. */
+static void sample_point(uint64_t *rng, int i, const tree_facts *f, const mcsg_node_id *leaves,
+                         int leaf_n, const box *scene, const box *outbox, bool empty_out,
+                         double scale, double p[3])
+{
+    int mode = i % 4;
+    if (mode <= 1 || (mode == 2 && empty_out)) {
+        box_sample(rng, scene, p);
+    } else if (mode == 2) {
+        box_sample(rng, outbox, p);
+    } else {
+        const mcsg_mesh *m = mcsg_tree_leaf_mesh(f->tree, leaves[test_random_int(rng, 0, leaf_n - 1)]);
+        size_t t = (size_t)(test_xorshift(rng) % m->triangle_count);
+        const uint32_t *tri = m->triangles + 3 * t;
+        double u = sqrt(uniform(rng)), v = uniform(rng), n[3];
+        double off = scale * pow(10, uniform_in(rng, -4, -2)) *
+                     (test_random_int(rng, 0, 1) ? 1 : -1);
+        triangle_normal(m, t, n);
+        for (int k = 0; k < 3; k++)
+            p[k] = (1 - u) * m->vertices[3 * tri[0] + k] +
+                   u * (1 - v) * m->vertices[3 * tri[1] + k] +
+                   u * v * m->vertices[3 * tri[2] + k] + off * n[k] / norm(n);
+    }
+}
+
+/* The oracle point by point, then the volume against its Monte Carlo estimate. */
+static bool check_points(const tree_facts *f, const tree_facts *claim, uint64_t seed,
+                         const mcsg_mesh *out, box scene, double scale, csg_result *r)
+{
+    uint64_t rng = csg_mix_seed(seed ^ 0x706f696e7473u);
+    mcsg_node_id *leaves = malloc((f->node_count + 1) * sizeof *leaves);
+    int leaf_n = 0;
+    size_t uniform_points = 0, uniform_inside = 0;
+    box outbox = empty_box();
+    double volume = test_signed_volume(out);
+    point_query q = {claim, NULL, true};
+    bool ok = true;
+    for (size_t i = 0; i < f->node_count; i++)
+        if (f->reach[i] && mcsg_tree_node_kind(f->tree, (mcsg_node_id)i) == MCSG_NODE_LEAF &&
+            mcsg_tree_leaf_mesh(f->tree, (mcsg_node_id)i)->triangle_count > 0)
+            leaves[leaf_n++] = (mcsg_node_id)i;
+    box_add_mesh(&outbox, out);
+    /* Sampling boxes slightly larger than the scene. */
+    for (int k = 0; k < 3; k++) {
+        double pad = 0.02 * (scene.hi[k] - scene.lo[k]);
+        scene.lo[k] -= pad, scene.hi[k] += pad;
+    }
+    for (int i = 0; i < POINTS_PER_TREE && ok && leaf_n > 0; i++) {
+        double p[3], w_out;
+        bool expect;
+        sample_point(&rng, i, f, leaves, leaf_n, &scene, &outbox, out->triangle_count == 0,
+                     scale, p);
+        r->points++;
+        q.p = p;
+        q.clear = true;
+        expect = member(&q, mcsg_tree_root(claim->tree));
+        if (!q.clear)
+            continue;
+        w_out = winding(out, &outbox, p);
+        if (!near_integer(w_out))
+            continue;
+        r->checked++;
+        r->inside += expect;
+        if (i % 4 <= 1) {
+            uniform_points++;
+            uniform_inside += expect;
+        }
+        if (nearbyint(w_out) != (expect ? 1 : 0))
+            ok = fail(r, "at (%.17g, %.17g, %.17g) the result's winding number is %.6f but "
+                      "the point is %s the tree's solid", p[0], p[1], p[2], w_out,
+                      expect ? "inside" : "outside");
+    }
+    free(leaves);
+    if (ok && 2 * r->checked < r->points)
+        ok = fail(r, "only %zu of %zu points were far enough from surfaces to check",
+                  r->checked, r->points);
+    /* Loose: five standard deviations plus 5% of the box. */
+    if (ok && uniform_points > 0) {
+        double frac = (double)uniform_inside / (double)uniform_points, vbox = box_volume(&scene);
+        double sigma = vbox * sqrt(frac * (1 - frac) / (double)uniform_points);
+        if (fabs(volume - vbox * frac) > 5 * sigma + 0.05 * vbox)
+            ok = fail(r, "output volume %g, Monte Carlo estimate %g (box %g, %zu of %zu "
+                      "points inside)", volume, vbox * frac, vbox, uniform_inside,
+                      uniform_points);
+    }
+    return ok;
+}
+
+bool csg_self_check;
+
+bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed,
+                    bool with_provenance, bool allow_touching, csg_result *r)
+{
+    tree_facts f = {0}, cf = {0};
+    mcsg_mesh out = {0};
+    mcsg_provenance *prov = NULL;
+    mcsg_eval_stats stats;
+    mcsg_error err;
+    mcsg_status st;
+    box scene = empty_box();
+    double scale = 1, t0;
+    bool ok;
+
+    memset(r, 0, sizeof *r);
+    if (!gather_facts(tree, &f) || (claim && !gather_facts(claim, &cf))) {
+        free_facts(&f);
+        free_facts(&cf);
+        return fail(r, "out of memory in the oracle");
+    }
+    for (size_t i = 0; i < f.node_count; i++)
+        if (f.reach[i] && mcsg_tree_node_kind(tree, (mcsg_node_id)i) == MCSG_NODE_LEAF)
+            for (int k = 0; k < 3; k++) {
+                scene.lo[k] = fmin(scene.lo[k], f.leaf_box[i].lo[k]);
+                scene.hi[k] = fmax(scene.hi[k], f.leaf_box[i].hi[k]);
+            }
+    for (int k = 0; k < 3; k++)
+        if (scene.lo[k] <= scene.hi[k])
+            scale = fmax(scale, fmax(fabs(scene.lo[k]), fabs(scene.hi[k])));
+
+    st = mcsg_eval(tree, NULL, &out, with_provenance ? &prov : NULL, &stats, &err);
+    if (st != MCSG_OK) {
+        ok = fail(r, "mcsg_eval: %s: %s", mcsg_status_string(st), err.message);
+    } else {
+        r->triangles = out.triangle_count;
+        r->dropped = stats.rounding_dropped_triangles;
+        r->eval_seconds = stats.seconds_total;
+        ok = check_mesh(&out, &stats, allow_touching, &scene, scale, r);
+        if (ok && test_signed_volume(&out) < -1e-9 * scale * scale * scale)
+            ok = fail(r, "negative output volume %g", test_signed_volume(&out));
+        if (ok && prov)
+            ok = check_provenance(&f, &out, prov, scale, r);
+        t0 = csg_now();
+        if (ok)
+            ok = check_points(&f, claim ? &cf : &f, seed, &out, scene, scale, r);
+        r->oracle_seconds = csg_now() - t0;
+    }
+    mcsg_free(prov, NULL);
+    mcsg_mesh_free(&out, NULL);
+    free_facts(&f);
+    free_facts(&cf);
+    return ok;
+}
+
+static mcsg_status build_tree(const csg_tree_spec *t, mcsg_tree **out, csg_result *r)
+{
+    mcsg_node_id id[CSG_MAX_NODES];
+    bool reach[CSG_MAX_NODES];
+    mcsg_error err;
+    mcsg_status st = mcsg_tree_create(NULL, out, &err);
+    reachable(t, reach);
+    for (int i = 0; i < t->node_count && st == MCSG_OK; i++) {
+        const csg_node_spec *n = &t->nodes[i];
+        if (!reach[i])
+            continue;
+        if (n->kind == MCSG_NODE_LEAF) {
+            mcsg_mesh mesh;
+            st = make_leaf_mesh(&t->leaves[n->leaf], &mesh, &err);
+            if (st == MCSG_OK)
+                st = mcsg_tree_add_leaf(*out, &mesh, t->leaves[n->leaf].m, NULL, &id[i], &err);
+            mcsg_mesh_free(&mesh, NULL);
+        } else {
+            mcsg_node_id kids[CSG_MAX_CHILDREN];
+            for (int c = 0; c < n->child_count; c++)
+                kids[c] = id[n->children[c]];
+            st = mcsg_tree_add_op(*out, n->kind, kids, (size_t)n->child_count, NULL, &id[i],
+                                  &err);
+        }
+    }
+    if (st == MCSG_OK)
+        st = mcsg_tree_set_root(*out, id[t->root], &err);
+    if (st != MCSG_OK)
+        fail(r, "building the tree: %s", err.message);
+    return st;
+}
+
+bool csg_run_case(const csg_tree_spec *t, const csg_tree_spec *claim, bool with_provenance,
+                  csg_result *r)
+{
+    mcsg_tree *tree = NULL, *claim_tree = NULL;
+    bool ok = false;
+    memset(r, 0, sizeof *r);
+    if (build_tree(t, &tree, r) == MCSG_OK && (!claim || build_tree(claim, &claim_tree, r) == MCSG_OK))
+        ok = csg_check_tree(tree, claim_tree, t->seed, with_provenance,
+                            t->family != CSG_FREE || has_copies(t), r);
+    mcsg_tree_free(tree);
+    mcsg_tree_free(claim_tree);
+    return ok;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Shrinking a failing case                                                            */
+
+/* Candidate reductions of t, numbered from 0; false when `which` is past the last. */
+static bool reduction(const csg_tree_spec *t, int which, csg_tree_spec *out)
+{
+    bool reach[CSG_MAX_NODES];
+    reachable(t, reach);
+    *out = *t;
+    /* A proper subtree as the whole tree. */
+    for (int i = 0; i < t->root; i++)
+        if (reach[i] && which-- == 0) {
+            out->root = i;
+            return true;
+        }
+    /* One child fewer. */
+    for (int i = 0; i <= t->root; i++) {
+        const csg_node_spec *n = &t->nodes[i];
+        if (!reach[i] || n->child_count < 2)
+            continue;
+        for (int c = 0; c < n->child_count; c++)
+            if (which-- == 0) {
+                csg_node_spec *m = &out->nodes[i];
+                memmove(m->children + c, m->children + c + 1,
+                        (size_t)(m->child_count - c - 1) * sizeof *m->children);
+                m->child_count--;
+                return true;
+            }
+    }
+    /* An operation child replaced by one of its own children. */
+    for (int i = 0; i <= t->root; i++) {
+        const csg_node_spec *n = &t->nodes[i];
+        if (!reach[i] || n->kind == MCSG_NODE_LEAF)
+            continue;
+        for (int c = 0; c < n->child_count; c++) {
+            const csg_node_spec *k = &t->nodes[n->children[c]];
+            for (int g = 0; g < k->child_count; g++)
+                if (which-- == 0) {
+                    out->nodes[i].children[c] = k->children[g];
+                    return true;
+                }
+        }
+    }
+    return false;
+}
+
+void csg_shrink(csg_tree_spec *t, bool with_provenance, double budget)
+{
+    double end = csg_now() + budget;
+    bool progress = true;
+    static csg_tree_spec smaller;
+    while (progress && csg_now() < end) {
+        csg_result r;
+        progress = false;
+        for (int which = 0; reduction(t, which, &smaller) && csg_now() < end; which++) {
+            if (!csg_run_case(&smaller, NULL, with_provenance, &r)) {
+                *t = smaller;
+                progress = true;
+                break;
+            }
+        }
+    }
+}

@@ -1,0 +1,106 @@
+/*
+ * Random CSG trees checked against an independent membership oracle: the generator,
+ * oracle and shrinker shared by test_eval_oracle (a fixed-seed slice in CTest, plus the
+ * saved regressions) and fuzz_csg (open-ended differential fuzzing, `make fuzz-csg`).
+ * See csg_fuzz.c for what is generated and what is checked.
+ */
+#ifndef MCSG_CSG_FUZZ_H
+#define MCSG_CSG_FUZZ_H
+
+#include "meshcsg.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#define CSG_MAX_LEAVES 100
+#define CSG_MAX_NODES (2 * CSG_MAX_LEAVES)
+#define CSG_MAX_CHILDREN 4
+#define CSG_MAX_DEPTH 12
+
+typedef enum csg_shape { CSG_CUBE, CSG_SPHERE, CSG_CYLINDER, CSG_MODEL } csg_shape;
+
+/* free: random primitives and models under random rigid motions, some leaves sharing
+ * another's placement; grid: axis-aligned boxes, cylinders and spheres with small
+ * integer coordinates (coplanar faces, shared edges and vertices everywhere); tilted:
+ * grid leaves under exact integer similarity transforms, so that planes in general
+ * directions are shared exactly. */
+typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED } csg_family;
+
+typedef struct csg_leaf_spec {
+    csg_shape shape;
+    double size[3];   /* cube */
+    double r1, r2, h; /* sphere: r1; cylinder: h, r1 at the bottom, r2 at the top */
+    int center;       /* cube, cylinder */
+    int fn;           /* sphere, cylinder */
+    int model;        /* index into the models */
+    double m[12];     /* row-major 3x4 placement */
+} csg_leaf_spec;
+
+typedef struct csg_node_spec {
+    mcsg_node_kind kind;
+    int leaf; /* index into leaves[] when kind == MCSG_NODE_LEAF */
+    int child_count;
+    int children[CSG_MAX_CHILDREN]; /* node indices, each smaller than this node's */
+} csg_node_spec;
+
+/* Nodes are listed children first; only those reachable from `root` are in the tree
+ * (shrinking a failing case drops some). */
+typedef struct csg_tree_spec {
+    uint64_t seed;
+    csg_family family;
+    int leaf_count, node_count, root;
+    csg_leaf_spec leaves[CSG_MAX_LEAVES];
+    csg_node_spec nodes[CSG_MAX_NODES];
+} csg_tree_spec;
+
+typedef struct csg_result {
+    char why[1024];             /* the first problem found */
+    size_t points, checked, inside;
+    size_t triangles, dropped;
+    double eval_seconds, oracle_seconds;
+    bool touching;              /* accepted edge-non-manifold output (shared edges) */
+    bool rounding_artifacts;    /* closed and oriented, but flat triangles left by rounding */
+    bool self_intersecting;     /* with csg_self_check: the rounded output intersects itself */
+} csg_result;
+
+/* When set, every output is also tested for self-intersections (counted, not failed:
+ * rounding to doubles may create them). */
+extern bool csg_self_check;
+
+/* Loads the shared models used by free trees (cube.obj, sphere1.obj, cow.obj); false if
+ * one cannot be read (free trees then use primitives only). */
+bool csg_load_models(void);
+void csg_free_models(void);
+const char *csg_model_name(int index);
+
+uint64_t csg_mix_seed(uint64_t x);
+double csg_now(void);
+
+/* A random tree of 5..100 leaves and depth at most CSG_MAX_DEPTH from the seed. */
+void csg_random_tree(csg_tree_spec *t, uint64_t seed);
+/* Leaves reachable from the root. */
+int csg_reachable_leaves(const csg_tree_spec *t);
+/* A random leaf of the free family (for hand-made cases). */
+void csg_free_leaf(uint64_t *rng, csg_leaf_spec *l);
+
+/* Evaluates `tree` and checks it: status, mesh validity (edge-non-manifold output only
+ * with allow_touching), provenance, membership at a few hundred points against the
+ * oracle evaluating `claim` (NULL: the same tree; same leaves, maybe other operations),
+ * volume. False with r->why on the first problem. */
+bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed,
+                    bool with_provenance, bool allow_touching, csg_result *r);
+/* The same for a spec (claim may be NULL). */
+bool csg_run_case(const csg_tree_spec *t, const csg_tree_spec *claim, bool with_provenance,
+                  csg_result *r);
+/* Greedy shrinking of a failing case for at most `budget` seconds. */
+void csg_shrink(csg_tree_spec *t, bool with_provenance, double budget);
+
+/* The case as a CSG file. The first line is a comment that csg_read_header parses:
+ * "// fuzz-csg: seed 0x... family F touching T provenance P". Models are imported by
+ * file name: parse with import paths relative to the shared models folder. */
+void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance);
+/* Parses that first line; false if it is not there. */
+bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance);
+
+#endif
