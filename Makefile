@@ -5,15 +5,19 @@
 #                   and a clang -Werror compile check
 #   make sanitize   only the ASan+UBSan build and suite
 #   make bench      Release build and the benchmarks in bench/
-#   make fuzz       libFuzzer (clang) on every parser for FUZZ_SECONDS each (default 60)
+#   make fuzz       libFuzzer (clang) on every parser and the evaluator for FUZZ_SECONDS
+#                   each (default 60)
+#   make fuzz-csg   differential CSG fuzzing against the winding-number oracle for SECONDS
+#                   (default 600); failures are saved under tests/data/csg-regressions/
 
 JOBS ?= 2
 MAKEFLAGS += --no-print-directory
 FUZZ_SECONDS ?= 60
+SECONDS ?= 600
 BUILD := build
 CMAKE_FLAGS := -DMCSG_WERROR=ON
 
-.PHONY: all demo test check sanitize clang-check bench fuzz deps clean
+.PHONY: all demo test check sanitize clang-check bench fuzz fuzz-csg deps clean
 
 all: demo
 
@@ -56,6 +60,11 @@ fuzz:
 	CC=clang cmake -S . -B $(BUILD)/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMCSG_FUZZ=ON $(CMAKE_FLAGS) >/dev/null
 	cmake --build $(BUILD)/fuzz -j $(JOBS)
 	bash fuzz/run.sh $(BUILD)/fuzz $(FUZZ_SECONDS)
+
+fuzz-csg: deps
+	CC=gcc cmake -S . -B $(BUILD)/test -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_FLAGS) >/dev/null
+	cmake --build $(BUILD)/test -j $(JOBS) --target fuzz_csg
+	MCSG_SHARED_DIR="$$(cd .. && pwd)/shared" ./$(BUILD)/test/tests/fuzz_csg $(SECONDS)
 
 clean:
 	rm -rf $(BUILD)

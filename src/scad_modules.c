@@ -358,6 +358,7 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
 {
     const mci_ctx *ctx = sc->ev.ctx;
     bool empty = t->degenerate || mesh->triangle_count == 0;
+    int call_len = (int)label->len; /* the call as written, e.g. import("a.off") */
     mcsg_status st;
     if (!mci_buf_printf(ctx, label, " at %s:%u:%u%s", sc->name, ca->stmt->line, ca->stmt->col,
                         !empty ? "" : t->degenerate ? " (empty: flattened by a transform)"
@@ -372,8 +373,9 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
             if (!isfinite(mesh->vertices[i])) {
                 mci_mesh_free(ctx, mesh);
                 return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err,
-                                    MCSG_ERR_PARSE, "%s(): vertex %zu is not finite%s",
-                                    ca->module, i / 3, is_identity(t->m) ? ""
+                                    MCSG_ERR_PARSE, "%.*s: vertex %zu is not finite%s",
+                                    call_len, (const char *)label->data, i / 3,
+                                    is_identity(t->m) ? ""
                                     : " after the transforms above it");
             }
         }

@@ -42,6 +42,47 @@ static int common_vertices(const mcsg_mesh *m, uint32_t s, uint32_t t)
     return n;
 }
 
+/* x between a and b (inclusive) along axis k, for explicit points. */
+static bool between(const double *a, const double *b, const double *x, int k)
+{
+    return (a[k] <= x[k] && x[k] <= b[k]) || (b[k] <= x[k] && x[k] <= a[k]);
+}
+
+/* Whether the closed segments pq and rs meet, all four points in one plane, seen along
+ * `axis` (the plane's projection axis: the projection is one to one). */
+static bool segments_meet(const double *p, const double *q, const double *r, const double *s,
+                          int axis)
+{
+    mci_point P, Q, R, S;
+    int i = (axis + 1) % 3, j = (axis + 2) % 3, o1, o2, o3, o4;
+    mci_point_explicit(&P, p);
+    mci_point_explicit(&Q, q);
+    mci_point_explicit(&R, r);
+    mci_point_explicit(&S, s);
+    o1 = mci_orient2d_projected(&P, &Q, &R, axis);
+    o2 = mci_orient2d_projected(&P, &Q, &S, axis);
+    o3 = mci_orient2d_projected(&R, &S, &P, axis);
+    o4 = mci_orient2d_projected(&R, &S, &Q, axis);
+    if (o1 * o2 < 0 && o3 * o4 < 0)
+        return true;
+    return (o1 == 0 && between(p, q, r, i) && between(p, q, r, j)) ||
+           (o2 == 0 && between(p, q, s, i) && between(p, q, s, j)) ||
+           (o3 == 0 && between(r, s, p, i) && between(r, s, p, j)) ||
+           (o4 == 0 && between(r, s, q, i) && between(r, s, q, j));
+}
+
+/* Coplanar triangles with disjoint interiors touch when two of their edges meet. */
+static bool coplanar_boundaries_meet(const double *const a[3], const double *const b[3],
+                                     const mci_plane *plane)
+{
+    int sign, axis = mci_plane_projection_axis(plane, &sign);
+    for (int e = 0; e < 3; e++)
+        for (int f = 0; f < 3; f++)
+            if (segments_meet(a[e], a[(e + 1) % 3], b[f], b[(f + 1) % 3], axis))
+                return true;
+    return false;
+}
+
 static bool pair_intersects(const mcsg_mesh *m, uint32_t s, uint32_t t)
 {
     const double *a[3] = {vertex(m, s, 0), vertex(m, s, 1), vertex(m, s, 2)};
@@ -66,7 +107,7 @@ static bool pair_intersects(const mcsg_mesh *m, uint32_t s, uint32_t t)
     case MCI_TT_SEGMENT:
         return shared < 2;
     case MCI_TT_COPLANAR:
-        return shared == 0 || r.overlap;
+        return r.overlap || (shared == 0 && coplanar_boundaries_meet(a, b, &ps));
     }
     return false;
 }

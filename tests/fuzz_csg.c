@@ -8,6 +8,8 @@
  * (or from the third argument) and are printed, so a run can be repeated.
  *
  * usage: fuzz_csg SECONDS [DIR [FIRST_SEED]]; exit status 1 if anything failed.
+ *        fuzz_csg print SEED   prints the tree of one seed as a CSG file (imports relative
+ *                              to the shared models folder).
  */
 #include "csg_fuzz.h"
 #include "testlib.h"
@@ -45,6 +47,13 @@ int main(int argc, char **argv)
     const char *dir = argc > 2 ? argv[2] : MCSG_REGRESSION_DIR;
     uint64_t first = argc > 3 ? strtoull(argv[3], NULL, 0) : (uint64_t)(start * 1e6);
     static csg_tree_spec t;
+    if (argc == 3 && strcmp(argv[1], "print") == 0) {
+        csg_load_models();
+        csg_random_tree(&t, strtoull(argv[2], NULL, 0));
+        csg_print_case(stdout, &t, false);
+        csg_free_models();
+        return 0;
+    }
     long trees = 0, failures = 0, leaves = 0, self_intersecting = 0;
     if (!csg_load_models())
         fprintf(stderr, "fuzz_csg: shared models missing: free trees use primitives only\n");

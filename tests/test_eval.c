@@ -367,6 +367,82 @@ TEST(allocation_failures_leak_nothing)
     mcsg_tree_free(tree);
 }
 
+/* A cube with one change: a triangle dropped, flipped, repeated, or a vertex moved. */
+static const double contract_cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
+                                         0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
+static const uint32_t contract_cube_t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                           1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+
+/* Evaluates union(cube(2), leaf) through the API; the status and message. */
+static mcsg_status eval_with_leaf(const mcsg_mesh *leaf, mcsg_error *err)
+{
+    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    double size[3] = {2, 2, 2};
+    mcsg_tree *tree;
+    mcsg_mesh cube, out;
+    mcsg_node_id ids[2], root;
+    mcsg_status st;
+    CHECK_OK(mcsg_tree_create(NULL, &tree, err), err);
+    CHECK_OK(mcsg_make_cube(size, 1, NULL, &cube, err), err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, &cube, identity, "big cube", &ids[0], err), err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, leaf, identity, "the leaf", &ids[1], err), err);
+    CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, &root, err), err);
+    CHECK_OK(mcsg_tree_set_root(tree, root, err), err);
+    st = mcsg_eval(tree, NULL, &out, NULL, NULL, err);
+    CHECK(st != MCSG_OK || out.triangle_count > 0);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_mesh_free(&cube, NULL);
+    mcsg_tree_free(tree);
+    return st;
+}
+
+static void expect_contract_error(const mcsg_mesh *leaf, const char *problem)
+{
+    mcsg_error err;
+    CHECK(eval_with_leaf(leaf, &err) == MCSG_ERR_INVALID_MESH);
+    CHECK_CONTAINS(err.message, "leaf 1, the leaf: ");
+    CHECK_CONTAINS(err.message, problem);
+}
+
+/* mcsg_eval checks every leaf against its input contract before any geometry and names
+ * the first that breaks it. */
+TEST(input_contract_is_checked)
+{
+    double v[24];
+    uint32_t t[39];
+    mcsg_mesh m = {v, t, 8, 12};
+    mcsg_error err;
+    memcpy(v, contract_cube_v, sizeof contract_cube_v);
+    memcpy(t, contract_cube_t, sizeof contract_cube_t);
+    CHECK_OK(eval_with_leaf(&m, &err), &err);
+    m.triangle_count = 11;
+    expect_contract_error(&m, "the surface is open: 3 boundary edges, e.g. from (");
+    m.triangle_count = 13;
+    memcpy(t + 36, t, 3 * sizeof *t);
+    expect_contract_error(&m, "non-manifold edges");
+    m.triangle_count = 12;
+    t[0] = 0, t[1] = 1, t[2] = 2; /* one triangle flipped */
+    expect_contract_error(&m, "not consistently oriented");
+    for (int i = 0; i < 12; i++) { /* all flipped */
+        t[3 * i] = contract_cube_t[3 * i];
+        t[3 * i + 1] = contract_cube_t[3 * i + 2];
+        t[3 * i + 2] = contract_cube_t[3 * i + 1];
+    }
+    expect_contract_error(&m, "inside out");
+    memcpy(t, contract_cube_t, sizeof contract_cube_t);
+    v[3 * 6] = NAN;
+    expect_contract_error(&m, "NaN or infinite coordinates, e.g. vertex 6");
+    v[3 * 6] = 1;
+    {
+        /* A tetrahedron whose bottom edge 0-1 has its midpoint 4 as a vertex, the gap
+         * closed by the zero-area triangle (0, 4, 1): closed and manifold, but flat. */
+        static const double tv[] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 2, 1, 0, 0};
+        static const uint32_t tt[] = {0, 2, 4, 4, 2, 1, 0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+        mcsg_mesh sliver = {(double *)tv, (uint32_t *)tt, 5, 6};
+        expect_contract_error(&sliver, "triangles of zero area (no plane), e.g. triangle 2");
+    }
+}
+
 int main(void)
 {
     RUN(box_scenes_have_exact_volumes);
@@ -379,5 +455,6 @@ int main(void)
     RUN(empty_and_trivial_trees);
     RUN(output_is_independent_of_memory_layout_and_threads);
     RUN(allocation_failures_leak_nothing);
+    RUN(input_contract_is_checked);
     return test_summary();
 }

@@ -717,7 +717,7 @@ TEST(bad_argument_types)
     expect_error("multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 0]]) cube(1);",
                  MCSG_ERR_PARSE, "t.scad:1:12:", "m[3][3] is 0");
     expect_error("scale(1e300) scale(1e300) cube(1);", MCSG_ERR_PARSE, "t.scad:1:27:",
-                 "cube(): vertex 0 is not finite after the transforms");
+                 "cube(size=[1, 1, 1], center=false): vertex 0 is not finite after the transforms");
     expect_error("translate([1e308, 0, 0]) translate([1e308, 0, 0]) cube(1);", MCSG_ERR_PARSE,
                  "t.scad:1:51:", "vertex 0 is not finite");
     expect_error("sphere(1, $fn=\"x\");", MCSG_ERR_PARSE, "t.scad:1:1:",
