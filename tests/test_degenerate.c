@@ -10,7 +10,10 @@
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+static int outputs, self_intersecting_outputs; /* after rounding to doubles (reported) */
 
 typedef struct outcome {
     mcsg_mesh mesh;
@@ -38,19 +41,27 @@ static bool solid(const char *text, bool touching, outcome *o)
               o->report.degenerate_triangles, o->report.duplicate_triangles);
     CHECK_MSG(test_index_manifold_defects(&o->mesh) == 0 || o->report.nonmanifold_edges > 0,
               "%s: not manifold by index", text);
+    if (o->mesh.triangle_count > 0) {
+        size_t pairs;
+        CHECK_OK(mcsg_mesh_self_intersections(&o->mesh, NULL, &pairs, NULL, &err), &err);
+        outputs++;
+        self_intersecting_outputs += pairs > 0;
+    }
     return true;
 }
 
-static double volume_of(const char *text)
+static double volume_touching(const char *text, bool touching)
 {
     outcome o;
     double v = NAN;
-    if (solid(text, false, &o)) {
+    if (solid(text, touching, &o)) {
         v = o.volume;
         mcsg_mesh_free(&o.mesh, NULL);
     }
     return v;
 }
+
+static double volume_of(const char *text) { return volume_touching(text, false); }
 
 static void expect_volume(const char *text, double expected, double rel)
 {
@@ -171,21 +182,65 @@ TEST(scales_and_far_from_the_origin)
               volume_of(text), base);
 }
 
-TEST(union_of_many_overlapping_spheres)
+/* n spheres of radius 1 ($fn = 16: 252 faces each) on a helix, sphere k from `first`. */
+static void sphere_helix(char *text, size_t size, int first, int n)
 {
-    static char text[65536];
-    size_t n = 0;
+    size_t len = (size_t)snprintf(text, size, "union() {");
+    for (int i = first; i < first + n; i++) /* each crosses several neighbours */
+        len += (size_t)snprintf(text + len, size - len,
+                                " translate([%.17g,%.17g,%.17g]) sphere(1, $fn=16);",
+                                6 * cos(i * 0.15), 6 * sin(i * 0.15), i * 0.02);
+    snprintf(text + len, size - len, " }");
+}
+
+/* 400 spheres (150 under the sanitizers): one solid, and |A u B| = |A| + |B| - |A n B| for
+ * the unions A, B of the two halves. */
+TEST(union_of_hundreds_of_overlapping_spheres)
+{
+    static char all[262144], a[131072], b[131072], both[270000];
+    int n = getenv("MCSG_SANITIZED") ? 150 : 400;
+    double va, vb, vn;
     outcome o;
-    n += (size_t)snprintf(text + n, sizeof text - n, "union() {");
-    for (int i = 0; i < 150; i++) /* a helix of spheres, each crossing several others */
-        n += (size_t)snprintf(text + n, sizeof text - n,
-                              " translate([%.17g,%.17g,%.17g]) sphere(1, $fn=10);",
-                              3 * cos(i * 0.3), 3 * sin(i * 0.3), i * 0.05);
-    snprintf(text + n, sizeof text - n, " }");
-    if (solid(text, false, &o)) {
-        CHECK(o.volume > 4.0 / 3 * 3.1 && o.volume < 150 * 4.2);
-        CHECK(o.report.components == 1);
+    sphere_helix(all, sizeof all, 0, n);
+    sphere_helix(a, sizeof a, 0, n / 2);
+    sphere_helix(b, sizeof b, n / 2, n - n / 2);
+    if (solid(all, false, &o)) {
+        CHECK_EQ_SIZE(o.report.components, 1);
+        CHECK(o.volume > 4.0 && o.volume < n * 4.2);
+        va = volume_of(a);
+        vb = volume_of(b);
+        snprintf(both, sizeof both, "intersection() { %s %s }", a, b);
+        vn = volume_of(both);
+        CHECK_MSG(fabs(o.volume - (va + vb - vn)) <= 1e-12 * o.volume,
+                  "%.17g vs %.17g + %.17g - %.17g", o.volume, va, vb, vn);
+        printf("  %d spheres: %zu output triangles, volume %.6f\n", n,
+               o.mesh.triangle_count, o.volume);
         mcsg_mesh_free(&o.mesh, NULL);
+    }
+}
+
+/* A real model minus a copy rotated by 1e-7 rad or moved by about an ulp of its
+ * coordinates: |A - B| + |A n B| = |A|, with thin slivers everywhere. */
+TEST(models_minus_nearly_identical_copies)
+{
+    static const char *const moves[] = {
+        "rotate(a=5.729577951308232e-6, v=[1,2,3])", "translate([1e-16, 2e-16, -1e-16])"};
+    char model[4300], moved[4500], diff[9000], inter[9000];
+    const char *names[] = {"cow.obj", "bunny.obj"};
+    for (int m = 0; m < 2; m++) {
+        double va, vd, vi;
+        snprintf(model, sizeof model, "import(\"%s\");", test_shared_model(names[m]));
+        snprintf(moved, sizeof moved, "%s %s", moves[m], model);
+        snprintf(diff, sizeof diff, "difference() { %s %s }", model, moved);
+        snprintf(inter, sizeof inter, "intersection() { %s %s }", model, moved);
+        /* Where the surface is parallel to the motion, the exact difference pinches to
+         * nothing: its parts may touch along edges there. */
+        va = volume_of(model);
+        vd = volume_touching(diff, true);
+        vi = volume_touching(inter, true);
+        CHECK_MSG(fabs(vd + vi - va) <= 1e-12 * va, "%s: %.17g + %.17g vs %.17g", names[m], vd,
+                  vi, va);
+        CHECK(vd < 1e-4 * va);
     }
 }
 
@@ -197,6 +252,9 @@ int main(void)
     RUN(needles_and_slivers);
     RUN(fans_of_cylinders_through_one_axis);
     RUN(scales_and_far_from_the_origin);
-    RUN(union_of_many_overlapping_spheres);
+    RUN(union_of_hundreds_of_overlapping_spheres);
+    RUN(models_minus_nearly_identical_copies);
+    printf("outputs self-intersecting after rounding to doubles: %d of %d\n",
+           self_intersecting_outputs, outputs);
     return test_summary();
 }
