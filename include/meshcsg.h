@@ -369,8 +369,8 @@ mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *nam
  * segments[2i+1]. The segments are the pieces of the curves where faces of different
  * leaves cross, and the edges of coplanar faces of other leaves clipped to each face, all
  * split at every point where they meet (triple points included). Each exact point
- * appears once, however many faces produced it; its coordinates are approximated in double precision (for display: the exactly
- * rounded output comes with evaluation). */
+ * appears once, however many faces produced it; its coordinates are the exact point's
+ * coordinates rounded to the nearest doubles. */
 typedef struct mcsg_curves {
     double *points;
     uint32_t *segments;
@@ -446,9 +446,11 @@ typedef struct mcsg_eval_stats {
  * edge-manifold, finite, without zero-area or repeated triangles. This is checked first;
  * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
  * (its label: file or primitive, and position in the CSG text) and an example of the
- * problem. Leaves must also not intersect themselves; that is not checked here (it costs
- * as much as an evaluation: see mcsg_mesh_self_intersections), and a self-intersecting
- * leaf gives an unspecified but valid mesh or MCSG_ERR_INVALID_MESH.
+ * problem. Leaves must also not intersect themselves; that is not checked up front (it
+ * costs about as much as an evaluation: see mcsg_mesh_self_intersections). With a
+ * self-intersecting leaf the result is unspecified (a mesh that may not be the intended
+ * set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal consistency check
+ * trips on it (see docs/robustness.md).
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
