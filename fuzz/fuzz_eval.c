@@ -24,6 +24,7 @@
  * DIR/leafN.off (each leaf as the tree holds it, transformed) and DIR/tree.scad importing
  * them, which `meshcsg eval DIR/tree.scad` evaluates; a failed check prints what it saw.
  */
+#include "fuzz_alloc.h"
 #include "meshcsg.h"
 
 #include <math.h>
@@ -35,41 +36,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-#define BUDGET ((size_t)256 << 20)
 #define MAX_LEAVES 8
-
-typedef struct budget {
-    size_t live;
-} budget;
-
-typedef union header {
-    size_t size;
-    max_align_t align;
-} header;
-
-static void *capped_realloc(void *user, void *ptr, size_t size)
-{
-    budget *b = user;
-    header *h = ptr ? (header *)ptr - 1 : NULL;
-    size_t old = h ? h->size : 0;
-    if (size > BUDGET || b->live - old + size > BUDGET)
-        return NULL;
-    h = realloc(h, sizeof *h + size);
-    if (!h)
-        return NULL;
-    b->live = b->live - old + size;
-    h->size = size;
-    return h + 1;
-}
-
-static void *capped_malloc(void *user, size_t size) { return capped_realloc(user, NULL, size); }
-
-static void capped_free(void *user, void *ptr)
-{
-    header *h = (header *)ptr - 1;
-    ((budget *)user)->live -= h->size;
-    free(h);
-}
 
 typedef struct reader {
     const uint8_t *data;
@@ -285,7 +252,7 @@ static mcsg_status build(reader *r, const mcsg_options *opts, mcsg_tree *tree, i
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    budget b = {0};
+    fuzz_budget b = {0};
     reader r = {data, size, 0};
     mcsg_options opts;
     mcsg_tree *tree = NULL;
@@ -294,11 +261,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     mcsg_error err;
     mcsg_status st;
     int valid = 1;
-    memset(&opts, 0, sizeof opts);
-    opts.allocator.malloc_fn = capped_malloc;
-    opts.allocator.realloc_fn = capped_realloc;
-    opts.allocator.free_fn = capped_free;
-    opts.allocator.user = &b;
+    opts = capped_options(&b);
     opts.threads = 1;
     st = mcsg_tree_create(&opts, &tree, NULL);
     if (st == MCSG_OK)

@@ -12,6 +12,7 @@
  * files is the mesh readers' business, fuzzed by their own targets. Replayed over
  * fuzz/corpus/scad/ by CTest (fuzz/replay_main.c).
  */
+#include "fuzz_alloc.h"
 #include "meshcsg.h"
 
 #include <stddef.h>
@@ -20,42 +21,6 @@
 #include <string.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-#define BUDGET ((size_t)256 << 20)
-
-typedef struct budget {
-    size_t live;
-} budget;
-
-/* Each block starts with a header holding its size, padded for any alignment. */
-typedef union header {
-    size_t size;
-    max_align_t align;
-} header;
-
-static void *capped_realloc(void *user, void *ptr, size_t size)
-{
-    budget *b = user;
-    header *h = ptr ? (header *)ptr - 1 : NULL;
-    size_t old = h ? h->size : 0;
-    if (size > BUDGET || b->live - old + size > BUDGET)
-        return NULL;
-    h = realloc(h, sizeof *h + size);
-    if (!h)
-        return NULL;
-    b->live = b->live - old + size;
-    h->size = size;
-    return h + 1;
-}
-
-static void *capped_malloc(void *user, size_t size) { return capped_realloc(user, NULL, size); }
-
-static void capped_free(void *user, void *ptr)
-{
-    header *h = (header *)ptr - 1;
-    ((budget *)user)->live -= h->size;
-    free(h);
-}
 
 static int contains(const uint8_t *data, size_t size, const char *word)
 {
@@ -87,18 +52,14 @@ static void check_tree(const mcsg_tree *tree)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    budget b = {0};
+    fuzz_budget b = {0};
     mcsg_options opts;
     mcsg_tree *tree = NULL;
     mcsg_error err;
     mcsg_status st;
     if (contains(data, size, "import"))
         return 0;
-    memset(&opts, 0, sizeof opts);
-    opts.allocator.malloc_fn = capped_malloc;
-    opts.allocator.realloc_fn = capped_realloc;
-    opts.allocator.free_fn = capped_free;
-    opts.allocator.user = &b;
+    opts = capped_options(&b);
     st = mcsg_scad_read_memory((const char *)data, size, "fuzz.scad", NULL, &opts, &tree, &err);
     if (st == MCSG_OK) {
         check_tree(tree);
