@@ -2,7 +2,8 @@
  * mcsg_eval against the winding-number oracle (csg_fuzz.c): the fixed-seed slice of the
  * differential CSG fuzzer, and every saved regression case.
  *
- * - random_trees: 30 trees from fixed seeds (MCSG_TEST_SCALE=k runs k times as many;
+ * - random_trees: 30 trees from fixed seeds, the first 15 under the sanitizers
+ *   (MCSG_TEST_SCALE=k runs k times as many;
  *   MCSG_TEST_SEED=0x... replays one seed and shrinks it if it fails, for up to 10
  *   minutes; MCSG_ORACLE_VERBOSE=1 prints a line per tree). Up to three failures are
  *   shrunk for 5 s each and printed as CSG files.
@@ -61,7 +62,8 @@ static void print_totals(const char *what, const totals *s, double seconds)
 TEST(random_trees)
 {
     const char *replay = getenv("MCSG_TEST_SEED");
-    int trees = replay ? 1 : (int)(30 * test_scale() + 0.5);
+    int base = getenv("MCSG_SANITIZED") ? 15 : 30; /* sanitizers: 3-5x slower */
+    int trees = replay ? 1 : (int)(base * test_scale() + 0.5);
     totals s = {0};
     double start = csg_now();
     static csg_tree_spec t;
