@@ -7,10 +7,11 @@
  *    internal error;
  *  - when every leaf is valid by construction (primitives and non-flat tetrahedra under
  *    finite transforms), the evaluation succeeds;
- *  - with such valid leaves, a result is closed and consistently oriented (every edge
- *    used as often in each direction, vertices identified by coordinates), has finite
- *    vertices, no repeated triangles, only the zero-area triangles the evaluator
- *    reports as left by rounding, and a volume that is not negative;
+ *  - with such valid leaves, a result has no boundary edge and no edge used twice in
+ *    the same direction (vertices identified by coordinates; edges where parts touch
+ *    may have four triangles), finite vertices, no repeated triangles, only the
+ *    zero-area triangles the evaluator reports as left by rounding, and it is not
+ *    inverted (the oracle test checks edge balance and membership in depth);
  *  - nothing is left allocated.
  *
  * Byte layout (missing bytes read as 0, so every input is meaningful):

@@ -41,8 +41,9 @@ void mci_big_sub(mci_big *r, const mci_big *a, const mci_big *b);
 void mci_big_mul(mci_big *r, const mci_big *a, const mci_big *b);
 int mci_big_sign(const mci_big *a);
 /* num / den * 2^exp2 rounded to the nearest double (ties to even), subnormal results
- * included; 0 if num = 0 or den = 0. The result must not overflow. Uses thread-local
- * scratch. */
+ * included; 0 if num = 0 or den = 0. Requires exp2 >= -1074 (the lsb exponent of a
+ * double: the unit of mci_big_from_double's integers) and a result that does not
+ * overflow. Uses thread-local scratch. */
 double mci_big_ratio_to_double(const mci_big *num, const mci_big *den, int exp2);
 
 /* Sign of (a-c) x (b-c) in 2D: +1 counter-clockwise, -1 clockwise, 0 collinear. Exact

@@ -386,7 +386,7 @@ double mci_big_ratio_to_double(const mci_big *num, const mci_big *den, int exp2)
         /* The result is below 2^-1021, where the unit is 2^-1074: round N/D 2^(exp2+1074)
          * to an integer directly (ties to even) instead of rounding twice. */
         shift = exp2 + 1074;
-        if (shift < -(int)(MCI_BIG_LIMBS * GMP_NUMB_BITS))
+        if (shift < 0) /* outside the contract (exp2 >= -1074): not reached by callers */
             return negative ? -0.0 : 0.0;
         int inexact = divide_shifted(num, den, shift, q, r, &rn);
         top = (uint64_t)q[0];

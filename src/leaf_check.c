@@ -100,6 +100,9 @@ static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *t
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
     opts.allocator = ctx->alloc;
+    opts.log = ctx->log;
+    opts.log_user = ctx->log_user;
+    opts.threads = ctx->threads;
     for (size_t k = 0; k < ptree->leaf_count; k++) {
         mcsg_node_id node = ptree->leaf_source[k];
         const char *label = mcsg_tree_node_label(tree, node);

@@ -100,8 +100,12 @@ static bool load_model(model *md)
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     mcsg_error err;
     if (mcsg_mesh_read(test_shared_model(md->name), MCSG_FORMAT_AUTO, NULL, &md->mesh,
-                       &err) != MCSG_OK || md->mesh.vertex_count == 0)
+                       &err) != MCSG_OK)
         return false;
+    if (md->mesh.vertex_count == 0) {
+        mcsg_mesh_free(&md->mesh, NULL);
+        return false;
+    }
     for (size_t v = 0; v < md->mesh.vertex_count; v++)
         for (int k = 0; k < 3; k++) {
             double x = md->mesh.vertices[3 * v + k];
@@ -310,7 +314,8 @@ static void random_leaves(csg_tree_spec *t, uint64_t *rng)
 
 /* Joins the pending nodes into operations until one is left. Left-deep chains (take
  * the first pending nodes) or random groups; a group that would exceed the depth limit
- * is taken from the shallowest pending nodes instead. */
+ * is taken from the shallowest pending nodes instead. The limit is a target, not a
+ * guarantee: when only deep nodes are left to join, the tree can be a level deeper. */
 static void random_operations(csg_tree_spec *t, uint64_t *rng)
 {
     int pending[CSG_MAX_LEAVES], depth[CSG_MAX_NODES] = {0}, count = t->leaf_count;
@@ -328,6 +333,10 @@ static void random_operations(csg_tree_spec *t, uint64_t *rng)
         /* Mostly two operands for the shrinking operations, or little would be left. */
         if (n->kind != MCSG_NODE_UNION && test_random_int(rng, 0, 3) != 0)
             take = 2;
+        /* Chains stop growing a few levels below the limit, so that the last joins of
+         * deep pending nodes still fit under it. */
+        if (chain && depth[pending[0]] >= CSG_MAX_DEPTH - 3)
+            chain = false;
         at = chain ? 0 : test_random_int(rng, 0, count - take);
         for (int c = 0; c < take; c++)
             deepest = depth[pending[at + c]] > deepest ? depth[pending[at + c]] : deepest;
@@ -913,6 +922,8 @@ static bool check_points(const tree_facts *f, const tree_facts *claim, uint64_t 
     double volume = test_signed_volume(out);
     point_query q = {claim, NULL, true};
     bool ok = true;
+    if (!leaves)
+        return fail(r, "out of memory in the oracle");
     for (size_t i = 0; i < f->node_count; i++)
         if (f->reach[i] && mcsg_tree_node_kind(f->tree, (mcsg_node_id)i) == MCSG_NODE_LEAF &&
             mcsg_tree_leaf_mesh(f->tree, (mcsg_node_id)i)->triangle_count > 0)
@@ -1111,16 +1122,28 @@ static bool reduction(const csg_tree_spec *t, int which, csg_tree_spec *out)
     return false;
 }
 
+/* Failures of the same kind start with the same words (up to the first number or
+ * parenthesis): a reduction must keep the failure it is shrinking, not find another. */
+static bool same_kind_of_failure(const char *a, const char *b)
+{
+    size_t n = strcspn(b, "0123456789(");
+    return strncmp(a, b, n) == 0;
+}
+
 void csg_shrink(csg_tree_spec *t, bool with_provenance, double budget)
 {
     double end = csg_now() + budget;
     bool progress = true;
     static csg_tree_spec smaller;
+    csg_result first;
+    if (csg_run_case(t, NULL, with_provenance, &first))
+        return; /* nothing to shrink */
     while (progress && csg_now() < end) {
         csg_result r;
         progress = false;
         for (int which = 0; reduction(t, which, &smaller) && csg_now() < end; which++) {
-            if (!csg_run_case(&smaller, NULL, with_provenance, &r)) {
+            if (!csg_run_case(&smaller, NULL, with_provenance, &r) &&
+                same_kind_of_failure(r.why, first.why)) {
                 *t = smaller;
                 progress = true;
                 break;

@@ -54,7 +54,7 @@ int main(int argc, char **argv)
         csg_free_models();
         return 0;
     }
-    long trees = 0, failures = 0, leaves = 0, self_intersecting = 0;
+    long trees = 0, failures = 0, leaves = 0, self_intersecting[3] = {0}, families[3] = {0};
     if (!csg_load_models())
         fprintf(stderr, "fuzz_csg: shared models missing: free trees use primitives only\n");
     csg_self_check = true;
@@ -67,9 +67,10 @@ int main(int argc, char **argv)
         csg_result r;
         csg_random_tree(&t, seed);
         trees++;
+        families[t.family]++;
         leaves += t.leaf_count;
         if (csg_run_case(&t, NULL, with_provenance, &r)) {
-            self_intersecting += r.self_intersecting;
+            self_intersecting[t.family] += r.self_intersecting;
             continue;
         }
         failures++;
@@ -77,9 +78,10 @@ int main(int argc, char **argv)
         save_case(dir, &t, with_provenance);
         fflush(stdout);
     }
-    printf("fuzz_csg: %ld trees (%ld leaves) in %.0f s, %ld failed, %ld outputs "
-           "self-intersecting after rounding\n", trees, leaves, csg_now() - start, failures,
-           self_intersecting);
+    printf("fuzz_csg: %ld trees (%ld free, %ld grid, %ld tilted; %ld leaves) in %.0f s, %ld "
+           "failed; outputs that intersect themselves: %ld free, %ld grid, %ld tilted\n", trees,
+           families[0], families[1], families[2], leaves, csg_now() - start, failures,
+           self_intersecting[0], self_intersecting[1], self_intersecting[2]);
     csg_free_models();
     return failures ? 1 : 0;
 }

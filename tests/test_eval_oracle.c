@@ -31,6 +31,7 @@ static double test_scale(void)
 
 typedef struct totals {
     int trees, failed, families[3], touching, rounded, self_intersecting, empty, max_leaves;
+    int self_by_family[3];
     size_t points, checked, inside, triangles, dropped;
     double eval_seconds, oracle_seconds;
 } totals;
@@ -51,11 +52,13 @@ static void print_totals(const char *what, const totals *s, double seconds)
 {
     printf("%s: %d trees (%d free, %d grid, %d tilted; up to %d leaves), %d failed: %zu points, "
            "%zu checked (%zu inside); %d empty results, %d with edges where solids touch, %d "
-           "with triangles flattened by rounding, %d self-intersecting after rounding; %zu "
+           "with triangles flattened by rounding, %d self-intersecting after rounding (free "
+           "%d, grid %d, tilted %d); %zu "
            "output triangles, %zu dropped by rounding; %.1f s (%.1f s in mcsg_eval, %.1f s in "
            "the oracle)\n", what, s->trees, s->families[0], s->families[1], s->families[2],
            s->max_leaves, s->failed, s->points, s->checked, s->inside, s->empty, s->touching,
-           s->rounded, s->self_intersecting, s->triangles, s->dropped, seconds,
+           s->rounded, s->self_intersecting, s->self_by_family[0], s->self_by_family[1],
+           s->self_by_family[2], s->triangles, s->dropped, seconds,
            s->eval_seconds, s->oracle_seconds);
 }
 
@@ -82,6 +85,7 @@ TEST(random_trees)
                    r.triangles, r.inside, r.checked, r.eval_seconds, r.oracle_seconds,
                    passed ? "" : ", FAILED");
         add_result(&s, &r);
+        s.self_by_family[t.family] += r.self_intersecting;
         CHECK_MSG(passed, "seed 0x%016" PRIx64 " (%d leaves%s): %s", seed, t.leaf_count,
                   with_provenance ? ", with provenance" : "", r.why);
         if (!passed && ++s.failed <= 3) {

@@ -149,6 +149,9 @@ static int check_mesh(const char *name, mcsg_mesh *m, const mcsg_options *opts, 
     }
     if (!mcsg_check_report_is_valid(&r)) {
         print_problems(name, m, &r);
+        /* The exact test needs only valid indices and finite coordinates. */
+        if (self && r.out_of_range_indices == 0 && r.nonfinite_vertices == 0)
+            check_self_intersections(name, m, opts);
         return 0;
     }
     if (r.volume_sign == 0) {
