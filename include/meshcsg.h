@@ -97,6 +97,10 @@ typedef struct mcsg_options {
                                  at once and must be thread-safe (malloc is) */
     mcsg_progress_fn progress; /* NULL: no progress reports */
     void *progress_user;       /* passed to progress */
+    int check_self_intersections; /* mcsg_eval: nonzero tests every leaf for
+                                     self-intersections before evaluating (exact, costs
+                                     about as much as an evaluation) and names the first
+                                     such leaf with MCSG_ERR_INVALID_MESH */
 } mcsg_options;
 
 /* Release a buffer returned by the library (e.g. from mcsg_mesh_write_memory).
@@ -446,8 +450,8 @@ typedef struct mcsg_eval_stats {
  * edge-manifold, finite, without zero-area or repeated triangles. This is checked first;
  * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
  * (its label: file or primitive, and position in the CSG text) and an example of the
- * problem. Leaves must also not intersect themselves; that is not checked up front (it
- * costs about as much as an evaluation: see mcsg_mesh_self_intersections). With a
+ * problem. Leaves must also not intersect themselves; that is checked up front only with
+ * opts->check_self_intersections (it costs about as much as an evaluation). With a
  * self-intersecting leaf the result is unspecified (a mesh that may not be the intended
  * set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal consistency check
  * trips on it (see docs/robustness.md).

@@ -27,6 +27,7 @@ typedef struct mci_ctx {
     int threads;
     mcsg_progress_fn progress;
     void *progress_user;
+    int check_self_intersections;
 } mci_ctx;
 
 /* Report the start (done = 0) or end (done = 1) of a step, if asked to. */

@@ -4,8 +4,8 @@
  * zero-area triangles (they have no plane) and facing outward. A leaf that breaks it is
  * named in a one-line message (its label says which file or primitive it came from, and
  * where in the CSG text) with the first offending edge, triangle or vertex, so that the
- * user can find it; nothing is evaluated. Self-intersecting leaves are not looked for up
- * front (that costs an intersection pass of its own); but when evaluation stops on an
+ * user can find it; nothing is evaluated. Self-intersecting leaves are looked for up
+ * front only when the options ask (that costs an intersection pass of its own); but when evaluation stops on an
  * internal consistency check, which a self-intersecting leaf can trip, the leaves are
  * tested then, and a leaf that intersects itself is named instead of reporting a bug.
  */
@@ -85,11 +85,17 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
                     label[0] ? ", " : "", label, problem);
 }
 
+static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
+                                          const mci_ptree *ptree, mcsg_error *err);
+
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mci_ptree *ptree,
                              mcsg_error *err)
 {
     leaf_check_job job = {tree, ptree, ctx};
-    return mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
+    mcsg_status st = mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
+    if (st == MCSG_OK && ctx->check_self_intersections)
+        st = find_self_intersecting(ctx, tree, ptree, err);
+    return st;
 }
 
 /* The first primitive that intersects itself, as an INVALID_MESH error; MCSG_OK if none

@@ -5,9 +5,10 @@
 #include "csgtree.h"
 
 /* MCSG_OK when every primitive of ptree is a closed, consistently oriented, outward,
- * edge-manifold mesh with finite coordinates and no zero-area or repeated triangles;
- * otherwise MCSG_ERR_INVALID_MESH naming the first such leaf (lowest primitive number)
- * and its first problem. */
+ * edge-manifold mesh with finite coordinates and no zero-area or repeated triangles (and,
+ * with ctx->check_self_intersections, does not intersect itself); otherwise
+ * MCSG_ERR_INVALID_MESH naming the first such leaf (lowest primitive number) and its
+ * first problem. */
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mci_ptree *ptree,
                              mcsg_error *err);
 

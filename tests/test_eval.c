@@ -374,7 +374,8 @@ static const uint32_t contract_cube_t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0
                                            1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
 
 /* Evaluates union(cube(2), leaf) through the API; the status and message. */
-static mcsg_status eval_with_leaf(const mcsg_mesh *leaf, mcsg_error *err)
+static mcsg_status eval_with_leaf_opts(const mcsg_mesh *leaf, const mcsg_options *opts,
+                                       mcsg_error *err)
 {
     static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     double size[3] = {2, 2, 2};
@@ -388,12 +389,17 @@ static mcsg_status eval_with_leaf(const mcsg_mesh *leaf, mcsg_error *err)
     CHECK_OK(mcsg_tree_add_leaf(tree, leaf, identity, "the leaf", &ids[1], err), err);
     CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, &root, err), err);
     CHECK_OK(mcsg_tree_set_root(tree, root, err), err);
-    st = mcsg_eval(tree, NULL, &out, NULL, NULL, err);
+    st = mcsg_eval(tree, opts, &out, NULL, NULL, err);
     CHECK(st != MCSG_OK || out.triangle_count > 0);
     mcsg_mesh_free(&out, NULL);
     mcsg_mesh_free(&cube, NULL);
     mcsg_tree_free(tree);
     return st;
+}
+
+static mcsg_status eval_with_leaf(const mcsg_mesh *leaf, mcsg_error *err)
+{
+    return eval_with_leaf_opts(leaf, NULL, err);
 }
 
 static void expect_contract_error(const mcsg_mesh *leaf, const char *problem)
@@ -440,6 +446,19 @@ TEST(input_contract_is_checked)
         static const uint32_t tt[] = {0, 2, 4, 4, 2, 1, 0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
         mcsg_mesh sliver = {(double *)tv, (uint32_t *)tt, 5, 6};
         expect_contract_error(&sliver, "triangles of zero area (no plane), e.g. triangle 2");
+    }
+    {
+        /* The corner (1, 1, 1) pushed through the bottom face: a positive volume, but the
+         * surface crosses itself; found only when the options ask for it. */
+        mcsg_options opts;
+        memset(&opts, 0, sizeof opts);
+        opts.check_self_intersections = 1;
+        v[3 * 6] = 0.5, v[3 * 6 + 1] = 0.5, v[3 * 6 + 2] = -0.2;
+        CHECK(eval_with_leaf_opts(&m, &opts, &err) == MCSG_ERR_INVALID_MESH);
+        CHECK_CONTAINS(err.message, "leaf 1, the leaf intersects itself: 6 pairs");
+        opts.check_self_intersections = 0;
+        v[3 * 6] = v[3 * 6 + 1] = v[3 * 6 + 2] = 1;
+        CHECK_OK(eval_with_leaf_opts(&m, &opts, &err), &err);
     }
 }
 

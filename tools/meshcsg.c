@@ -617,36 +617,11 @@ static void print_eval_stats(const mcsg_eval_stats *s)
     printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
 }
 
-/* --check-inputs: every leaf is tested for self-intersections before evaluation. */
-static int leaves_do_not_intersect_themselves(const mcsg_tree *tree, const mcsg_options *opts)
-{
-    for (mcsg_node_id id = 0; id < mcsg_tree_node_count(tree); id++) {
-        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, id);
-        size_t pairs;
-        uint32_t example[2];
-        mcsg_error err;
-        if (!leaf || leaf->triangle_count == 0)
-            continue;
-        if (mcsg_mesh_self_intersections(leaf, opts, &pairs, example, &err) != MCSG_OK) {
-            fprintf(stderr, "meshcsg: leaf %u, %s: %s\n", id, mcsg_tree_node_label(tree, id),
-                    err.message);
-            return 0;
-        }
-        if (pairs > 0) {
-            fprintf(stderr, "meshcsg: leaf %u, %s intersects itself: %zu pairs of its "
-                    "triangles cross or overlap, e.g. triangles %u and %u\n", id,
-                    mcsg_tree_node_label(tree, id), pairs, example[0], example[1]);
-            return 0;
-        }
-    }
-    return 1;
-}
-
 static int cmd_eval(int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     const char *in = NULL, *out = NULL;
-    int show_stats = 0, check_inputs = 0, ok;
+    int show_stats = 0, ok;
     mcsg_status st;
     mcsg_tree *tree;
     mcsg_mesh result;
@@ -658,7 +633,7 @@ static int cmd_eval(int argc, char **argv)
         else if (strcmp(argv[i], "--stats") == 0)
             show_stats = 1;
         else if (strcmp(argv[i], "--check-inputs") == 0)
-            check_inputs = 1;
+            opts.check_self_intersections = 1;
         else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc && atoi(argv[i + 1]) > 0)
             opts.threads = atoi(argv[++i]);
         else
@@ -671,10 +646,6 @@ static int cmd_eval(int argc, char **argv)
     }
     if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
-        return EXIT_PROBLEM;
-    }
-    if (check_inputs && !leaves_do_not_intersect_themselves(tree, &opts)) {
-        mcsg_tree_free(tree);
         return EXIT_PROBLEM;
     }
     start_progress(&opts);

@@ -60,8 +60,9 @@ contains 'warning: '
 contains 'import() is empty'
 contains '8 vertices, 12 triangles'
 
-# Self-intersecting leaves: found with --check-inputs (exact), before any evaluation.
-printf 'OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n-0.5 -0.5 -0.5\n0 1 1\n' > "$WORK/pushed.off"
+# Self-intersecting leaves (the corner (1, 1, 1) pushed through the bottom face: still a
+# positive volume): found with --check-inputs (exact), before any evaluation.
+printf 'OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n0.5 0.5 -0.2\n0 1 1\n' > "$WORK/pushed.off"
 cube_off | tail -n 12 >> "$WORK/pushed.off"
 printf 'union() { translate([5, 0, 0]) cube(1); import("pushed.off"); }\n' > "$WORK/case.scad"
 rm -f "$WORK/out.off"
