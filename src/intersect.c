@@ -79,27 +79,88 @@ static bool cache_planes(const mci_ctx *ctx, const mci_scene *s, const uint64_t 
     return true;
 }
 
+/* The pair tests run in fixed-size chunks, each with its own hit list; the lists are
+ * joined in chunk order, so the hits come out in pair order whatever the thread count. */
+#define PAIR_CHUNK 4096
+
+typedef struct pair_chunk {
+    hit_list hits;
+    size_t crossing, points, coplanar;
+} pair_chunk;
+
+typedef struct pair_job {
+    const mci_ctx *ctx;
+    const uint64_t *pairs;
+    size_t count;
+    const plane_cache *cache;
+    pair_chunk *chunks;
+} pair_job;
+
 /* Every coplanar pair is kept, touching or not: faces that only share an edge still
  * exchange the points on it. */
-static bool intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
-                            size_t count, hit_list *hits)
+static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    pair_job *j = user;
+    pair_chunk *c = &j->chunks[chunk];
+    size_t end = (chunk + 1) * PAIR_CHUNK < j->count ? (chunk + 1) * PAIR_CHUNK : j->count;
+    for (size_t i = chunk * PAIR_CHUNK; i < end; i++) {
+        uint32_t f = (uint32_t)(j->pairs[i] >> 32), g = (uint32_t)j->pairs[i];
+        mci_tt_result r;
+        mci_triangle_intersection(&j->cache->planes[j->cache->slot[f]],
+                                  &j->cache->planes[j->cache->slot[g]], &r);
+        c->crossing += r.kind == MCI_TT_SEGMENT;
+        c->points += r.kind == MCI_TT_POINT;
+        c->coplanar += r.kind == MCI_TT_COPLANAR && r.overlap;
+        if (r.kind != MCI_TT_DISJOINT && !push_hit(j->ctx, &c->hits, f, g, &r))
+            return mci_fail_nomem(err, "intersecting faces");
+    }
+    return MCSG_OK;
+}
+
+/* Moves the chunks' hits into *hits (in chunk order) and frees the chunks' lists. */
+static bool join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks, size_t n,
+                        hit_list *hits)
+{
+    size_t total = 0;
+    for (size_t c = 0; c < n; c++)
+        total += chunks[c].hits.count;
+    hits->v = mci_malloc_array(ctx, total + 1, sizeof *hits->v);
+    if (!hits->v)
+        return false;
+    hits->capacity = total + 1;
+    for (size_t c = 0; c < n; c++) {
+        if (chunks[c].hits.count)
+            memcpy(hits->v + hits->count, chunks[c].hits.v,
+                   chunks[c].hits.count * sizeof *hits->v);
+        hits->count += chunks[c].hits.count;
+        s->stats.intersecting_pairs += chunks[c].crossing;
+        s->stats.point_contacts += chunks[c].points;
+        s->stats.coplanar_pairs += chunks[c].coplanar;
+        mci_free(ctx, chunks[c].hits.v);
+        chunks[c].hits.v = NULL;
+    }
+    return true;
+}
+
+static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
+                                   size_t count, hit_list *hits, mcsg_error *err)
 {
     plane_cache cache = {NULL, NULL};
-    bool ok = cache_planes(ctx, s, pairs, count, &cache);
-    for (size_t i = 0; ok && i < count; i++) {
-        uint32_t f = (uint32_t)(pairs[i] >> 32), g = (uint32_t)pairs[i];
-        mci_tt_result r;
-        mci_triangle_intersection(&cache.planes[cache.slot[f]], &cache.planes[cache.slot[g]],
-                                  &r);
-        s->stats.intersecting_pairs += r.kind == MCI_TT_SEGMENT;
-        s->stats.point_contacts += r.kind == MCI_TT_POINT;
-        s->stats.coplanar_pairs += r.kind == MCI_TT_COPLANAR && r.overlap;
-        if (r.kind != MCI_TT_DISJOINT && !push_hit(ctx, hits, f, g, &r))
-            ok = false;
-    }
+    size_t n = (count + PAIR_CHUNK - 1) / PAIR_CHUNK;
+    pair_job job = {ctx, pairs, count, &cache, mci_calloc_array(ctx, n + 1, sizeof *job.chunks)};
+    mcsg_status st = job.chunks && cache_planes(ctx, s, pairs, count, &cache)
+                         ? MCSG_OK
+                         : mci_fail_nomem(err, "intersecting faces");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, n, intersect_chunk, &job, err);
+    if (st == MCSG_OK && !join_chunks(ctx, s, job.chunks, n, hits))
+        st = mci_fail_nomem(err, "intersecting faces");
+    for (size_t c = 0; job.chunks && c < n; c++)
+        mci_free(ctx, job.chunks[c].hits.v);
+    mci_free(ctx, job.chunks);
     mci_free(ctx, cache.slot);
     mci_free(ctx, cache.planes);
-    return ok;
+    return st;
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -420,38 +481,72 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
     return st;
 }
 
+/* Faces are arranged independently (each writes only its own arrs[k]), in parallel. */
+typedef struct arrange_job {
+    const mci_ctx *ctx;
+    mci_scene *s;
+    const hit_list *hits;
+    const uint32_t *start, *list, *face_of;
+    const face_facts *ff;
+} arrange_job;
+
+static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
+{
+    const arrange_job *j = user;
+    uint32_t f = j->face_of[k];
+    return arrange_face(j->ctx, j->s, f, j->hits, j->list + j->start[f],
+                        j->start[f + 1] - j->start[f], j->ff, &j->s->arrs[k], err);
+}
+
+static mcsg_status split_one(void *user, size_t k, mcsg_error *err)
+{
+    const arrange_job *j = user;
+    return mci_arr_split(j->ctx, &j->s->arrs[k], err);
+}
+
+/* arr_of, arr_count and face_of (arrangement index -> face) from the hit index. */
+static bool number_arranged_faces(const mci_ctx *ctx, mci_scene *s, const uint32_t *start,
+                                  uint32_t **face_of)
+{
+    s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
+    if (!s->arr_of)
+        return false;
+    for (uint32_t f = 0; f < s->face_count; f++) {
+        s->arr_of[f] = start[f + 1] > start[f] ? (uint32_t)s->arr_count++ : MCI_NONE;
+    }
+    *face_of = mci_malloc_array(ctx, s->arr_count + 1, sizeof **face_of);
+    s->arrs = mci_calloc_array(ctx, s->arr_count + 1, sizeof *s->arrs);
+    if (!*face_of || !s->arrs)
+        return false;
+    for (uint32_t f = 0; f < s->face_count; f++)
+        if (s->arr_of[f] != MCI_NONE)
+            (*face_of)[s->arr_of[f]] = f;
+    return true;
+}
+
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
                                       mcsg_error *err)
 {
-    uint32_t *start = NULL, *list = NULL;
+    uint32_t *start = NULL, *list = NULL, *face_of = NULL;
     face_facts ff = {NULL, NULL};
+    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff};
     mcsg_status st = MCSG_OK;
-    bool facts = compute_face_facts(ctx, s, hits, &ff);
-    s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
-    if (!facts || !s->arr_of || !index_hits(ctx, s, hits, &start, &list)) {
-        free_face_facts(ctx, &ff);
-        return mci_fail_nomem(err, "arranging faces");
-    }
-    for (uint32_t f = 0; f < s->face_count; f++)
-        s->arr_count += start[f + 1] > start[f];
-    s->arrs = mci_calloc_array(ctx, s->arr_count + 1, sizeof *s->arrs);
-    if (!s->arrs)
+    if (!compute_face_facts(ctx, s, hits, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
+        !number_arranged_faces(ctx, s, start, &face_of))
         st = mci_fail_nomem(err, "arranging faces");
-    for (uint32_t f = 0, k = 0; f < s->face_count; f++) {
-        s->arr_of[f] = MCI_NONE;
-        if (start[f + 1] == start[f] || st != MCSG_OK)
-            continue;
-        s->arr_of[f] = k;
-        st = arrange_face(ctx, s, f, hits, list + start[f], start[f + 1] - start[f],
-                          &ff, &s->arrs[k++], err);
-    }
+    job.start = start;
+    job.list = list;
+    job.face_of = face_of;
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, s->arr_count, arrange_one, &job, err);
     free_face_facts(ctx, &ff);
     mci_free(ctx, start);
     mci_free(ctx, list);
+    mci_free(ctx, face_of);
     if (st == MCSG_OK)
         st = share_edge_points(ctx, s, err);
-    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++)
-        st = mci_arr_split(ctx, &s->arrs[k], err);
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, s->arr_count, split_one, &job, err);
     return st;
 }
 
@@ -469,8 +564,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
         return st;
     t1 = mci_seconds_now();
     s->stats.candidate_pairs = count;
-    if (!intersect_pairs(ctx, s, pairs, count, &hits))
-        st = mci_fail_nomem(err, "intersecting faces");
+    st = intersect_pairs(ctx, s, pairs, count, &hits, err);
     mci_free(ctx, pairs);
     t2 = mci_seconds_now();
     if (st == MCSG_OK && !build_neighbours(ctx, s, &hits))

@@ -192,31 +192,34 @@ static bool check_duplicates(check_state *s)
     return true;
 }
 
-/* LSD radix sort of edge uses by key, 16 bits per pass; passes where every key has the
- * same digit are skipped. */
+/* LSD radix sort of edge uses by key; passes where every key has the same digit are
+ * skipped. Small meshes (most CSG leaves) use 8-bit digits: clearing a 16-bit count
+ * table four times costs more than sorting a few hundred edges. */
 static bool sort_edges(const mci_ctx *ctx, edge_use *items, size_t n)
 {
+    const int bits = n < 65536 ? 8 : 16;
+    const size_t digits = (size_t)1 << bits, mask = digits - 1;
     edge_use *tmp = mci_malloc_array(ctx, n, sizeof *tmp);
-    size_t *count = mci_malloc_array(ctx, 65536, sizeof *count);
+    size_t *count = mci_malloc_array(ctx, digits, sizeof *count);
     if (!tmp || !count) {
         mci_free(ctx, tmp);
         mci_free(ctx, count);
         return false;
     }
-    for (int shift = 0; shift < 64; shift += 16) {
+    for (int shift = 0; shift < 64; shift += bits) {
         size_t sum = 0;
-        memset(count, 0, 65536 * sizeof *count);
+        memset(count, 0, digits * sizeof *count);
         for (size_t i = 0; i < n; i++)
-            count[(items[i].key >> shift) & 0xffff]++;
-        if (n && count[(items[0].key >> shift) & 0xffff] == n)
+            count[(items[i].key >> shift) & mask]++;
+        if (n && count[(items[0].key >> shift) & mask] == n)
             continue;
-        for (size_t d = 0; d < 65536; d++) {
+        for (size_t d = 0; d < digits; d++) {
             size_t c = count[d];
             count[d] = sum;
             sum += c;
         }
         for (size_t i = 0; i < n; i++)
-            tmp[count[(items[i].key >> shift) & 0xffff]++] = items[i];
+            tmp[count[(items[i].key >> shift) & mask]++] = items[i];
         memcpy(items, tmp, n * sizeof *items);
     }
     mci_free(ctx, tmp);

@@ -587,11 +587,13 @@ static double peak_memory_mib(void)
 }
 
 /* The paper's Table 1 columns: faces, primitives, time per step and in total. */
-static void print_eval_stats(const mcsg_eval_stats *s)
+static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
 {
     const mcsg_intersect_stats *x = &s->intersect;
     printf("primitives %zu, faces %zu (min %zu, max %zu per primitive)\n", s->primitives,
            s->faces, s->faces_min, s->faces_max);
+    if (read_seconds >= 0)
+        printf("  read input       %8.3f s\n", read_seconds);
     printf("  positive tree    %8.3f s\n", s->seconds_tree);
     printf("  input check      %8.3f s\n", s->seconds_check);
     printf("  octree           %8.3f s  (%zu cells)\n", x->seconds_octree, x->cells);
@@ -614,7 +616,6 @@ static void print_eval_stats(const mcsg_eval_stats *s)
         printf("  touching parts: %zu vertices given separate copies\n",
                s->touching_vertices_split);
     printf("  total            %8.3f s\n", s->seconds_total);
-    printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
 }
 
 static int cmd_eval(int argc, char **argv)
@@ -622,6 +623,7 @@ static int cmd_eval(int argc, char **argv)
     mcsg_options opts = cli_options();
     const char *in = NULL, *out = NULL;
     int show_stats = 0, ok;
+    double read_seconds, write_seconds;
     mcsg_status st;
     mcsg_tree *tree;
     mcsg_mesh result;
@@ -644,10 +646,12 @@ static int cmd_eval(int argc, char **argv)
                 "[--check-inputs]\n");
         return EXIT_USAGE;
     }
+    read_seconds = now_seconds();
     if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
         return EXIT_PROBLEM;
     }
+    read_seconds = now_seconds() - read_seconds;
     start_progress(&opts);
     st = mcsg_eval(tree, &opts, &result, NULL, &stats, &err);
     stop_progress();
@@ -656,11 +660,16 @@ static int cmd_eval(int argc, char **argv)
         mcsg_tree_free(tree);
         return EXIT_PROBLEM;
     }
+    write_seconds = now_seconds();
     ok = !out || mcsg_mesh_write(out, MCSG_FORMAT_AUTO, &result, &opts, &err) == MCSG_OK;
+    write_seconds = now_seconds() - write_seconds;
     if (!ok)
         fail_line(&err);
-    if (show_stats)
-        print_eval_stats(&stats);
+    if (show_stats) {
+        print_eval_stats(&stats, read_seconds);
+        printf("  write output     %8.3f s\n", write_seconds);
+        printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
+    }
     else
         printf("%zu vertices, %zu triangles\n", result.vertex_count, result.triangle_count);
     mcsg_mesh_free(&result, &opts);
@@ -730,7 +739,8 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
         fail_line(&err);
         return 0;
     }
-    print_eval_stats(&st);
+    print_eval_stats(&st, -1);
+    printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
     ok = mcsg_mesh_check(&result, opts, &rep, &err) == MCSG_OK &&
          mcsg_check_report_is_valid(&rep);
     printf("result: %zu vertices, %zu triangles, %zu shells, volume %.15g (%s)\n",

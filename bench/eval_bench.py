@@ -1,0 +1,335 @@
+#!/usr/bin/env python3
+"""End-to-end benchmark of `meshcsg eval`: the paper's Table 1 / Table 2 scenes and ours.
+
+Each scene is a folder of OFF leaves and a tree.scad (the layout of
+../shared/scenes/make_scenes.py, whose generators are reused so that the reference
+volumes apply). Scenes are generated once into a cache folder. Every scene is then run as
+a whole process (parse + evaluate + write an OFF file), RUNS times on one thread and RUNS
+times on two, and the medians go into a Markdown table written between the markers
+<!-- eval-bench:begin --> and <!-- eval-bench:end --> of docs/benchmarks.md.
+
+usage: eval_bench.py MESHCSG SHARED_DIR CACHE_DIR DOC.md [--runs N] [--only a,b]
+"""
+import math
+import os
+import platform
+import random
+import re
+import statistics
+import subprocess
+import sys
+import time
+
+BEGIN, END = '<!-- eval-bench:begin -->', '<!-- eval-bench:end -->'
+GENERATOR_VERSION = '1'
+
+# Targets of issue 7: whole process, one thread, seconds.
+TARGETS = {
+    'ring_spheres_800': 0.5, 'spheres_overlap_700': 0.5, 'cow100K_minus_shifted': 0.4,
+    'armadillo_union_6bunnies': 0.6, 'cylinder_28_holes': 0.1, 'bunny_and_bunny_same': 0.1,
+    'box_grid_8': 0.02,
+}
+MEMORY_TARGET = 250  # bytes per input face
+
+
+def icosphere(centre, radius, rot):
+    """A level-2 icosphere (320 faces), rotated by the matrix rot, outward oriented."""
+    t = (1 + 5 ** 0.5) / 2
+    v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+         (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    f = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+         (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+         (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    unit = lambda p: tuple(c / math.sqrt(sum(x * x for x in p)) for c in p)
+    v = [unit(p) for p in v]
+    for _ in range(2):
+        v, f = subdivide((v, f), unit)
+    out = []
+    for p in v:
+        q = [sum(rot[i][j] * p[j] for j in range(3)) for i in range(3)]
+        out.append(tuple(centre[i] + radius * q[i] for i in range(3)))
+    return out, f
+
+
+def subdivide(mesh, project=lambda p: p):
+    """Split every triangle into four at its edge midpoints (shared between neighbours)."""
+    v, f = mesh
+    v = list(v)
+    mid = {}
+
+    def midpoint(a, b):
+        key = (a, b) if a < b else (b, a)
+        if key not in mid:
+            mid[key] = len(v)
+            v.append(project(tuple((v[a][i] + v[b][i]) / 2 for i in range(3))))
+        return mid[key]
+
+    out = []
+    for a, b, c in f:
+        ab, bc, ca = midpoint(a, b), midpoint(b, c), midpoint(c, a)
+        out += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+    return v, out
+
+
+def random_rotation(rnd):
+    """A rotation matrix from a random unit quaternion."""
+    q = [rnd.gauss(0, 1) for _ in range(4)]
+    n = math.sqrt(sum(x * x for x in q))
+    w, x, y, z = (c / n for c in q)
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def spheres_overlap(count=700, seed=7):
+    """`count` icospheres of radius 1 on a jittered grid of spacing 1.5: every sphere
+    crosses its (up to six) axis neighbours."""
+    rnd = random.Random(seed)
+    nx, ny = 10, 10
+    meshes = []
+    for k in range(count):
+        i, j, l = k % nx, (k // nx) % ny, k // (nx * ny)
+        c = tuple(1.5 * g + rnd.uniform(-0.15, 0.15) for g in (i, j, l))
+        meshes.append(icosphere(c, rnd.uniform(0.95, 1.05), random_rotation(rnd)))
+    return meshes, ['union'] + list(range(count))
+
+
+def model_minus_shifted(ms, models, name, levels=0):
+    m = ms.normalize(ms.read_obj(os.path.join(models, name)))
+    for _ in range(levels):
+        m = subdivide(m)
+    return [m, ms.transform(m, 1.0, (0.7, 0.4, 0.3), 0.05)], ['difference', 0, 1]
+
+
+def scene_builders(ms, models):
+    """(name, builder, note) in table order."""
+    out = []
+    for n in range(100, 900, 100):
+        out.append(('ring_spheres_%d' % n, lambda n=n: ms.ring_spheres(n), 'Table 2'))
+    out.append(('cylinder_28_holes', ms.cylinder_holes, 'Table 1 no. 5'))
+    out.append(('box_grid_8', ms.box_grid, 'plate - holes + bars'))
+    model = {}
+
+    def from_models(name):
+        if not model:
+            for scene, meshes, tree in ms.model_scenes(models):
+                model[scene] = (meshes, tree)
+        return model[name]
+    for name in ('armadillo_union_6bunnies', 'cow100K_minus_shifted', 'bunny100k_minus_shifted',
+                 'bunny_and_bunny_same'):
+        out.append((name, lambda name=name: from_models(name), 'model'))
+    out.append(('spheres_overlap_700', spheres_overlap, '700 x 320 faces'))
+    for faces in ('25k', '50k'):
+        out.append(('bunny%s_minus_shifted' % faces,
+                    lambda f=faces: model_minus_shifted(ms, models, 'bunny%s.obj' % f),
+                    'scaling'))
+    out.append(('bunny400k_minus_shifted',
+                lambda: model_minus_shifted(ms, models, 'bunny100k.obj', 1), 'scaling'))
+    out.append(('bunny1600k_minus_shifted',
+                lambda: model_minus_shifted(ms, models, 'bunny100k.obj', 2), 'scaling, 3.2M'))
+    return out
+
+
+def ensure_scene(ms, cache, name, build):
+    d = os.path.join(cache, name)
+    stamp = os.path.join(d, 'generator-version')
+    if os.path.exists(stamp) and open(stamp).read() == GENERATOR_VERSION:
+        return d
+    sys.stderr.write('generating %s\n' % name)
+    meshes, tree = build()
+    ms.emit(cache, name, meshes, tree)
+    open(stamp, 'w').write(GENERATOR_VERSION)
+    return d
+
+
+STEP_LINE = re.compile(r'^\s+([a-z ]+?)\s{2,}([0-9.]+) s')
+HEAD_LINE = re.compile(r'primitives (\d+), faces (\d+) \(min (\d+), max (\d+)')
+
+
+def run_once(meshcsg, scene_dir, out, threads):
+    """One whole-process run: (wall seconds, peak RSS bytes, stats dict)."""
+    cmd = [meshcsg, 'eval', os.path.join(scene_dir, 'tree.scad'), '-o', out, '--stats',
+           '--threads', str(threads)]
+    start = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    stdout, stderr = proc.communicate()
+    wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        sys.exit('%s failed: %s' % (' '.join(cmd), stderr.decode().strip()))
+    rss = 0
+    stats = {}
+    for line in stdout.decode().splitlines():
+        m = STEP_LINE.match(line)
+        if m:
+            stats[m.group(1)] = float(m.group(2))
+        m = HEAD_LINE.search(line)
+        if m:
+            stats['primitives'], stats['faces'], stats['min'], stats['max'] = map(
+                int, m.groups())
+        m = re.search(r'\((\d+) vertices, (\d+) triangles\)', line)
+        if m and line.strip().startswith('assemble'):
+            stats['out_triangles'] = int(m.group(2))
+        m = re.search(r'peak memory\s+([0-9.]+) MiB', line)
+        if m:
+            rss = float(m.group(1)) * 1048576
+    return wall, rss, stats
+
+
+def check_output(meshcsg, out):
+    """(volume, shells, message) of the result, by `meshcsg check`."""
+    res = subprocess.run([meshcsg, 'check', out], capture_output=True, text=True)
+    m = re.search(r'ok: .* (\d+) components?, volume ([-0-9.e+]+)', res.stdout)
+    if res.returncode != 0 or not m:
+        return None, None, (res.stdout + res.stderr).strip()
+    return float(m.group(2)), int(m.group(1)), 'ok'
+
+
+def references(shared):
+    ref = {}
+    path = os.path.join(shared, 'scenes', 'reference.tsv')
+    for line in open(path).read().splitlines()[1:]:
+        name, faces, volume, shells = line.split('\t')
+        ref[name] = (float(volume), int(shells))
+    return ref
+
+
+STEPS = {  # the paper's steps: 1 octree, 2 intersection, 3 classification
+    1: ('octree',),
+    2: ('candidate pairs', 'intersect', 'arrange faces', 'number points'),
+    3: ('triangulate', 'classify', 'assemble'),
+}
+
+
+def measure(meshcsg, scene_dir, runs, tmp):
+    out = os.path.join(tmp, 'result.off')
+    one = [run_once(meshcsg, scene_dir, out, 1) for _ in range(runs)]
+    two = [run_once(meshcsg, scene_dir, out, 2) for _ in range(runs)]
+    volume, shells, message = check_output(meshcsg, out)
+    med = lambda xs: statistics.median(xs)
+    stats = one[0][2]
+    row = {
+        'faces': stats['faces'], 'min': stats['min'], 'max': stats['max'],
+        'primitives': stats['primitives'], 'out': stats.get('out_triangles', 0),
+        'total': med([w for w, _, _ in one]), 'total2': med([w for w, _, _ in two]),
+        'memory': med([r for _, r, _ in one]),
+        'volume': volume, 'shells': shells, 'check': message,
+    }
+    for step, names in STEPS.items():
+        row['step%d' % step] = med([sum(s.get(n, 0) for n in names) for _, _, s in one])
+    row['io'] = med([w - s.get('total', 0) for w, _, s in one])
+    row['check_inputs'] = med([s.get('input check', 0) + s.get('positive tree', 0)
+                               for _, _, s in one])
+    return row
+
+
+def fmt_faces(n):
+    return '%.1fK' % (n / 1000) if n < 1e6 else '%.2fM' % (n / 1e6)
+
+
+def machine():
+    cpu = 'unknown CPU'
+    for line in open('/proc/cpuinfo'):
+        if line.startswith('model name'):
+            cpu = line.split(':', 1)[1].strip()
+            break
+    mem = 0
+    for line in open('/proc/meminfo'):
+        if line.startswith('MemTotal'):
+            mem = int(line.split()[1]) / 1048576
+    cc = subprocess.run(['cc', '--version'], capture_output=True, text=True).stdout
+    return '%s, %d cores visible, %.0f GiB; %s; %s' % (
+        cpu, os.cpu_count(), mem, cc.splitlines()[0] if cc else 'cc ?', platform.platform())
+
+
+def table(rows, refs, runs):
+    lines = [
+        '| scene | faces total | min | max | primitives | total (1 thread) | step 1 | step 2 '
+        '| step 3 | check + I/O | peak memory | bytes/face | output faces | 2 threads '
+        '| speed-up | target | result |',
+        '|' + '---|' * 17,
+    ]
+    for name, note, r in rows:
+        target = TARGETS.get(name)
+        ref = refs.get(name)
+        if r['check'] != 'ok':
+            result = 'INVALID: ' + r['check']
+        elif ref:
+            same = abs(r['volume'] - ref[0]) <= 1e-9 * abs(ref[0]) and r['shells'] == ref[1]
+            result = ('matches reference' if same else
+                      'MISMATCH: volume %.12g shells %d' % (r['volume'], r['shells']))
+        else:
+            result = 'closed, volume %.10g, %d shells' % (r['volume'], r['shells'])
+        per_face = r['memory'] / r['faces']
+        target_text = '-' if target is None else '%s %g s' % (
+            'met' if r['total'] <= target else 'MISSED', target)
+        lines.append(
+            '| %s (%s) | %s | %d | %d | %d | %.3f s | %.3f | %.3f | %.3f | %.3f | %.0f MiB | '
+            '%.0f%s | %d | %.3f s | %.2fx | %s | %s |' % (
+                name, note, fmt_faces(r['faces']), r['min'], r['max'], r['primitives'],
+                r['total'], r['step1'], r['step2'], r['step3'],
+                r['check_inputs'] + r['io'], r['memory'] / 1048576, per_face,
+                '' if per_face <= MEMORY_TARGET else ' (over)', r['out'], r['total2'],
+                r['total'] / r['total2'], target_text, result))
+    return '\n'.join(lines)
+
+
+def ring_growth(rows):
+    t = {name: r['total'] for name, _, r in rows}
+    if 'ring_spheres_100' in t and 'ring_spheres_800' in t:
+        ratio = t['ring_spheres_800'] / t['ring_spheres_100']
+        return ('Ring series growth: t(800) / t(100) = %.2f (target <= 9; the paper: 12.8 / '
+                '1.38 = 9.3).' % ratio)
+    return ''
+
+
+def write_doc(doc, text):
+    old = open(doc).read() if os.path.exists(doc) else ''
+    block = BEGIN + '\n' + text + '\n' + END
+    if BEGIN in old and END in old:
+        new = old[:old.index(BEGIN)] + block + old[old.index(END) + len(END):]
+    else:
+        new = old.rstrip('\n') + '\n\n' + block + '\n'
+    open(doc, 'w').write(new)
+
+
+def main():
+    args = sys.argv[1:]
+    if len(args) < 4:
+        sys.exit(__doc__)
+    meshcsg, shared, cache, doc = (os.path.abspath(a) for a in args[:4])
+    runs = int(args[args.index('--runs') + 1]) if '--runs' in args else 5
+    only = set(args[args.index('--only') + 1].split(',')) if '--only' in args else None
+    sys.path.insert(0, os.path.join(shared, 'scenes'))
+    import make_scenes as ms
+    os.makedirs(cache, exist_ok=True)
+    tmp = os.path.join(cache, 'out')
+    os.makedirs(tmp, exist_ok=True)
+    refs = references(shared)
+    rows = []
+    for name, build, note in scene_builders(ms, os.path.join(shared, 'models')):
+        if only and name not in only:
+            continue
+        d = ensure_scene(ms, cache, name, build)
+        r = measure(meshcsg, d, runs, tmp)
+        sys.stderr.write('%-28s %7.3f s (2 threads %.3f s) %6.0f MiB  %s\n' % (
+            name, r['total'], r['total2'], r['memory'] / 1048576, r['check']))
+        rows.append((name, note, r))
+    text = '\n'.join([
+        'Generated by `make bench` (bench/eval_bench.py) on %s.' % time.strftime('%Y-%m-%d'),
+        'Machine: %s.' % machine(),
+        'Whole process (`meshcsg eval tree.scad -o result.off --stats`: parse the leaves, '
+        'evaluate, write OFF), median of %d runs; steps as in the paper\'s Table 1: step 1 '
+        'octree, step 2 candidate pairs + intersection + per-face arrangement + point '
+        'numbering, step 3 triangulation + classification + assembly; "check + I/O" is the '
+        'rest (input contract check, parsing, writing). Peak memory is the process\'s peak '
+        'RSS on one thread.' % runs,
+        '',
+        table(rows, refs, runs),
+        '',
+        ring_growth(rows),
+    ])
+    write_doc(doc, text)
+
+
+if __name__ == '__main__':
+    main()
