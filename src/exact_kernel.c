@@ -241,6 +241,39 @@ void mci_point_explicit(mci_point *p, const double *x)
     p->v[0] = x;
     p->w = fv_exact(1.0);
     p->w_sign = 1;
+    memcpy(p->c, x, sizeof p->c);
+    p->r = 0;
+    p->exact_axes = 7;
+}
+
+/* The cached box of a constructed point (see mci_point): centre and radius from the
+ * certified bounds, then the coordinates the definition fixes exactly. */
+static void set_box(mci_point *p, const double exact[3], unsigned exact_axes)
+{
+    double lo[3], hi[3];
+    mci_point_bounds(p, lo, hi);
+    p->r = 0;
+    for (int k = 0; k < 3; k++) {
+        double c = lo[k] / 2 + hi[k] / 2;
+        /* |c - lo|, |hi - c| <= (hi - lo) / 2 up to the rounding of c and the halving */
+        double r = fmax(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070;
+        p->c[k] = isfinite(c) ? c : 0;
+        p->r = isfinite(c) && r > p->r ? r : isfinite(c) ? p->r : INFINITY;
+    }
+    p->exact_axes = (uint8_t)exact_axes;
+    for (int k = 0; k < 3; k++)
+        if ((exact_axes >> k) & 1)
+            p->c[k] = exact[k];
+}
+
+/* Axis k if the plane's three vertices share coordinate k (the plane is x_k = const),
+ * else -1. */
+static int aligned_axis(const mci_plane *plane)
+{
+    for (int k = 0; k < 3; k++)
+        if (plane->a[k] == plane->b[k] && plane->a[k] == plane->c[k])
+            return k;
+    return -1;
 }
 
 /* Exact sign of a constructed point's W, computed from scratch. */
@@ -272,6 +305,24 @@ static bool normalize_w(mci_point *p)
     return true;
 }
 
+static void lpi_box(mci_point *p, const double *l0, const double *l1, const mci_plane *plane)
+{
+    double exact[3];
+    unsigned axes = 0;
+    int k = aligned_axis(plane);
+    for (int j = 0; j < 3; j++) {
+        if (l0[j] == l1[j]) { /* the line keeps coordinate j */
+            exact[j] = l0[j];
+            axes |= 1u << j;
+        }
+    }
+    if (k >= 0) {
+        exact[k] = plane->a[k];
+        axes |= 1u << k;
+    }
+    set_box(p, exact, axes);
+}
+
 bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane)
 {
     mci_fv u[3], to_plane[3], s;
@@ -289,7 +340,24 @@ bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_p
     s = fv_dot(plane->n, to_plane);
     for (int k = 0; k < 3; k++)
         p->y[k] = fv_mul(u[k], s);
-    return normalize_w(p);
+    if (!normalize_w(p))
+        return false;
+    lpi_box(p, l0, l1, plane);
+    return true;
+}
+
+static void tpi_box(mci_point *p, const mci_plane *const planes[3])
+{
+    double exact[3];
+    unsigned axes = 0;
+    for (int i = 0; i < 3; i++) {
+        int k = aligned_axis(planes[i]);
+        if (k >= 0) {
+            exact[k] = planes[i]->a[k];
+            axes |= 1u << k;
+        }
+    }
+    set_box(p, exact, axes);
 }
 
 bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const mci_plane *p3)
@@ -316,7 +384,10 @@ bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const
         }
         p->y[col] = fv_det3(swapped[0], swapped[1], swapped[2]);
     }
-    return normalize_w(p);
+    if (!normalize_w(p))
+        return false;
+    tpi_box(p, planes);
+    return true;
 }
 
 void mci_point_approx(const mci_point *p, double out[3])
@@ -449,9 +520,20 @@ static bool explicit_on_plane(const mci_point *p, const mci_plane *plane)
             same_coordinates(p->v[0], plane->c));
 }
 
+/* An explicit point at p's exact coordinates (p must be exact on every axis). */
+static void exact_twin(const mci_point *p, mci_point *twin)
+{
+    mci_point_explicit(twin, p->c);
+}
+
 int mci_orient3d(const mci_point *p, const mci_plane *plane)
 {
     int s;
+    if (p->kind != MCI_POINT_EXPLICIT && p->exact_axes == 7) {
+        mci_point twin;
+        exact_twin(p, &twin);
+        return mci_orient3d(&twin, plane);
+    }
     if (explicit_on_plane(p, plane))
         return 0;
     s = mci_orient3d_filtered(p, plane);
@@ -487,11 +569,13 @@ bool mci_points_same_definition(const mci_point *a, const mci_point *b)
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
 {
     int s;
-    if (a->kind == MCI_POINT_EXPLICIT && b->kind == MCI_POINT_EXPLICIT)
-        return (a->v[0][axis] > b->v[0][axis]) - (a->v[0][axis] < b->v[0][axis]);
+    if ((a->exact_axes & b->exact_axes) >> axis & 1)
+        return (a->c[axis] > b->c[axis]) - (a->c[axis] < b->c[axis]);
     if (mci_points_same_definition(a, b))
         return 0;
-    s = mci_compare_coord_filtered(a, b, axis);
+    s = fv_sign(fv_sub((mci_fv){a->c[axis], a->r}, (mci_fv){b->c[axis], b->r}));
+    if (s == MCI_UNCERTAIN)
+        s = mci_compare_coord_filtered(a, b, axis);
     return s != MCI_UNCERTAIN ? s : mci_compare_coord_exact(a, b, axis);
 }
 
@@ -536,34 +620,38 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
     return big_orient2d(points, axis, s.e0);
 }
 
-/* A coordinate as centre +- radius, from the certified box of the point. */
-static mci_fv coordinate_interval(const double lo[3], const double hi[3], int k)
-{
-    double c = lo[k] / 2 + hi[k] / 2;
-    /* |c - lo|, |hi - c| <= (hi - lo) / 2 up to the rounding of c and of the halving. */
-    return (mci_fv){c, fmax(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070};
-}
-
-/* Second filter for points close together but defined far away (consecutive points of
- * a curve, say): the homogeneous determinant's bound grows with the distances to the
- * defining vertices, while differences of certified coordinate intervals stay small. */
-static int orient2d_intervals(const mci_point *p, const mci_point *q, const mci_point *r,
-                              int axis)
+/* First filter, on the cached boxes: for points close together but defined far away
+ * (consecutive points of a curve, say) the homogeneous determinant's bound grows with
+ * the distances to the defining vertices, while differences of the boxes stay small;
+ * and it is a few operations instead of a 3x3 determinant. */
+static int orient2d_boxes(const mci_point *p, const mci_point *q, const mci_point *r, int axis)
 {
     int i = (axis + 1) % 3, j = (axis + 2) % 3;
-    double lo[3][3], hi[3][3];
-    const mci_point *pts[3] = {p, q, r};
-    mci_fv c[3][2], d[2][2];
-    for (int k = 0; k < 3; k++) {
-        mci_point_bounds(pts[k], lo[k], hi[k]);
-        c[k][0] = coordinate_interval(lo[k], hi[k], i);
-        c[k][1] = coordinate_interval(lo[k], hi[k], j);
-    }
-    for (int k = 0; k < 2; k++) {
-        d[0][k] = fv_sub(c[1][k], c[0][k]);
-        d[1][k] = fv_sub(c[2][k], c[0][k]);
-    }
+    mci_fv d[2][2];
+    d[0][0] = fv_sub((mci_fv){q->c[i], q->r}, (mci_fv){p->c[i], p->r});
+    d[0][1] = fv_sub((mci_fv){q->c[j], q->r}, (mci_fv){p->c[j], p->r});
+    d[1][0] = fv_sub((mci_fv){r->c[i], r->r}, (mci_fv){p->c[i], p->r});
+    d[1][1] = fv_sub((mci_fv){r->c[j], r->r}, (mci_fv){p->c[j], p->r});
     return fv_sign(fv_sub(fv_mul(d[0][0], d[1][1]), fv_mul(d[0][1], d[1][0])));
+}
+
+/* Whether the projected coordinates of p are exact in the box (axes other than axis). */
+static bool exact_in_projection(const mci_point *p, int axis)
+{
+    unsigned need = 7u & ~(1u << axis);
+    return (p->exact_axes & need) == need;
+}
+
+/* orient2d of the exact centres (all projected coordinates exact): explicit points with
+ * those coordinates (the projection axis's coordinate is irrelevant). */
+static int orient2d_exact_centres(const mci_point *p, const mci_point *q, const mci_point *r,
+                                  int axis)
+{
+    mci_point tp, tq, tr;
+    exact_twin(p, &tp);
+    exact_twin(q, &tq);
+    exact_twin(r, &tr);
+    return mci_orient2d_projected_exact(&tp, &tq, &tr, axis);
 }
 
 static bool explicit_twins(const mci_point *a, const mci_point *b)
@@ -578,9 +666,13 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
     int s;
     if (explicit_twins(p, q) || explicit_twins(q, r) || explicit_twins(p, r))
         return 0;
+    s = orient2d_boxes(p, q, r, axis);
+    if (s != MCI_UNCERTAIN)
+        return s;
+    if (exact_in_projection(p, axis) && exact_in_projection(q, axis) &&
+        exact_in_projection(r, axis))
+        return orient2d_exact_centres(p, q, r, axis);
     s = mci_orient2d_projected_filtered(p, q, r, axis);
-    if (s == MCI_UNCERTAIN)
-        s = orient2d_intervals(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 

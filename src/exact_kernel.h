@@ -69,6 +69,13 @@ typedef struct mci_point {
     /* Cached offset from v[0]: point = v[0] + (y[0], y[1], y[2]) / w, with w.v >= 0
      * whenever the sign of W is known (the offsets are negated to make it so). */
     mci_fv y[3], w;
+    /* Cached certified box, set by the constructors: |coordinate k - c[k]| <= r, and
+     * coordinate k equals c[k] exactly when bit k of exact_axes is set (explicit
+     * points; a coordinate fixed by an axis-aligned plane or by a line that keeps it
+     * constant). First-stage filters use it; axis-aligned input (CAD parts, coplanar
+     * grids) then decides ties without the exact stage. */
+    double c[3], r;
+    uint8_t exact_axes;
     int8_t w_sign; /* exact sign of the stored w (+1), or 0 if W is exactly 0 (no point) */
 } mci_point;
 
