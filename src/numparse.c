@@ -455,6 +455,23 @@ static size_t normalise_decimal_point(char *text, size_t len)
     return out;
 }
 
+/* text = value with `precision` significant digits; whether it reads back as value
+ * (17 digits always do, and are not checked). */
+static bool format_round_trips(double value, int precision, char text[64], size_t *len)
+{
+    double back;
+    const char *next;
+    int n = snprintf(text, 64, "%.*g", precision, value);
+    if (n < 0 || n >= 64) { /* cannot happen for a finite double */
+        memcpy(text, "0", 2);
+        *len = 1;
+        return false;
+    }
+    *len = normalise_decimal_point(text, (size_t)n);
+    return precision == 17 ||
+           (mci_parse_double(text, text + *len, &back, &next) && back == value);
+}
+
 size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
 {
     char text[64] = "0";
@@ -465,17 +482,18 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
         memcpy(buf, word, len + 1);
         return len;
     }
-    for (int precision = 15; precision <= 17; precision++) {
-        double back;
-        const char *next;
-        int n = snprintf(text, sizeof text, "%.*g", precision, value);
-        if (n < 0 || (size_t)n >= sizeof text)
-            continue; /* cannot happen for a finite double; 17 digits will be tried */
-        len = normalise_decimal_point(text, (size_t)n);
-        if (precision == 17)
-            break;
-        if (mci_parse_double(text, text + len, &back, &next) && back == value)
-            break;
+    /* The shortest of 15, 16 and 17 significant digits that reads back as value; 16
+     * first: most computed coordinates need 16 or 17, and if 15 digits read back, so do
+     * 16 (the nearest 16-digit decimal is at least as close as the 15-digit one). */
+    if (!format_round_trips(value, 16, text, &len))
+        format_round_trips(value, 17, text, &len);
+    else {
+        char shorter[64];
+        size_t shorter_len;
+        if (format_round_trips(value, 15, shorter, &shorter_len)) {
+            memcpy(text, shorter, shorter_len + 1);
+            len = shorter_len;
+        }
     }
     memcpy(buf, text, len + 1);
     return len;

@@ -109,8 +109,6 @@ typedef struct builder {
     mci_octree *tree;
     mci_octree_params params;
     size_t cell_capacity, id_capacity;
-    uint32_t *stack;
-    size_t stack_len, stack_capacity;
     double *face_box; /* per face: min x, y, z, max x, y, z */
 } builder;
 
@@ -119,15 +117,6 @@ const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
     const mcsg_mesh *m = t->leaves[t->face_leaf[face]];
     uint32_t local = face - t->face_base[t->face_leaf[face]];
     return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)local + (size_t)k];
-}
-
-static bool push_cell(builder *b, uint32_t cell)
-{
-    if (!mci_grow_array(b->ctx, (void **)&b->stack, &b->stack_capacity,
-                        b->stack_len + 1, sizeof *b->stack, 64))
-        return false;
-    b->stack[b->stack_len++] = cell;
-    return true;
 }
 
 static size_t total_faces(const mcsg_mesh *const *leaves, size_t leaf_count)
@@ -295,98 +284,139 @@ static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
     return box;
 }
 
-/* Child `index` of `parent`: its box, and the parent's faces that touch it appended to
- * face_ids. */
-static bool fill_child(builder *b, uint32_t parent, uint32_t child, int index,
-                       const double mid[3])
+/* The octree is built level by level: the cells of one level are split in parallel,
+ * each into its own list of children's faces, and the lists are appended in cell order,
+ * so the tree (cells, numbering, face lists) does not depend on the thread count. */
+typedef struct cell_split {
+    bool split;
+    uint32_t counts[8];
+    uint32_t *ids; /* the children's faces, child after child */
+    size_t id_count, id_capacity;
+} cell_split;
+
+typedef struct level_job {
+    builder *b;
+    const uint32_t *cells;
+    cell_split *out;
+} level_job;
+
+static void child_box(const mci_cell *parent, int index, const double mid[3], mci_cell *c)
 {
-    mci_octree *t = b->tree;
-    mci_cell *c = &t->cells[child];
-    const mci_cell *p = &t->cells[parent];
     for (int k = 0; k < 3; k++) {
-        c->lo[k] = (index >> k) & 1 ? mid[k] : p->lo[k];
-        c->hi[k] = (index >> k) & 1 ? p->hi[k] : mid[k];
+        c->lo[k] = (index >> k) & 1 ? mid[k] : parent->lo[k];
+        c->hi[k] = (index >> k) & 1 ? parent->hi[k] : mid[k];
     }
-    c->depth = (uint16_t)(p->depth + 1);
-    c->child = NO_CHILD;
-    c->critical = 0;
-    c->first = (uint32_t)t->face_id_count;
-    c->count = 0;
-    for (uint32_t i = 0; i < p->count; i++) {
-        uint32_t f = t->face_ids[p->first + i];
-        if (!face_touches_cell(b, f, c))
-            continue;
-        if (!mci_grow_array(b->ctx, (void **)&t->face_ids, &b->id_capacity,
-                            t->face_id_count + 1, sizeof *t->face_ids, 64))
-            return false;
-        t->face_ids[t->face_id_count++] = f;
-        c = &t->cells[child]; /* unchanged: cells are not reallocated here */
-        c->count++;
-    }
-    /* Pathological inputs (thousands of faces through one point) could repeat faces in
-     * cells beyond 32-bit ids; report that as a failure rather than wrap. */
-    return t->face_id_count < UINT32_MAX;
 }
 
-/* Split a cell; returns false only on allocation failure. When no child has fewer faces
- * than the parent (many faces through one point, e.g. the centre of a cylinder's cap
- * fan), splitting cannot help: the children are dropped and the cell stays a leaf. */
-static bool split_cell(builder *b, uint32_t cell, const double mid[3], bool *split)
+/* The faces of the parent that touch each child. When no child has fewer faces than
+ * the parent (many faces through one point, e.g. the centre of a cylinder's cap fan),
+ * splitting cannot help: the cell stays a leaf. */
+static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
 {
-    mci_octree *t = b->tree;
-    uint32_t first_child = (uint32_t)t->cell_count, largest = 0;
-    size_t ids_before = t->face_id_count;
-    if (!mci_grow_array(b->ctx, (void **)&t->cells, &b->cell_capacity,
-                        t->cell_count + 8, sizeof *t->cells, 64))
-        return false;
-    t->cell_count += 8;
-    for (int i = 0; i < 8; i++) {
-        if (!fill_child(b, cell, first_child + (uint32_t)i, i, mid))
-            return false;
-        if (t->cells[first_child + (uint32_t)i].count > largest)
-            largest = t->cells[first_child + (uint32_t)i].count;
-    }
-    *split = largest < t->cells[cell].count;
-    if (!*split) {
-        t->cell_count -= 8;
-        t->face_id_count = ids_before;
-        return true;
-    }
-    t->cells[cell].child = first_child;
-    for (int i = 0; i < 8; i++) {
-        if (!push_cell(b, first_child + (uint32_t)i))
-            return false;
-    }
-    return true;
-}
-
-static bool process_cell(builder *b, uint32_t index)
-{
-    mci_octree *t = b->tree;
-    mci_cell *cell = &t->cells[index];
+    level_job *j = user;
+    const mci_octree *t = j->b->tree;
+    const mci_cell *cell = &t->cells[j->cells[i]];
+    cell_split *out = &j->out[i];
+    uint32_t largest = 0;
     double mid[3];
-    cell->critical = cell_is_critical(t, cell);
-    if (cell->depth > t->max_depth)
-        t->max_depth = cell->depth;
-    if (cell->critical && cell->count > b->params.max_cell_faces &&
-        cell->depth < b->params.max_depth && split_points(cell, mid)) {
-        bool split;
-        if (!split_cell(b, index, mid, &split))
-            return false;
-        if (split)
-            return true;
+    if (!cell_is_critical(t, cell) || cell->count <= j->b->params.max_cell_faces ||
+        cell->depth >= j->b->params.max_depth || !split_points(cell, mid))
+        return MCSG_OK;
+    for (int c = 0; c < 8; c++) {
+        mci_cell box;
+        child_box(cell, c, mid, &box);
+        for (uint32_t k = 0; k < cell->count; k++) {
+            uint32_t f = t->face_ids[cell->first + k];
+            if (!face_touches_cell(j->b, f, &box))
+                continue;
+            if (!mci_grow_array(j->b->ctx, (void **)&out->ids, &out->id_capacity,
+                                out->id_count + 1, sizeof *out->ids, 64))
+                return mci_fail_nomem(err, "building the octree");
+            out->ids[out->id_count++] = f;
+            out->counts[c]++;
+        }
+        largest = out->counts[c] > largest ? out->counts[c] : largest;
     }
-    if (t->cells[index].critical)
-        t->critical_leaf_cells++;
+    out->split = largest < cell->count;
+    return MCSG_OK;
+}
+
+/* Appends the children of a split cell (its faces in out->ids) to the tree. */
+static bool add_children(builder *b, uint32_t parent, const cell_split *out, uint32_t *next,
+                         size_t *next_count)
+{
+    mci_octree *t = b->tree;
+    uint32_t first_child = (uint32_t)t->cell_count;
+    double mid[3];
+    if (!mci_grow_array(b->ctx, (void **)&t->cells, &b->cell_capacity, t->cell_count + 8,
+                        sizeof *t->cells, 64) ||
+        !mci_grow_array(b->ctx, (void **)&t->face_ids, &b->id_capacity,
+                        t->face_id_count + out->id_count, sizeof *t->face_ids, 64) ||
+        t->face_id_count + out->id_count >= UINT32_MAX)
+        return false;
+    split_points(&t->cells[parent], mid);
+    memcpy(t->face_ids + t->face_id_count, out->ids, out->id_count * sizeof *out->ids);
+    for (int i = 0; i < 8; i++) {
+        mci_cell *c = &t->cells[first_child + (uint32_t)i];
+        child_box(&t->cells[parent], i, mid, c);
+        c->depth = (uint16_t)(t->cells[parent].depth + 1);
+        c->child = NO_CHILD;
+        c->critical = 0;
+        c->first = (uint32_t)t->face_id_count;
+        c->count = out->counts[i];
+        t->face_id_count += out->counts[i];
+        next[(*next_count)++] = first_child + (uint32_t)i;
+    }
+    t->cells[parent].child = first_child;
+    t->cell_count += 8;
     return true;
 }
 
-static bool build_cells(builder *b)
+/* Splits every cell of one level; *level becomes the next level's cells. */
+static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg_error *err)
 {
     mci_octree *t = b->tree;
+    cell_split *out = mci_calloc_array(b->ctx, *count + 1, sizeof *out);
+    level_job job = {b, *level, out};
+    uint32_t *next = NULL;
+    size_t splits = 0, next_count = 0;
+    mcsg_status st = out ? mci_parallel_for(b->ctx, *count, split_task, &job, err)
+                         : mci_fail_nomem(err, "building the octree");
+    for (size_t i = 0; st == MCSG_OK && i < *count; i++)
+        splits += out[i].split;
+    if (st == MCSG_OK && !(next = mci_malloc_array(b->ctx, 8 * splits + 1, sizeof *next)))
+        st = mci_fail_nomem(err, "building the octree");
+    for (size_t i = 0; st == MCSG_OK && i < *count; i++) {
+        mci_cell *cell = &t->cells[(*level)[i]];
+        cell->critical = cell_is_critical(t, cell);
+        if (cell->depth > t->max_depth)
+            t->max_depth = cell->depth;
+        if (out[i].split && !add_children(b, (*level)[i], &out[i], next, &next_count))
+            st = mci_fail_nomem(err, "building the octree");
+        else if (!out[i].split && t->cells[(*level)[i]].critical)
+            t->critical_leaf_cells++;
+    }
+    for (size_t i = 0; out && i < *count; i++)
+        mci_free(b->ctx, out[i].ids);
+    mci_free(b->ctx, out);
+    mci_free(b->ctx, *level);
+    *level = next;
+    *count = st == MCSG_OK ? next_count : 0;
+    return st;
+}
+
+static mcsg_status build_cells(builder *b, mcsg_error *err)
+{
+    mci_octree *t = b->tree;
+    uint32_t *level;
+    size_t count = 1;
+    mcsg_status st = MCSG_OK;
     t->cells = mci_malloc_array(b->ctx, 64, sizeof *t->cells);
-    if (!t->cells)
-        return false;
+    level = mci_malloc_array(b->ctx, 1, sizeof *level);
+    if (!t->cells || !level) {
+        mci_free(b->ctx, level);
+        return mci_fail_nomem(err, "building the octree");
+    }
     b->cell_capacity = 64;
     b->id_capacity = t->face_id_count;
     memset(&t->cells[0], 0, sizeof t->cells[0]);
@@ -394,13 +424,11 @@ static bool build_cells(builder *b)
     t->cells[0].count = (uint32_t)t->face_id_count;
     t->cells[0].child = NO_CHILD;
     t->cell_count = 1;
-    if (!push_cell(b, 0))
-        return false;
-    while (b->stack_len > 0) {
-        if (!process_cell(b, b->stack[--b->stack_len]))
-            return false;
-    }
-    return true;
+    level[0] = 0;
+    while (st == MCSG_OK && count > 0)
+        st = build_level(b, &level, &count, err);
+    mci_free(b->ctx, level);
+    return st;
 }
 
 mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
@@ -408,7 +436,7 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                              mci_octree *out, mcsg_error *err)
 {
     builder b;
-    bool ok;
+    mcsg_status st;
     memset(out, 0, sizeof *out);
     /* Face ids and cell face lists are 32-bit; the lists repeat faces, so leave room. */
     if (total_faces(leaves, leaf_count) >= UINT32_MAX / 4)
@@ -421,15 +449,13 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     b.tree = out;
     b.params.max_cell_faces = params ? params->max_cell_faces : DEFAULT_MAX_CELL_FACES;
     b.params.max_depth = params ? params->max_depth : DEFAULT_MAX_DEPTH;
-    ok = index_faces(ctx, out) && (b.face_box = face_boxes(ctx, out)) != NULL &&
-         build_cells(&b);
-    mci_free(ctx, b.stack);
+    st = index_faces(ctx, out) && (b.face_box = face_boxes(ctx, out)) != NULL
+             ? build_cells(&b, err)
+             : mci_fail_nomem(err, "building the octree");
     mci_free(ctx, b.face_box);
-    if (!ok) {
+    if (st != MCSG_OK)
         mci_octree_free(ctx, out);
-        return mci_fail_nomem(err, "building the octree");
-    }
-    return MCSG_OK;
+    return st;
 }
 
 void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
