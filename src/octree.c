@@ -289,6 +289,7 @@ static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
  * so the tree (cells, numbering, face lists) does not depend on the thread count. */
 typedef struct cell_split {
     bool split;
+    double mid[3]; /* the split point */
     uint32_t counts[8];
     uint32_t *ids; /* the children's faces, child after child */
     size_t id_count, id_capacity;
@@ -318,13 +319,12 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     const mci_cell *cell = &t->cells[j->cells[i]];
     cell_split *out = &j->out[i];
     uint32_t largest = 0;
-    double mid[3];
     if (!cell_is_critical(t, cell) || cell->count <= j->b->params.max_cell_faces ||
-        cell->depth >= j->b->params.max_depth || !split_points(cell, mid))
+        cell->depth >= j->b->params.max_depth || !split_points(cell, out->mid))
         return MCSG_OK;
     for (int c = 0; c < 8; c++) {
         mci_cell box;
-        child_box(cell, c, mid, &box);
+        child_box(cell, c, out->mid, &box);
         for (uint32_t k = 0; k < cell->count; k++) {
             uint32_t f = t->face_ids[cell->first + k];
             if (!face_touches_cell(j->b, f, &box))
@@ -347,18 +347,16 @@ static bool add_children(builder *b, uint32_t parent, const cell_split *out, uin
 {
     mci_octree *t = b->tree;
     uint32_t first_child = (uint32_t)t->cell_count;
-    double mid[3];
     if (!mci_grow_array(b->ctx, (void **)&t->cells, &b->cell_capacity, t->cell_count + 8,
                         sizeof *t->cells, 64) ||
         !mci_grow_array(b->ctx, (void **)&t->face_ids, &b->id_capacity,
                         t->face_id_count + out->id_count, sizeof *t->face_ids, 64) ||
         t->face_id_count + out->id_count >= UINT32_MAX)
         return false;
-    split_points(&t->cells[parent], mid);
     memcpy(t->face_ids + t->face_id_count, out->ids, out->id_count * sizeof *out->ids);
     for (int i = 0; i < 8; i++) {
         mci_cell *c = &t->cells[first_child + (uint32_t)i];
-        child_box(&t->cells[parent], i, mid, c);
+        child_box(&t->cells[parent], i, out->mid, c);
         c->depth = (uint16_t)(t->cells[parent].depth + 1);
         c->child = NO_CHILD;
         c->critical = 0;
