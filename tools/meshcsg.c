@@ -578,9 +578,22 @@ static void stop_progress(void)
 
 /* ---------------------------------------------------------------------------------- */
 
+/* Peak resident memory of this program: VmHWM from /proc/self/status where there is
+ * one (getrusage's ru_maxrss also counts the memory of the process that ran us before
+ * exec, e.g. a benchmark driver), else ru_maxrss. */
 static double peak_memory_mib(void)
 {
+    char line[256];
+    double kib = -1;
     struct rusage ru;
+    FILE *f = fopen("/proc/self/status", "r");
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %lf kB", &kib) == 1)
+            break;
+    if (f)
+        fclose(f);
+    if (kib >= 0)
+        return kib / 1024.0;
     if (getrusage(RUSAGE_SELF, &ru) != 0)
         return 0;
     return (double)ru.ru_maxrss / 1024.0; /* Linux reports KiB */
