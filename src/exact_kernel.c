@@ -246,19 +246,45 @@ void mci_point_explicit(mci_point *p, const double *x)
     p->exact_axes = 7;
 }
 
+/* A certified box from the cached Y and W (the cached box's source). */
+static void compute_bounds(const mci_point *p, double lo[3], double hi[3])
+{
+    double wl = p->w.v - p->w.e, wh = p->w.v + p->w.e;
+    for (int k = 0; k < 3; k++) {
+        double base = p->v[0][k], yl, yh, ql, qh, slack;
+        lo[k] = hi[k] = base;
+        if (p->kind == MCI_POINT_EXPLICIT)
+            continue;
+        yl = p->y[k].v - p->y[k].e;
+        yh = p->y[k].v + p->y[k].e;
+        /* Interval quotient for W > 0; the slack covers the rounding of these few
+         * operations (relative) and underflow (absolute). */
+        ql = yl >= 0 ? yl / wh : yl / wl;
+        qh = yh >= 0 ? yh / wl : yh / wh;
+        slack = 0x1p-48 * (fabs(base) + fmax(fabs(ql), fabs(qh))) + 0x1p-1060;
+        lo[k] = base + ql - slack;
+        hi[k] = base + qh + slack;
+        if (!(wl > 0) || !(lo[k] <= hi[k])) {
+            lo[k] = -INFINITY;
+            hi[k] = INFINITY;
+        }
+    }
+}
+
 /* The cached box of a constructed point (see mci_point): centre and radius from the
- * certified bounds, then the coordinates the definition fixes exactly. */
+ * certified bounds (infinite radius when they are), then the coordinates the definition
+ * fixes exactly. */
 static void set_box(mci_point *p, const double exact[3], unsigned exact_axes)
 {
     double lo[3], hi[3];
-    mci_point_bounds(p, lo, hi);
+    compute_bounds(p, lo, hi);
     p->r = 0;
     for (int k = 0; k < 3; k++) {
         double c = lo[k] / 2 + hi[k] / 2;
         /* |c - lo|, |hi - c| <= (hi - lo) / 2 up to the rounding of c and the halving */
         double r = fmax(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070;
         p->c[k] = isfinite(c) ? c : 0;
-        p->r = isfinite(c) && r > p->r ? r : isfinite(c) ? p->r : INFINITY;
+        p->r = fmax(p->r, isfinite(c) && isfinite(r) ? r : INFINITY);
     }
     p->exact_axes = (uint8_t)exact_axes;
     for (int k = 0; k < 3; k++)
@@ -452,24 +478,13 @@ void mci_point_round(const mci_point *p, double out[3])
 
 void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
 {
-    double wl = p->w.v - p->w.e, wh = p->w.v + p->w.e;
     for (int k = 0; k < 3; k++) {
-        double base = p->v[0][k], yl, yh, ql, qh, slack;
-        lo[k] = hi[k] = base;
-        if (p->kind == MCI_POINT_EXPLICIT)
-            continue;
-        yl = p->y[k].v - p->y[k].e;
-        yh = p->y[k].v + p->y[k].e;
-        /* Interval quotient for W > 0; the slack covers the rounding of these few
-         * operations (relative) and underflow (absolute). */
-        ql = yl >= 0 ? yl / wh : yl / wl;
-        qh = yh >= 0 ? yh / wl : yh / wh;
-        slack = 0x1p-48 * (fabs(base) + fmax(fabs(ql), fabs(qh))) + 0x1p-1060;
-        lo[k] = base + ql - slack;
-        hi[k] = base + qh + slack;
-        if (!(wl > 0) || !(lo[k] <= hi[k])) {
-            lo[k] = -INFINITY;
-            hi[k] = INFINITY;
+        if ((p->exact_axes >> k) & 1) {
+            lo[k] = hi[k] = p->c[k];
+        } else {
+            /* one step outward covers the rounding of c -+ r */
+            lo[k] = nextafter(p->c[k] - p->r, -INFINITY);
+            hi[k] = nextafter(p->c[k] + p->r, INFINITY);
         }
     }
 }

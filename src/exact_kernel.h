@@ -161,7 +161,8 @@ void mci_point_approx(const mci_point *p, double out[3]);
 void mci_point_round(const mci_point *p, double out[3]);
 
 /* A box certainly containing the point (possibly infinite when the cached W is too
- * uncertain). For culling only: decisions stay with the predicates. */
+ * uncertain): the cached box, a single value on the exactly known axes. For culling
+ * only: decisions stay with the predicates. */
 void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);
 
 /* Each predicate above is the combination of two stages, exposed for tests (which check
