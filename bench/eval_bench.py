@@ -241,7 +241,7 @@ def machine():
         cpu, os.cpu_count(), mem, cc.splitlines()[0] if cc else 'cc ?', platform.platform())
 
 
-def table(rows, refs, runs):
+def table(rows, refs):
     lines = [
         '| scene | faces total | min | max | primitives | total (1 thread) | step 1 | step 2 '
         '| step 3 | check + I/O | peak memory | bytes/face | output faces | 2 threads '
@@ -324,7 +324,7 @@ def main():
         'rest (input contract check, parsing, writing). Peak memory is the process\'s peak '
         'RSS on one thread.' % runs,
         '',
-        table(rows, refs, runs),
+        table(rows, refs),
         '',
         ring_growth(rows),
     ])

@@ -511,9 +511,8 @@ static bool number_arranged_faces(const mci_ctx *ctx, mci_scene *s, const uint32
     s->arr_of = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->arr_of);
     if (!s->arr_of)
         return false;
-    for (uint32_t f = 0; f < s->face_count; f++) {
+    for (uint32_t f = 0; f < s->face_count; f++)
         s->arr_of[f] = start[f + 1] > start[f] ? (uint32_t)s->arr_count++ : MCI_NONE;
-    }
     *face_of = mci_malloc_array(ctx, s->arr_count + 1, sizeof **face_of);
     s->arrs = mci_calloc_array(ctx, s->arr_count + 1, sizeof *s->arrs);
     if (!*face_of || !s->arrs)

@@ -288,7 +288,7 @@ static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
  * each into its own list of children's faces, and the lists are appended in cell order,
  * so the tree (cells, numbering, face lists) does not depend on the thread count. */
 typedef struct cell_split {
-    bool split;
+    bool critical, split;
     double mid[3]; /* the split point */
     uint32_t counts[8];
     uint32_t *ids; /* the children's faces, child after child */
@@ -319,7 +319,8 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     const mci_cell *cell = &t->cells[j->cells[i]];
     cell_split *out = &j->out[i];
     uint32_t largest = 0;
-    if (!cell_is_critical(t, cell) || cell->count <= j->b->params.max_cell_faces ||
+    out->critical = cell_is_critical(t, cell);
+    if (!out->critical || cell->count <= j->b->params.max_cell_faces ||
         cell->depth >= j->b->params.max_depth || !split_points(cell, out->mid))
         return MCSG_OK;
     for (int c = 0; c < 8; c++) {
@@ -386,7 +387,7 @@ static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg
         st = mci_fail_nomem(err, "building the octree");
     for (size_t i = 0; st == MCSG_OK && i < *count; i++) {
         mci_cell *cell = &t->cells[(*level)[i]];
-        cell->critical = cell_is_critical(t, cell);
+        cell->critical = out[i].critical;
         if (cell->depth > t->max_depth)
             t->max_depth = cell->depth;
         if (out[i].split && !add_children(b, (*level)[i], &out[i], next, &next_count))
