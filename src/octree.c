@@ -252,13 +252,17 @@ static bool triangle_misses_box(const double *const v[3], const double lo[3],
 static bool face_touches_cell(const builder *b, uint32_t f, const mci_cell *cell)
 {
     const double *box = b->face_box + 6 * (size_t)f;
-    bool inside = true;
+    int inside_axes = 0;
     for (int k = 0; k < 3; k++) {
         if (box[3 + k] < cell->lo[k] || box[k] > cell->hi[k])
             return false;
-        inside = inside && cell->lo[k] <= box[k] && box[3 + k] <= cell->hi[k];
+        inside_axes += cell->lo[k] <= box[k] && box[3 + k] <= cell->hi[k];
     }
-    if (inside)
+    /* Box inside the cell on two axes and overlapping on the third: the triangle is
+     * convex, so it has a point within the cell's range on the third axis, and that
+     * point is within range on the other two. Long thin faces (a cylinder's sides) take
+     * this exact shortcut instead of the separating-axis tests. */
+    if (inside_axes >= 2)
         return true;
     {
         const double *v[3] = {mci_octree_face_vertex(b->tree, f, 0),
