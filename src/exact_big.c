@@ -233,6 +233,10 @@ int mci_orient2d(double ax, double ay, double bx, double by, double cx, double c
     double bound = (3.0 + 16.0 * EPS) * EPS * magnitude;
     if (isfinite(magnitude) && magnitude >= FILTER_MIN_MAGNITUDE && fabs(det) > bound)
         return det > 0 ? 1 : -1;
+    /* A zero factor in each product (points sharing a coordinate, as on axis-aligned
+     * faces): exactly 0, since a floating-point difference is 0 only for equal inputs. */
+    if ((ax == cx || by == cy) && (ay == cy || bx == cx))
+        return 0;
     return orient2d_exact(ax, ay, bx, by, cx, cy);
 }
 

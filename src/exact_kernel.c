@@ -250,6 +250,8 @@ void mci_point_explicit(mci_point *p, const double *x)
 static void compute_bounds(const mci_point *p, double lo[3], double hi[3])
 {
     double wl = p->w.v - p->w.e, wh = p->w.v + p->w.e;
+    /* Reciprocals instead of six divisions: one more rounding, well within the slack. */
+    double inv_wl = 1 / wl, inv_wh = 1 / wh;
     for (int k = 0; k < 3; k++) {
         double base = p->v[0][k], yl, yh, ql, qh, slack;
         lo[k] = hi[k] = base;
@@ -259,8 +261,8 @@ static void compute_bounds(const mci_point *p, double lo[3], double hi[3])
         yh = p->y[k].v + p->y[k].e;
         /* Interval quotient for W > 0; the slack covers the rounding of these few
          * operations (relative) and underflow (absolute). */
-        ql = yl >= 0 ? yl / wh : yl / wl;
-        qh = yh >= 0 ? yh / wl : yh / wh;
+        ql = yl >= 0 ? yl * inv_wh : yl * inv_wl;
+        qh = yh >= 0 ? yh * inv_wl : yh * inv_wh;
         slack = 0x1p-48 * (fabs(base) + fmax(fabs(ql), fabs(qh))) + 0x1p-1060;
         lo[k] = base + ql - slack;
         hi[k] = base + qh + slack;
