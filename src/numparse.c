@@ -15,9 +15,12 @@
  *     between two doubles has at most 767 significant digits, so digits beyond 800 can
  *     only tell "a little above" from "exactly", which the sticky digit preserves.
  *
- * Formatting tries printf's %.15g, %.16g and %.17g (17 digits always round-trip) and
- * keeps the first that parses back to the same double; the locale's decimal point,
- * whatever it is, is then replaced by '.'.
+ * Formatting writes the text printf's %.15g, %.16g or %.17g would (17 digits always
+ * round-trip), the first that parses back to the same double, with '.' whatever the
+ * locale. printf itself is the fallback only: short decimals are found by a double
+ * division test, and 16 or 17 digits come from an exact 128-bit product m 5^k 2^j,
+ * correctly rounded (printf's multi-precision path cost ~5,000 instructions per number,
+ * most of the time of writing a mesh).
  */
 #include "numparse.h"
 
@@ -455,13 +458,110 @@ static size_t normalise_decimal_point(char *text, size_t len)
     return out;
 }
 
+/* round_half_even(|value| * 10^scale) for 0 <= scale <= 32, exactly: |value| = m 2^e,
+ * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
+static bool scaled_decimal(double value, int scale, u128 *out)
+{
+    int e;
+    double fraction = frexp(fabs(value), &e);
+    u128 m = (u128)(uint64_t)ldexp(fraction, 53), q, rest, half;
+    int shift;
+    if (scale < 0 || scale > 32)
+        return false;
+    m *= pow10_u128(scale) >> scale; /* 5^scale: 10^scale / 2^scale */
+    shift = e - 53 + scale;          /* value * 10^scale = m 5^scale 2^shift */
+    if (shift >= 0) {
+        if (shift > 20 || bit_length128(m) + shift > 127)
+            return false;
+        *out = m << shift;
+        return true;
+    }
+    if (-shift >= 128) {
+        *out = 0;
+        return true;
+    }
+    q = m >> -shift;
+    rest = m & ((((u128)1) << -shift) - 1);
+    half = ((u128)1) << (-shift - 1);
+    *out = q + (rest > half || (rest == half && (q & 1)));
+    return true;
+}
+
+/* printf's "%.*g" of a nonzero finite value, from the exact digits above; 0 when the
+ * value's decimal exponent is outside their range (then printf is used). */
+static size_t format_g_exact(char *text, double value, int precision)
+{
+    int exponent = (int)floor(log10(fabs(value))), tries = 0;
+    u128 digits, low = pow10_u128(precision - 1), high = pow10_u128(precision);
+    char d[40];
+    size_t len = 0, count = 0;
+    int decimals;
+    for (;;) { /* the estimate can be one off near powers of 10 (and after rounding) */
+        if (++tries > 4 || !scaled_decimal(value, precision - 1 - exponent, &digits))
+            return 0;
+        if (digits >= high)
+            exponent++;
+        else if (digits < low)
+            exponent--;
+        else
+            break;
+    }
+    if (digits == low) { /* 10^(p-1) may be a value just below 10^exponent rounded up */
+        u128 below;
+        if (!scaled_decimal(value, precision - exponent, &below))
+            return 0;
+        if (below < high) {
+            exponent--;
+            digits = below;
+        }
+    }
+    for (int k = 0; k < precision; k++, digits /= 10)
+        d[precision - 1 - k] = (char)('0' + (int)(digits % 10));
+    count = (size_t)precision;
+    while (count > 1 && d[count - 1] == '0')
+        count--; /* %g drops trailing zeros */
+    if (value < 0)
+        text[len++] = '-';
+    if (exponent < -4 || exponent >= precision) {
+        text[len++] = d[0];
+        if (count > 1)
+            text[len++] = '.';
+        memcpy(text + len, d + 1, count - 1);
+        len += count - 1;
+        len += (size_t)snprintf(text + len, 16, "e%c%02d", exponent < 0 ? '-' : '+',
+                                exponent < 0 ? -exponent : exponent);
+        return len;
+    }
+    decimals = (int)count - 1 - exponent; /* digits after the point, may be <= 0 */
+    if (exponent < 0) {
+        text[len++] = '0';
+        text[len++] = '.';
+        for (int k = -1; k > exponent; k--)
+            text[len++] = '0';
+        memcpy(text + len, d, count);
+        len += count;
+    } else {
+        for (int k = 0; k <= exponent; k++)
+            text[len++] = k < (int)count ? d[k] : '0';
+        if (decimals > 0) {
+            text[len++] = '.';
+            memcpy(text + len, d + exponent + 1, (size_t)decimals);
+            len += (size_t)decimals;
+        }
+    }
+    text[len] = '\0';
+    return len;
+}
+
 /* text = value with `precision` significant digits; whether it reads back as value
  * (17 digits always do, and are not checked). */
 static bool format_round_trips(double value, int precision, char text[64], size_t *len)
 {
     double back;
     const char *next;
-    int n = snprintf(text, 64, "%.*g", precision, value);
+    int n = value != 0 ? (int)format_g_exact(text, value, precision) : 0;
+    if (n == 0)
+        n = snprintf(text, 64, "%.*g", precision, value);
     if (n < 0 || n >= 64) { /* cannot happen for a finite double */
         memcpy(text, "0", 2);
         *len = 1;
@@ -470,6 +570,55 @@ static bool format_round_trips(double value, int precision, char text[64], size_
     *len = normalise_decimal_point(text, (size_t)n);
     return precision == 17 ||
            (mci_parse_double(text, text + *len, &back, &next) && back == value);
+}
+
+/* Writes |n| < 10^15 with `decimals` digits after the point (and a sign). */
+static size_t write_fixed(char *buf, double value, uint64_t n, int decimals)
+{
+    char digits[24];
+    size_t count = 0, len = 0;
+    do {
+        digits[count++] = (char)('0' + n % 10);
+        n /= 10;
+    } while (n > 0);
+    while (count <= (size_t)decimals)
+        digits[count++] = '0'; /* leading zeros of 0.000ddd */
+    if (value < 0)
+        buf[len++] = '-';
+    while (count > 0) {
+        if (count == (size_t)decimals)
+            buf[len++] = '.';
+        buf[len++] = digits[--count];
+    }
+    buf[len] = '\0';
+    return len;
+}
+
+/* The %.15g text of value when it is a decimal of at most 15 significant digits in the
+ * range %g writes without an exponent (1e-4 <= |value| < 1e15), else 0, decided without
+ * printf: for k = 0, 1, ... the integer n nearest value * 10^k (within 1/4: n < 2^50) is
+ * tried while n < 10^15, and n / 10^k == value (an IEEE division of exact operands,
+ * rounded like a correctly rounded decimal reader) means that the decimal n e-k reads
+ * back as value. A decimal of at most 15 digits that reads back as a double is the
+ * double's %.15g text (DBL_DIG is 15, and a midpoint between doubles needs more bits
+ * than n / 10^k has), so the result is the same text as printf's. */
+static size_t format_short_decimal(char *buf, double value)
+{
+    static const double power[19] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,
+                                      1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13,
+                                      1e14, 1e15, 1e16, 1e17, 1e18};
+    double magnitude = fabs(value);
+    if (!(magnitude >= 1e-4 && magnitude < 1e15))
+        return 0;
+    for (int k = 0; k < 19; k++) {
+        double scaled = magnitude * power[k], n;
+        if (scaled >= 1e15)
+            return 0;
+        n = nearbyint(scaled);
+        if (n / power[k] == magnitude)
+            return write_fixed(buf, value, (uint64_t)n, k);
+    }
+    return 0;
 }
 
 size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
@@ -482,12 +631,15 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
         memcpy(buf, word, len + 1);
         return len;
     }
-    /* The shortest of 15, 16 and 17 significant digits that reads back as value; 16
-     * first: most computed coordinates need 16 or 17, and if 15 digits read back, so do
-     * 16 (the nearest 16-digit decimal is at least as close as the 15-digit one). */
+    /* The shortest of 15, 16 and 17 significant digits that reads back as value. Short
+     * decimals (input coordinates) first, without printf; then 16 digits: most computed
+     * coordinates need 16 or 17, and if 15 digits read back, so do 16 (the nearest
+     * 16-digit decimal is at least as close as the 15-digit one). */
+    if ((len = format_short_decimal(buf, value)) > 0)
+        return len;
     if (!format_round_trips(value, 16, text, &len))
         format_round_trips(value, 17, text, &len);
-    else {
+    else if (!(fabs(value) >= 1e-4 && fabs(value) < 1e15)) { /* else 15 digits failed */
         char shorter[64];
         size_t shorter_len;
         if (format_round_trips(value, 15, shorter, &shorter_len)) {

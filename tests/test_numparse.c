@@ -330,6 +330,64 @@ TEST(format_round_trip)
     CHECK(mci_format_double(out, NAN) == 3 && strcmp(out, "nan") == 0);
 }
 
+/* Input coordinates are short decimals: the formatter's printf-free path for them must
+ * give printf's text, at every digit count and scale, near the fixed-notation limits
+ * (1e-4, 1e15) and where 15 digits do not suffice. */
+TEST(format_short_decimals)
+{
+    char out[MCI_DOUBLE_TEXT_MAX], text[64];
+    int before = test_failures;
+    static const double edges[] = {1e-4, 1e15, 999999999999999.0, 999999999999999.875,
+                                   0.000099999999999999, 0.000100000000000001,
+                                   123456789012345.6, 0.30000000000000004, 1e-5, 5e-324};
+    for (size_t i = 0; i < sizeof edges / sizeof edges[0]; i++) {
+        for (int sign = -1; sign <= 1; sign += 2) {
+            mci_format_double(out, sign * edges[i]);
+            CHECK_MSG(shortest_is_right(sign * edges[i], out), "%a formatted as %s",
+                      sign * edges[i], out);
+        }
+    }
+    for (int i = 0; i < 200000 && test_failures - before < 10; i++) {
+        int digits = 1 + (int)(next_random() % 17), exponent = (int)(next_random() % 40) - 22;
+        uint64_t scale = 1, mantissa;
+        double d;
+        for (int k = 0; k < digits; k++)
+            scale *= 10;
+        mantissa = next_random() % scale;
+        snprintf(text, sizeof text, "%s%llue%d", next_random() % 2 ? "-" : "",
+                 (unsigned long long)mantissa, exponent);
+        d = strtod(text, NULL);
+        mci_format_double(out, d);
+        CHECK_MSG(shortest_is_right(d, out), "%s = %a formatted as %s", text, d, out);
+    }
+}
+
+/* Computed coordinates need 16 or 17 digits, which the formatter derives exactly
+ * without printf for decimal exponents in about [-16, 16]: random doubles there, and the
+ * neighbours of powers of ten (where the exponent estimate and rounding can be one off),
+ * must give printf's text. */
+TEST(format_typical_range)
+{
+    char out[MCI_DOUBLE_TEXT_MAX];
+    int before = test_failures;
+    for (int i = 0; i < 300000 && test_failures - before < 10; i++) {
+        double d = ldexp(1.0 + (double)(next_random() >> 12) * 0x1p-52,
+                         (int)(next_random() % 140) - 70);
+        d = next_random() % 2 ? -d : d;
+        mci_format_double(out, d);
+        CHECK_MSG(shortest_is_right(d, out), "%a formatted as %s", d, out);
+    }
+    for (int k = -25; k <= 25; k++) {
+        double p = pow(10, k), near[5] = {p, nextafter(p, 0), nextafter(p, INFINITY),
+                                          nextafter(nextafter(p, 0), 0),
+                                          nextafter(nextafter(p, INFINITY), INFINITY)};
+        for (int j = 0; j < 5; j++) {
+            mci_format_double(out, near[j]);
+            CHECK_MSG(shortest_is_right(near[j], out), "%a formatted as %s", near[j], out);
+        }
+    }
+}
+
 TEST(locale_independence)
 {
     char out[MCI_DOUBLE_TEXT_MAX];
@@ -372,6 +430,8 @@ int main(void)
     RUN(random_digit_strings);
     RUN(halfway_cases);
     RUN(format_round_trip);
+    RUN(format_short_decimals);
+    RUN(format_typical_range);
     RUN(locale_independence);
     return test_summary();
 }
