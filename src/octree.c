@@ -296,7 +296,7 @@ typedef struct cell_split {
     double mid[3]; /* the split point */
     uint32_t counts[8];
     uint32_t *ids; /* the children's faces, child after child */
-    size_t id_count, id_capacity;
+    size_t id_count;
 } cell_split;
 
 typedef struct level_job {
@@ -313,35 +313,66 @@ static void child_box(const mci_cell *parent, int index, const double mid[3], mc
     }
 }
 
+/* Bit c set for each child c (bit k of c: upper half on axis k) the face touches. The
+ * face's box picks the candidate children (one side of the split or both, per axis);
+ * the exact shortcut or the separating-axis tests decide those. */
+static uint8_t children_touched(const builder *b, const mci_cell *cell, const double mid[3],
+                                uint32_t f)
+{
+    const double *box = b->face_box + 6 * (size_t)f;
+    uint8_t sides[3], mask = 0;
+    for (int k = 0; k < 3; k++)
+        sides[k] = (uint8_t)((box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1);
+    for (int c = 0; c < 8; c++) {
+        mci_cell child;
+        if (!((sides[0] >> (c & 1)) & 1) || !((sides[1] >> ((c >> 1) & 1)) & 1) ||
+            !((sides[2] >> ((c >> 2) & 1)) & 1))
+            continue;
+        child_box(cell, c, mid, &child);
+        if (face_touches_cell(b, f, &child))
+            mask |= (uint8_t)(1u << c);
+    }
+    return mask;
+}
+
 /* The faces of the parent that touch each child. When no child has fewer faces than
  * the parent (many faces through one point, e.g. the centre of a cylinder's cap fan),
- * splitting cannot help: the cell stays a leaf. */
+ * splitting cannot help: the cell stays a leaf. One pass computes each face's children,
+ * a second lists the faces child after child, in the parent's order. */
 static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
 {
     level_job *j = user;
     const mci_octree *t = j->b->tree;
     const mci_cell *cell = &t->cells[j->cells[i]];
+    const uint32_t *faces;
     cell_split *out = &j->out[i];
-    uint32_t largest = 0;
+    uint32_t largest = 0, offset[8];
+    uint8_t *mask;
     out->critical = cell_is_critical(t, cell);
     if (!out->critical || cell->count <= j->b->params.max_cell_faces ||
         cell->depth >= j->b->params.max_depth || !split_points(cell, out->mid))
         return MCSG_OK;
+    faces = t->face_ids + cell->first;
+    if (!(mask = mci_malloc_array(j->b->ctx, cell->count, sizeof *mask)))
+        return mci_fail_nomem(err, "building the octree");
+    for (uint32_t k = 0; k < cell->count; k++) {
+        mask[k] = children_touched(j->b, cell, out->mid, faces[k]);
+        for (int c = 0; c < 8; c++)
+            out->counts[c] += (mask[k] >> c) & 1;
+    }
     for (int c = 0; c < 8; c++) {
-        mci_cell box;
-        child_box(cell, c, out->mid, &box);
-        for (uint32_t k = 0; k < cell->count; k++) {
-            uint32_t f = t->face_ids[cell->first + k];
-            if (!face_touches_cell(j->b, f, &box))
-                continue;
-            if (!mci_grow_array(j->b->ctx, (void **)&out->ids, &out->id_capacity,
-                                out->id_count + 1, sizeof *out->ids, 64))
-                return mci_fail_nomem(err, "building the octree");
-            out->ids[out->id_count++] = f;
-            out->counts[c]++;
-        }
+        offset[c] = c == 0 ? 0 : offset[c - 1] + out->counts[c - 1];
         largest = out->counts[c] > largest ? out->counts[c] : largest;
     }
+    out->id_count = offset[7] + out->counts[7];
+    out->ids = mci_malloc_array(j->b->ctx, out->id_count + 1, sizeof *out->ids);
+    for (uint32_t k = 0; out->ids && k < cell->count; k++)
+        for (int c = 0; c < 8; c++)
+            if ((mask[k] >> c) & 1)
+                out->ids[offset[c]++] = faces[k];
+    mci_free(j->b->ctx, mask);
+    if (!out->ids)
+        return mci_fail_nomem(err, "building the octree");
     out->split = largest < cell->count;
     return MCSG_OK;
 }
