@@ -511,10 +511,11 @@ static uint32_t slot_to(const leaf_work *w, size_t slot)
 }
 
 /* Pair every directed piece edge with its opposite; a closed, consistently oriented
- * edge-manifold surface has exactly one. */
+ * edge-manifold surface has exactly one. The sorted edges are walked along the sorted
+ * separators (collect_separators), which marks the separator slots (is_sep). */
 static mcsg_status pair_edges(leaf_work *w)
 {
-    size_t n = 3 * w->np, i = 0;
+    size_t n = 3 * w->np, i = 0, sep = 0;
     mci_keyed *e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
     mcsg_status st = MCSG_OK;
     w->mate = mci_malloc_array(w->ctx, n + 1, sizeof *w->mate);
@@ -526,7 +527,7 @@ static mcsg_status pair_edges(leaf_work *w)
         e[k].key = mci_edge_key(slot_from(w, k), slot_to(w, k));
         e[k].ref = (uint32_t)k;
     }
-    mci_sort_keyed(e, n);
+    mci_sort_keyed_large(w->ctx, e, n);
     while (i < n && st == MCSG_OK) {
         size_t j = i;
         while (j < n && e[j].key == e[i].key)
@@ -539,6 +540,10 @@ static mcsg_status pair_edges(leaf_work *w)
         else {
             w->mate[e[i].ref] = e[i + 1].ref;
             w->mate[e[i + 1].ref] = e[i].ref;
+            while (sep < w->nsep && w->sep[sep].key < e[i].key)
+                sep++;
+            w->is_sep[e[i].ref] = w->is_sep[e[i + 1].ref] =
+                sep < w->nsep && w->sep[sep].key == e[i].key;
         }
         i = j;
     }
@@ -565,7 +570,7 @@ static mcsg_status collect_separators(leaf_work *w)
             w->sep[w->nsep++].ref = arr->edges[e].other;
         }
     }
-    mci_sort_keyed(w->sep, w->nsep);
+    mci_sort_keyed_large(w->ctx, w->sep, w->nsep);
     return MCSG_OK;
 }
 
@@ -596,8 +601,6 @@ static mcsg_status build_regions(leaf_work *w)
     for (uint32_t p = 0; p < w->np; p++)
         parent[p] = p;
     for (size_t k = 0; k < 3 * w->np; k++) {
-        uint64_t key = mci_edge_key(slot_from(w, k), slot_to(w, k));
-        w->is_sep[k] = find_separator(w, key) < w->nsep;
         if (!w->is_sep[k]) {
             uint32_t a = find_root(parent, (uint32_t)(k / 3));
             uint32_t b = find_root(parent, w->mate[k] / 3);
@@ -1009,9 +1012,9 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
     w.err = err;
     st = make_pieces(&w);
     if (st == MCSG_OK)
-        st = pair_edges(&w);
-    if (st == MCSG_OK)
         st = collect_separators(&w);
+    if (st == MCSG_OK)
+        st = pair_edges(&w);
     if (st == MCSG_OK)
         st = build_regions(&w);
     if (st == MCSG_OK)
