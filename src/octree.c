@@ -313,25 +313,24 @@ static void child_box(const mci_cell *parent, int index, const double mid[3], mc
     }
 }
 
-/* Bit c set for each child c (bit k of c: upper half on axis k) the face touches. The
- * face's box picks the candidate children (one side of the split or both, per axis);
- * the exact shortcut or the separating-axis tests decide those. */
-static uint8_t children_touched(const builder *b, const mci_cell *cell, const double mid[3],
-                                uint32_t f)
+/* Children on one side of the split along axis k (bit k of a child's index: upper
+ * half): side_children[k][s] for s = 1 lower, 2 upper, 3 both. */
+static const uint8_t side_children[3][4] = {
+    {0, 0x55, 0xAA, 0xFF}, {0, 0x33, 0xCC, 0xFF}, {0, 0x0F, 0xF0, 0xFF}};
+
+/* Bit c set for each child c the face touches. The face's box picks the candidate
+ * children (one side of the split or both, per axis); face_touches_cell decides those
+ * (at once when the box is inside the child). */
+static uint8_t children_touched(const builder *b, const mci_cell child[8],
+                                const double mid[3], uint32_t f)
 {
     const double *box = b->face_box + 6 * (size_t)f;
-    uint8_t sides[3], mask = 0;
+    uint8_t candidates = 0xFF, mask = 0;
     for (int k = 0; k < 3; k++)
-        sides[k] = (uint8_t)((box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1);
-    for (int c = 0; c < 8; c++) {
-        mci_cell child;
-        if (!((sides[0] >> (c & 1)) & 1) || !((sides[1] >> ((c >> 1) & 1)) & 1) ||
-            !((sides[2] >> ((c >> 2) & 1)) & 1))
-            continue;
-        child_box(cell, c, mid, &child);
-        if (face_touches_cell(b, f, &child))
+        candidates &= side_children[k][(box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1];
+    for (int c = 0; candidates >> c; c++)
+        if (((candidates >> c) & 1) && face_touches_cell(b, f, &child[c]))
             mask |= (uint8_t)(1u << c);
-    }
     return mask;
 }
 
@@ -347,6 +346,7 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     const uint32_t *faces;
     cell_split *out = &j->out[i];
     uint32_t largest = 0, offset[8];
+    mci_cell child[8];
     uint8_t *mask;
     out->critical = cell_is_critical(t, cell);
     if (!out->critical || cell->count <= j->b->params.max_cell_faces ||
@@ -355,9 +355,11 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     faces = t->face_ids + cell->first;
     if (!(mask = mci_malloc_array(j->b->ctx, cell->count, sizeof *mask)))
         return mci_fail_nomem(err, "building the octree");
+    for (int c = 0; c < 8; c++)
+        child_box(cell, c, out->mid, &child[c]);
     for (uint32_t k = 0; k < cell->count; k++) {
-        mask[k] = children_touched(j->b, cell, out->mid, faces[k]);
-        for (int c = 0; c < 8; c++)
+        mask[k] = children_touched(j->b, child, out->mid, faces[k]);
+        for (int c = 0; mask[k] >> c; c++)
             out->counts[c] += (mask[k] >> c) & 1;
     }
     for (int c = 0; c < 8; c++) {
@@ -367,7 +369,7 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     out->id_count = offset[7] + out->counts[7];
     out->ids = mci_malloc_array(j->b->ctx, out->id_count + 1, sizeof *out->ids);
     for (uint32_t k = 0; out->ids && k < cell->count; k++)
-        for (int c = 0; c < 8; c++)
+        for (int c = 0; mask[k] >> c; c++)
             if ((mask[k] >> c) & 1)
                 out->ids[offset[c]++] = faces[k];
     mci_free(j->b->ctx, mask);
