@@ -677,11 +677,24 @@ static bool explicit_twins(const mci_point *a, const mci_point *b)
            same_coordinates(a->v[0], b->v[0]);
 }
 
+/* Whether x is an LPI on the line through the explicit points a and b. */
+static bool lpi_on_line(const mci_point *x, const mci_point *a, const mci_point *b)
+{
+    return x->kind == MCI_POINT_LPI && a->kind == MCI_POINT_EXPLICIT &&
+           b->kind == MCI_POINT_EXPLICIT &&
+           ((same_coordinates(x->v[0], a->v[0]) && same_coordinates(x->v[1], b->v[0])) ||
+            (same_coordinates(x->v[0], b->v[0]) && same_coordinates(x->v[1], a->v[0])));
+}
+
 int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
                            int axis)
 {
     int s;
     if (explicit_twins(p, q) || explicit_twins(q, r) || explicit_twins(p, r))
+        return 0;
+    /* Collinear by definition: an exact zero, which only the slow exact stage could
+     * confirm (a crossing point on a face edge, tested against the edge's ends). */
+    if (lpi_on_line(r, p, q) || lpi_on_line(q, p, r) || lpi_on_line(p, q, r))
         return 0;
     s = orient2d_boxes(p, q, r, axis);
     if (s != MCI_UNCERTAIN)

@@ -274,8 +274,9 @@ static bool face_touches_cell(const builder *b, uint32_t f, const mci_cell *cell
 
 static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
 {
-    double *box = mci_malloc_array(ctx, t->face_id_count + 1, 6 * sizeof *box);
-    for (uint32_t f = 0; box && f < t->face_id_count; f++) {
+    uint32_t faces = t->face_base[t->leaf_count];
+    double *box = mci_malloc_array(ctx, (size_t)faces + 1, 6 * sizeof *box);
+    for (uint32_t f = 0; box && f < faces; f++) {
         double *out = box + 6 * (size_t)f;
         for (int v = 0; v < 3; v++) {
             const double *p = mci_octree_face_vertex(t, f, v);
@@ -506,21 +507,12 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
 /* ---------------------------------------------------------------------------------- */
 /* Candidate pairs                                                                     */
 
-static bool face_boxes_overlap(const mci_octree *t, uint32_t f, uint32_t g)
+static bool face_boxes_overlap(const double *box, uint32_t f, uint32_t g)
 {
-    for (int k = 0; k < 3; k++) {
-        double fmin = mci_octree_face_vertex(t, f, 0)[k], fmax = fmin, gmin = mci_octree_face_vertex(t, g, 0)[k],
-               gmax = gmin;
-        for (int v = 1; v < 3; v++) {
-            double x = mci_octree_face_vertex(t, f, v)[k], y = mci_octree_face_vertex(t, g, v)[k];
-            fmin = x < fmin ? x : fmin;
-            fmax = x > fmax ? x : fmax;
-            gmin = y < gmin ? y : gmin;
-            gmax = y > gmax ? y : gmax;
-        }
-        if (fmax < gmin || gmax < fmin)
+    const double *a = box + 6 * (size_t)f, *b = box + 6 * (size_t)g;
+    for (int k = 0; k < 3; k++)
+        if (a[3 + k] < b[k] || b[3 + k] < a[k])
             return false;
-    }
     return true;
 }
 
@@ -556,14 +548,15 @@ static bool radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
 }
 
 
-static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const mci_cell *cell,
-                               uint64_t **pairs, size_t *count, size_t *capacity)
+static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const double *box,
+                               const mci_cell *cell, uint64_t **pairs, size_t *count,
+                               size_t *capacity)
 {
     for (uint32_t i = 0; i < cell->count; i++) {
         uint32_t f = t->face_ids[cell->first + i];
         for (uint32_t j = i + 1; j < cell->count; j++) {
             uint32_t g = t->face_ids[cell->first + j];
-            if (t->face_leaf[f] == t->face_leaf[g] || !face_boxes_overlap(t, f, g))
+            if (t->face_leaf[f] == t->face_leaf[g] || !face_boxes_overlap(box, f, g))
                 continue;
             if (!mci_grow_array(ctx, (void **)pairs, capacity, *count + 1, sizeof **pairs, 64))
                 return false;
@@ -577,19 +570,25 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
                                        uint64_t **pairs, size_t *count, mcsg_error *err)
 {
     size_t capacity = 0, unique = 0;
+    double *box = face_boxes(ctx, tree); /* contiguous: a pair's test reads 96 bytes */
     *pairs = NULL;
     *count = 0;
-    for (size_t c = 0; c < tree->cell_count; c++) {
+    for (size_t c = 0; box && c < tree->cell_count; c++) {
         const mci_cell *cell = &tree->cells[c];
         if (cell->child != NO_CHILD || !cell->critical)
             continue;
-        if (!collect_cell_pairs(ctx, tree, cell, pairs, count, &capacity)) {
-            mci_free(ctx, *pairs);
-            *pairs = NULL;
-            *count = 0;
-            return mci_fail_nomem(err, "collecting candidate pairs");
+        if (!collect_cell_pairs(ctx, tree, box, cell, pairs, count, &capacity)) {
+            mci_free(ctx, box);
+            box = NULL;
         }
     }
+    if (!box) {
+        mci_free(ctx, *pairs);
+        *pairs = NULL;
+        *count = 0;
+        return mci_fail_nomem(err, "collecting candidate pairs");
+    }
+    mci_free(ctx, box);
     /* A pair sharing several cells was collected once per cell: keep one. */
     if (*count && !radix_sort_u64(ctx, *pairs, *count)) {
         mci_free(ctx, *pairs);
