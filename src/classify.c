@@ -527,7 +527,7 @@ static mcsg_status pair_edges(leaf_work *w)
         e[k].key = mci_edge_key(slot_from(w, k), slot_to(w, k));
         e[k].ref = (uint32_t)k;
     }
-    mci_sort_keyed_large(w->ctx, e, n);
+    mci_sort_keyed(e, n);
     while (i < n && st == MCSG_OK) {
         size_t j = i;
         while (j < n && e[j].key == e[i].key)
@@ -570,7 +570,7 @@ static mcsg_status collect_separators(leaf_work *w)
             w->sep[w->nsep++].ref = arr->edges[e].other;
         }
     }
-    mci_sort_keyed_large(w->ctx, w->sep, w->nsep);
+    mci_sort_keyed(w->sep, w->nsep);
     return MCSG_OK;
 }
 

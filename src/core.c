@@ -514,74 +514,62 @@ static void intro_sort_keyed(mci_keyed *items, size_t n, int depth)
     insertion_sort_keyed(items, n);
 }
 
+static size_t keyed_digit(const mci_keyed *item, int shift)
+{
+    return (size_t)(keyed_rank(item) >> shift) & 255;
+}
+
+/* In-place most-significant-digit radix sort (American flag sort) on the 96-bit rank,
+ * 8-bit digits from bit `shift` down; digits equal in every item of a bucket cost one
+ * counting pass and no moves. Short buckets go to the introsort. No buffer: the
+ * classification sorts arrays of millions of edge keys, and a copy would be the peak. */
+static void radix_sort_keyed(mci_keyed *items, size_t n, int shift, int depth)
+{
+    size_t count[256], next[256], end[256];
+    for (; shift >= 0; shift -= 8) {
+        if (n <= 64) {
+            intro_sort_keyed(items, n, depth);
+            return;
+        }
+        memset(count, 0, sizeof count);
+        for (size_t i = 0; i < n; i++)
+            count[keyed_digit(&items[i], shift)]++;
+        if (count[keyed_digit(&items[0], shift)] < n)
+            break; /* this digit varies: distribute by it */
+    }
+    if (shift < 0)
+        return; /* all ranks equal */
+    for (size_t d = 0, sum = 0; d < 256; d++) {
+        next[d] = sum;
+        sum += count[d];
+        end[d] = sum;
+    }
+    for (size_t d = 0; d < 256; d++)
+        while (next[d] < end[d]) { /* cycle the item at next[d] to its bucket */
+            mci_keyed item = items[next[d]];
+            size_t home = keyed_digit(&item, shift);
+            while (home != d) {
+                mci_keyed displaced = items[next[home]];
+                items[next[home]++] = item;
+                item = displaced;
+                home = keyed_digit(&item, shift);
+            }
+            items[next[d]++] = item;
+        }
+    for (size_t d = 0, first = 0; d < 256 && shift > 0; first += count[d], d++)
+        if (count[d] > 1)
+            radix_sort_keyed(items + first, count[d], shift - 8, depth);
+}
+
 void mci_sort_keyed(mci_keyed *items, size_t n)
 {
     int depth = 0;
     for (size_t m = n; m > 1; m >>= 1)
         depth += 2;
-    if (n > 1)
+    if (n > 4096)
+        radix_sort_keyed(items, n, 88, depth);
+    else if (n > 1)
         intro_sort_keyed(items, n, depth);
-}
-
-/* Digit d of an item's (key, ref) rank, 11 bits each: digits 0-2 from ref, 3-8 from
- * key (least significant first). */
-static size_t keyed_digit(const mci_keyed *item, int d)
-{
-    uint64_t field = d < 3 ? item->ref : item->key;
-    return (size_t)(field >> (11 * (d < 3 ? d : d - 3)) & 2047);
-}
-
-/* One stable counting pass over digit d. */
-static void radix_pass_keyed(const mci_keyed *src, mci_keyed *dst, size_t n, int d,
-                             size_t count[2048])
-{
-    size_t sum = 0;
-    memset(count, 0, 2048 * sizeof *count);
-    for (size_t i = 0; i < n; i++)
-        count[keyed_digit(&src[i], d)]++;
-    for (size_t v = 0; v < 2048; v++) {
-        size_t c = count[v];
-        count[v] = sum;
-        sum += c;
-    }
-    for (size_t i = 0; i < n; i++)
-        dst[count[keyed_digit(&src[i], d)]++] = src[i];
-}
-
-/* Least-significant-digit radix sort on (key, ref), skipping the digits that are equal
- * in every item (edge keys of a leaf use ~2 x 17 of the 64 bits, refs ~20 of 32): a few
- * linear passes instead of n log n comparisons. Same order as mci_sort_keyed, which it
- * falls back to for short arrays or when the buffers cannot be allocated. */
-void mci_sort_keyed_large(const mci_ctx *ctx, mci_keyed *items, size_t n)
-{
-    mci_keyed all_or = {0, 0}, all_and = {UINT64_MAX, UINT32_MAX}, varying;
-    mci_keyed *tmp = n >= 4096 ? mci_malloc_array(ctx, n, sizeof *tmp) : NULL, *src = items,
-              *dst = tmp;
-    size_t *count = tmp ? mci_malloc_array(ctx, 2048, sizeof *count) : NULL;
-    if (!count) {
-        mci_free(ctx, tmp);
-        mci_sort_keyed(items, n);
-        return;
-    }
-    for (size_t i = 0; i < n; i++) {
-        all_or.key |= items[i].key;
-        all_and.key &= items[i].key;
-        all_or.ref |= items[i].ref;
-        all_and.ref &= items[i].ref;
-    }
-    varying.key = all_or.key ^ all_and.key;
-    varying.ref = all_or.ref ^ all_and.ref;
-    for (int d = 0; d < 9; d++) {
-        if (keyed_digit(&varying, d) == 0)
-            continue; /* the same in every item: the pass would not move anything */
-        radix_pass_keyed(src, dst, n, d, count);
-        src = dst;
-        dst = src == items ? tmp : items;
-    }
-    if (src != items)
-        memcpy(items, src, n * sizeof *items);
-    mci_free(ctx, count);
-    mci_free(ctx, tmp);
 }
 
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key)

@@ -85,9 +85,6 @@ typedef struct mci_keyed {
 uint64_t mci_edge_key(uint32_t u, uint32_t v);
 /* Sort by key, then ref. */
 void mci_sort_keyed(mci_keyed *items, size_t n);
-/* The same order, by radix sort for long arrays (a temporary copy from ctx; falls back
- * to mci_sort_keyed when it cannot be allocated, so it cannot fail). */
-void mci_sort_keyed_large(const mci_ctx *ctx, mci_keyed *items, size_t n);
 /* Index of the first item with this key in sorted items[0 .. n), or n. */
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key);
 

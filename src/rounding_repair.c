@@ -64,7 +64,7 @@ static bool index_directed_edges(const mci_ctx *ctx, const uint32_t *tris, size_
             edges[3 * t + i].key = directed_key(tris[3 * t + i], tris[3 * t + (i + 1) % 3]);
             edges[3 * t + i].ref = (uint32_t)t;
         }
-    mci_sort_keyed_large(ctx, edges, 3 * nt);
+    mci_sort_keyed(edges, 3 * nt);
     *out = edges;
     return true;
 }
