@@ -128,6 +128,23 @@ static uint32_t find(uint32_t *parent, uint32_t x)
     return x;
 }
 
+/* One stable counting sort of corners by key(corner) (a vertex id): in[] (NULL: all
+ * corners in order) into out[], with start[v] the first position of key v. */
+static void sort_corners_by(const mcsg_mesh *m, uint32_t (*key)(const mcsg_mesh *, uint32_t),
+                            const uint32_t *in, uint32_t *out, uint32_t *start)
+{
+    size_t n = 3 * m->triangle_count;
+    memset(start, 0, (m->vertex_count + 2) * sizeof *start);
+    for (size_t c = 0; c < n; c++)
+        start[key(m, (uint32_t)c) + 2]++;
+    for (size_t v = 2; v < m->vertex_count + 2; v++)
+        start[v] += start[v - 1];
+    for (size_t k = 0; k < n; k++) {
+        uint32_t c = in ? in[k] : (uint32_t)k;
+        out[start[key(m, c) + 1]++] = c;
+    }
+}
+
 /* Corners (3t + i) grouped by vertex in CSR form, each vertex's corners ordered by the
  * vertex their edge goes to. Corner 3t + i is also the edge slot leaving its vertex, so
  * this lists each vertex's outgoing edges, and the edges u -> v form one run: a fan
@@ -142,25 +159,12 @@ static bool corners_by_vertex(splitter *sp)
     uint32_t *by_target = mci_malloc_array(sp->ctx, n + 1, sizeof *by_target);
     sp->start = start;
     sp->corner = corner;
-    if (!start || !corner || !by_target) {
-        mci_free(sp->ctx, by_target);
-        return false;
+    if (start && corner && by_target) {
+        sort_corners_by(m, slot_to, NULL, by_target, start);
+        sort_corners_by(m, slot_from, by_target, corner, start);
     }
-    for (size_t c = 0; c < n; c++)
-        start[slot_to(m, (uint32_t)c) + 2]++;
-    for (size_t v = 2; v < m->vertex_count + 2; v++)
-        start[v] += start[v - 1];
-    for (size_t c = 0; c < n; c++)
-        by_target[start[slot_to(m, (uint32_t)c) + 1]++] = (uint32_t)c;
-    memset(start, 0, (m->vertex_count + 2) * sizeof *start);
-    for (size_t c = 0; c < n; c++)
-        start[m->triangles[c] + 2]++;
-    for (size_t v = 2; v < m->vertex_count + 2; v++)
-        start[v] += start[v - 1];
-    for (size_t k = 0; k < n; k++)
-        corner[start[m->triangles[by_target[k]] + 1]++] = by_target[k];
     mci_free(sp->ctx, by_target);
-    return true;
+    return start && corner && by_target;
 }
 
 /* Append the slots from u to v to slots[*n]; returns how many there were. */

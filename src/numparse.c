@@ -471,7 +471,7 @@ static bool scaled_decimal(double value, int scale, u128 *out)
     m *= pow10_u128(scale) >> scale; /* 5^scale: 10^scale / 2^scale */
     shift = e - 53 + scale;          /* value * 10^scale = m 5^scale 2^shift */
     if (shift >= 0) {
-        if (shift > 20 || bit_length128(m) + shift > 127)
+        if (bit_length128(m) + shift > 127)
             return false;
         *out = m << shift;
         return true;
@@ -572,6 +572,12 @@ static bool format_round_trips(double value, int precision, char text[64], size_
            (mci_parse_double(text, text + *len, &back, &next) && back == value);
 }
 
+/* Whether %.15g writes |value| without an exponent (decimal exponent -4 .. 14). */
+static bool in_fixed_range(double value)
+{
+    return fabs(value) >= 1e-4 && fabs(value) < 1e15;
+}
+
 /* Writes |n| < 10^15 with `decimals` digits after the point (and a sign). */
 static size_t write_fixed(char *buf, double value, uint64_t n, int decimals)
 {
@@ -608,7 +614,7 @@ static size_t format_short_decimal(char *buf, double value)
                                       1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13,
                                       1e14, 1e15, 1e16, 1e17, 1e18};
     double magnitude = fabs(value);
-    if (!(magnitude >= 1e-4 && magnitude < 1e15))
+    if (!in_fixed_range(value))
         return 0;
     for (int k = 0; k < 19; k++) {
         double scaled = magnitude * power[k], n;
@@ -639,7 +645,7 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
         return len;
     if (!format_round_trips(value, 16, text, &len))
         format_round_trips(value, 17, text, &len);
-    else if (!(fabs(value) >= 1e-4 && fabs(value) < 1e15)) { /* else 15 digits failed */
+    else if (!in_fixed_range(value)) { /* in range, format_short_decimal tried 15 digits */
         char shorter[64];
         size_t shorter_len;
         if (format_round_trips(value, 15, shorter, &shorter_len)) {

@@ -570,7 +570,10 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
                                        uint64_t **pairs, size_t *count, mcsg_error *err)
 {
     size_t capacity = 0, unique = 0;
-    double *box = face_boxes(ctx, tree); /* contiguous: a pair's test reads 96 bytes */
+    /* Contiguous boxes: a pair's test reads 96 bytes instead of 12 vertices. The build
+     * computed them too (a pass over the faces, ~1 ms per 100K); they are not kept in
+     * the tree, which lives through the whole evaluation, to spare 48 bytes per face. */
+    double *box = face_boxes(ctx, tree);
     *pairs = NULL;
     *count = 0;
     for (size_t c = 0; box && c < tree->cell_count; c++) {
