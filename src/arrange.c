@@ -352,16 +352,24 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     uint32_t *idx = mci_malloc_array(ctx, n, sizeof *idx);
     uint32_t *tmp = mci_malloc_array(ctx, n, sizeof *tmp);
     uint32_t *remap = mci_malloc_array(ctx, n, sizeof *remap);
-    mci_point *merged = mci_malloc_array(ctx, n, sizeof *merged);
-    mci_point_lines *merged_lines = mci_malloc_array(ctx, n, sizeof *merged_lines);
-    mcsg_status st = table && idx && tmp && remap && merged && merged_lines ? MCSG_OK
+    mci_point *merged = NULL;
+    mci_point_lines *merged_lines = NULL;
+    mcsg_status st = table && idx && tmp && remap ? MCSG_OK
                                                   : mci_fail_nomem(err, "arranging a face");
     if (st == MCSG_OK) {
-        size_t out = 0;
         for (size_t i = 0; i < n; i++)
             idx[i] = (uint32_t)i;
         mci_sort_point_ids(table, idx, tmp, n);
         kept = merge_ids(arr, idx, remap);
+        /* Sized after merging: faces with twins or many neighbours along their edges
+         * collect several copies of each point, and the arrangement keeps this array. */
+        merged = mci_malloc_array(ctx, kept, sizeof *merged);
+        merged_lines = mci_malloc_array(ctx, kept, sizeof *merged_lines);
+        if (!merged || !merged_lines)
+            st = mci_fail_nomem(err, "arranging a face");
+    }
+    if (st == MCSG_OK) {
+        size_t out = 0;
         for (size_t i = 0; i < kept; i++)
             merged_lines[i].count = 0;
         for (size_t i = 0; i < n; i++) {

@@ -188,6 +188,18 @@ static bool split_points(const mci_cell *cell, double mid[3])
     return true;
 }
 
+/* Inline maximum and minimum of finite values (fmax and fmin are library calls that
+ * also order NaNs, which cannot occur here: the mesh check rejects non-finite input). */
+static double max_of(double x, double y)
+{
+    return x > y ? x : y;
+}
+
+static double min_of(double x, double y)
+{
+    return x < y ? x : y;
+}
+
 /* Whether the triangle's plane provably misses the box: the box corners extreme along
  * the normal, evaluated in doubles, are both strictly on one side by more than a bound
  * on the rounding error (differences, the cross product and the dot product each add at
@@ -208,7 +220,7 @@ static bool plane_misses_box(const double *a, const double *b, const double *c,
         double to_lo = lo[k] - a[k], to_hi = hi[k] - a[k];
         lowest += n * (n > 0 ? to_lo : to_hi);
         highest += n * (n > 0 ? to_hi : to_lo);
-        bound += n_abs * fmax(fabs(to_lo), fabs(to_hi));
+        bound += n_abs * max_of(fabs(to_lo), fabs(to_hi));
     }
     bound = bound * 1e-14 + 1e-300;
     return lowest > bound || highest < -bound;
@@ -226,10 +238,10 @@ static bool edge_axis_misses_box(const double *p, const double *q, const double 
     double lo_j = lo[j] - p[j], hi_j = hi[j] - p[j], lo_i = lo[i] - p[i], hi_i = hi[i] - p[i];
     double f_lo = ei * (ei > 0 ? lo_j : hi_j) - ej * (ej > 0 ? hi_i : lo_i);
     double f_hi = ei * (ei > 0 ? hi_j : lo_j) - ej * (ej > 0 ? lo_i : hi_i);
-    double bound = fabs(ei) * (fmax(fabs(lo_j), fabs(hi_j)) + fabs(r[j] - p[j])) +
-                   fabs(ej) * (fmax(fabs(lo_i), fabs(hi_i)) + fabs(r[i] - p[i]));
+    double bound = fabs(ei) * (max_of(fabs(lo_j), fabs(hi_j)) + fabs(r[j] - p[j])) +
+                   fabs(ej) * (max_of(fabs(lo_i), fabs(hi_i)) + fabs(r[i] - p[i]));
     bound = bound * 1e-14 + 1e-300;
-    return f_lo > fmax(0, fr) + bound || f_hi < fmin(0, fr) - bound;
+    return f_lo > max_of(0, fr) + bound || f_hi < min_of(0, fr) - bound;
 }
 
 static bool triangle_misses_box(const double *const v[3], const double lo[3],
@@ -319,16 +331,40 @@ static void child_box(const mci_cell *parent, int index, const double mid[3], mc
 static const uint8_t side_children[3][4] = {
     {0, 0x55, 0xAA, 0xFF}, {0, 0x33, 0xCC, 0xFF}, {0, 0x0F, 0xF0, 0xFF}};
 
+/* The children that hold a corner of face f (closed boxes: a corner on a split plane is
+ * in the children on both sides). A triangle touches every such child, so these need
+ * no separating-axis test; a face straddling a cell's edge has its corners in up to
+ * three of the four children it may touch. */
+static uint8_t children_holding_corners(const builder *b, const mci_cell *cell,
+                                        const double mid[3], uint32_t f)
+{
+    uint8_t held = 0;
+    for (int v = 0; v < 3; v++) {
+        const double *p = mci_octree_face_vertex(b->tree, f, v);
+        uint8_t in = 0xFF;
+        for (int k = 0; k < 3; k++) {
+            if (p[k] < cell->lo[k] || p[k] > cell->hi[k])
+                in = 0;
+            in &= side_children[k][(p[k] <= mid[k]) | (p[k] >= mid[k]) << 1];
+        }
+        held |= in;
+    }
+    return held;
+}
+
 /* Bit c set for each child c the face touches. The face's box picks the candidate
  * children (one side of the split or both, per axis); face_touches_cell decides those
  * (at once when the box is inside the child). */
-static uint8_t children_touched(const builder *b, const mci_cell child[8],
-                                const double mid[3], uint32_t f)
+static uint8_t children_touched(const builder *b, const mci_cell *cell,
+                                const mci_cell child[8], const double mid[3], uint32_t f)
 {
     const double *box = b->face_box + 6 * (size_t)f;
-    uint8_t candidates = 0xFF, mask = 0;
+    uint8_t candidates = 0xFF, mask;
     for (int k = 0; k < 3; k++)
         candidates &= side_children[k][(box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1];
+    mask = candidates & (candidates - 1) ? candidates & children_holding_corners(b, cell, mid, f)
+                                         : 0;
+    candidates &= (uint8_t)~mask;
     for (int c = 0; candidates >> c; c++)
         if (((candidates >> c) & 1) && face_touches_cell(b, f, &child[c]))
             mask |= (uint8_t)(1u << c);
@@ -359,7 +395,7 @@ static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
     for (int c = 0; c < 8; c++)
         child_box(cell, c, out->mid, &child[c]);
     for (uint32_t k = 0; k < cell->count; k++) {
-        mask[k] = children_touched(j->b, child, out->mid, faces[k]);
+        mask[k] = children_touched(j->b, cell, child, out->mid, faces[k]);
         for (int c = 0; mask[k] >> c; c++)
             out->counts[c] += (mask[k] >> c) & 1;
     }
