@@ -566,7 +566,7 @@ void mci_sort_keyed(mci_keyed *items, size_t n)
     int depth = 0;
     for (size_t m = n; m > 1; m >>= 1)
         depth += 2;
-    if (n > 4096)
+    if (n > 1024)
         radix_sort_keyed(items, n, 88, depth);
     else if (n > 1)
         intro_sort_keyed(items, n, depth);
