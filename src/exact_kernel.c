@@ -435,7 +435,7 @@ void mci_point_approx(const mci_point *p, double out[3])
  * exactly as hi + lo (two-sum), q's error bound E is certified, and hi is the nearest
  * double to every value within |lo| + E of it (strictly inside its rounding interval,
  * whose half-width is half the smaller gap to a neighbouring double). */
-static bool round_filtered(const mci_point *p, int k, double *out)
+static bool round_filtered(const mci_point *p, int k, double *out, double *guess)
 {
     double base = p->v[0][k], y = p->y[k].v, w = p->w.v, wl = w - p->w.e, q, hi, lo, bv;
     double err, gap;
@@ -446,6 +446,7 @@ static bool round_filtered(const mci_point *p, int k, double *out)
     err = fabs(q) * (p->w.e / wl) + p->y[k].e / wl + fabs(q) * 0x1p-53;
     err = err * (1 + 0x1p-40) + 0x1p-1060; /* the rounding of this bound itself */
     hi = base + q;
+    *guess = hi;
     bv = hi - base;
     lo = (base - (hi - bv)) + (q - bv);
     gap = fmin(nextafter(hi, INFINITY) - hi, hi - nextafter(hi, -INFINITY)) / 2;
@@ -460,22 +461,26 @@ void mci_point_round(const mci_point *p, double out[3])
     static const double zero[3] = {0, 0, 0};
     big_point exact;
     input_scale s;
-    bool computed = false;
+    double guess[3] = {0, 0, 0};
+    unsigned pending = 0;
     for (int k = 0; k < 3; k++) {
-        if (p->kind == MCI_POINT_EXPLICIT) {
+        if (p->kind == MCI_POINT_EXPLICIT)
             out[k] = p->v[0][k];
-            continue;
-        }
-        if (round_filtered(p, k, &out[k]))
-            continue;
-        /* X / W is the point in units of 2^e0 once X is measured from the origin. */
-        if (!computed) {
-            s = scale_of(&p, 1, NULL, 0);
-            big_point_at(&exact, p, zero, s.e0);
-            computed = true;
-        }
-        out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
+        else if ((p->exact_axes >> k) & 1) /* the definition fixes this coordinate */
+            out[k] = p->c[k];
+        else if (!round_filtered(p, k, &out[k], &guess[k]))
+            pending |= 1u << k;
     }
+    if (pending)
+        pending = mci_point_round_dd(p, pending, guess, out);
+    if (!pending)
+        return;
+    /* X / W is the point in units of 2^e0 once X is measured from the origin. */
+    s = scale_of(&p, 1, NULL, 0);
+    big_point_at(&exact, p, zero, s.e0);
+    for (int k = 0; k < 3; k++)
+        if ((pending >> k) & 1)
+            out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
 }
 
 void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
@@ -703,6 +708,8 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
         exact_in_projection(r, axis))
         return orient2d_exact_centres(p, q, r, axis);
     s = mci_orient2d_projected_filtered(p, q, r, axis);
+    if (s == MCI_UNCERTAIN)
+        s = mci_orient2d_projected_dd(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 

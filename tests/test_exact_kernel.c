@@ -929,6 +929,32 @@ static bool is_nearest_double(double r, mpq_srcptr x)
 }
 
 /* mci_point_round gives the nearest double on every axis; mci_point_approx is finite. */
+/* The double-double rounding stage on its own, from the approximation and from a guess
+ * two steps off (it must walk to the nearest double or give up). */
+static long dd_rounded, dd_round_tries;
+
+static void check_point_round_dd(const scenario *s, int i, const double approx[3])
+{
+    for (int shift = 0; shift < 2; shift++) {
+        double guess[3], r[3];
+        unsigned left;
+        for (int k = 0; k < 3; k++)
+            guess[k] = shift ? nextafter(nextafter(approx[k], INFINITY), INFINITY) : approx[k];
+        left = mci_point_round_dd(&ws.kpt[i], 7, guess, r);
+        for (int k = 0; k < 3; k++) {
+            if (fabs(mpq_get_d(ws.rx[i].c[k])) > 0x1p1020)
+                continue;
+            dd_round_tries++;
+            if ((left >> k) & 1)
+                continue;
+            dd_rounded++;
+            CHECK_MSG(is_nearest_double(r[k], ws.rx[i].c[k]), "mci_point_round_dd (%s) axis "
+                      "%d: %a, exact %a", class_names[s->cls], k, r[k],
+                      mpq_get_d(ws.rx[i].c[k]));
+        }
+    }
+}
+
 static void check_point_round(const scenario *s, int i)
 {
     double r[3], a[3];
@@ -943,6 +969,7 @@ static void check_point_round(const scenario *s, int i)
                   k, a[k]);
         rounded_coordinates++;
     }
+    check_point_round_dd(s, i, a);
 }
 
 /* ---------------------------------------------------------------- building a scenario */
@@ -1115,6 +1142,23 @@ static int ref_eval(const query *q)
     }
 }
 
+/* The double-double stage of orient2d, checked on every case: a sign it gives must be
+ * the reference's. Counted where the first filter gave up (where it is used). */
+static long dd_after_filter, dd_decided;
+
+static void check_orient2d_dd(const scenario *s, const query *q, int filtered, int ref)
+{
+    const mci_point *a = &ws.kpt[q->pt[0]], *b = &ws.kpt[q->pt[1]], *c = &ws.kpt[q->pt[2]];
+    int got = mci_orient2d_projected_dd(a, b, c, q->axis);
+    CHECK_MSG(got == MCI_UNCERTAIN || got == ref,
+              "mci_orient2d_projected_dd (%s): %d, reference %d", class_names[s->cls], got,
+              ref);
+    if (filtered == MCI_UNCERTAIN) {
+        dd_after_filter++;
+        dd_decided += got != MCI_UNCERTAIN;
+    }
+}
+
 static void run_query(const scenario *s, const query *q)
 {
     int got[3], ref = ref_eval(q);
@@ -1122,6 +1166,8 @@ static void run_query(const scenario *s, const query *q)
         return; /* precondition fails: the kernel must not be asked */
     kernel_eval(s, q, got);
     check_case(s, q, got, ref);
+    if (q->pred == PR_ORIENT2D)
+        check_orient2d_dd(s, q, got[2], ref);
 }
 
 /* Indices of the points that exist; returns their count. */
@@ -1775,6 +1821,10 @@ static void print_predicate_table(void)
     printf("total cases: %ld; cached values with an uninformative bound (inf/NaN): %ld\n",
            total, uninformative_bounds);
     printf("coordinates rounded by mci_point_round (checked nearest): %ld\n", rounded_coordinates);
+    printf("coordinates rounded by the double-double stage: %ld of %ld\n", dd_rounded,
+           dd_round_tries);
+    printf("orient2d cases the first filter left: %ld, double-double stage decided %ld\n",
+           dd_after_filter, dd_decided);
     printf("implicit point boxes: %ld, infinite %ld, tight (1e-10) %ld\n\n", box_points,
            box_infinite, box_tight);
 }
