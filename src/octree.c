@@ -188,8 +188,9 @@ static bool split_points(const mci_cell *cell, double mid[3])
     return true;
 }
 
-/* Inline maximum and minimum of finite values (fmax and fmin are library calls that
- * also order NaNs, which cannot occur here: the mesh check rejects non-finite input). */
+/* Inline maximum and minimum (fmax and fmin are library calls). They differ from those
+ * only on NaN, which overflow on extreme coordinates can produce; a NaN bound or value
+ * makes a "misses" test below false, which keeps the face: still conservative. */
 static double max_of(double x, double y)
 {
     return x > y ? x : y;
