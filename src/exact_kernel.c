@@ -562,6 +562,47 @@ int mci_orient3d(const mci_point *p, const mci_plane *plane)
     return s != MCI_UNCERTAIN ? s : mci_orient3d_exact(p, plane);
 }
 
+/* The same predicate for an input vertex, without building a point: the pair test
+ * asks it six times per candidate pair. */
+int mci_orient3d_vertex(const double *x, const mci_plane *plane)
+{
+    mci_fv d[3];
+    int s;
+    if (same_coordinates(x, plane->a) || same_coordinates(x, plane->b) ||
+        same_coordinates(x, plane->c))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        d[k] = fv_diff(x[k], plane->a[k]);
+    s = fv_sign(fv_dot(plane->n, d));
+    if (s == MCI_UNCERTAIN) {
+        mci_point p;
+        mci_point_explicit(&p, x);
+        s = mci_orient3d_exact(&p, plane);
+    }
+    return s;
+}
+
+int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d)
+{
+    mci_fv rows[3][3];
+    int s;
+    for (int k = 0; k < 3; k++) {
+        rows[0][k] = fv_diff(b[k], a[k]);
+        rows[1][k] = fv_diff(c[k], a[k]);
+        rows[2][k] = fv_diff(d[k], a[k]);
+    }
+    /* (b - a) x (c - a) . (d - a), as the cyclic det[b - a, c - a, d - a]. */
+    s = fv_sign(fv_det3(rows[0], rows[1], rows[2]));
+    if (s == MCI_UNCERTAIN) {
+        mci_plane plane;
+        mci_point p;
+        mci_plane_init(&plane, a, b, c);
+        mci_point_explicit(&p, d);
+        s = mci_orient3d_exact(&p, &plane);
+    }
+    return s;
+}
+
 /* ---------------------------------------------------------------------------------- */
 /* Coordinate comparison, lexicographic order, equality                                */
 

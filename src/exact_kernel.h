@@ -92,6 +92,13 @@ bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const
  * -1 behind, 0 on the plane. */
 int mci_orient3d(const mci_point *p, const mci_plane *plane);
 
+/* mci_orient3d for the input vertex x (same result as for an explicit point at x). */
+int mci_orient3d_vertex(const double *x, const mci_plane *plane);
+
+/* Side of input vertex d against the plane through input vertices a, b, c oriented by
+ * (b - a) x (c - a): sign((b - a) x (c - a) . (d - a)); 0 when a, b, c are collinear. */
+int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d);
+
 /* sign(a[axis] - b[axis]), axis in 0..2. */
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis);
 

@@ -22,17 +22,65 @@ static const double *corner(const mci_plane *t, int i)
 /* Side of each vertex of t against `plane`. */
 static void vertex_sides(const mci_plane *t, const mci_plane *plane, int side[3])
 {
-    for (int i = 0; i < 3; i++) {
-        mci_point p;
-        mci_point_explicit(&p, corner(t, i));
-        side[i] = mci_orient3d(&p, plane);
-    }
+    for (int i = 0; i < 3; i++)
+        side[i] = mci_orient3d_vertex(corner(t, i), plane);
 }
 
 static bool all_strictly_one_side(const int side[3])
 {
     return (side[0] > 0 && side[1] > 0 && side[2] > 0) ||
            (side[0] < 0 && side[1] < 0 && side[2] < 0);
+}
+
+static bool all_sides_strict(const int side[3])
+{
+    return side[0] != 0 && side[1] != 0 && side[2] != 0;
+}
+
+/* The index of the corner alone on its side (sides all strict, not all equal). */
+static int lone_corner(const int side[3])
+{
+    return side[0] == side[1] ? 2 : side[0] == side[2] ? 1 : 0;
+}
+
+/* t's corners from the lone one on, in t's circular order (same orientation). */
+static void corners_from(const mci_plane *t, int first, const double *out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = corner(t, (first + i) % 3);
+}
+
+static void swap_last_two(const double *v[3])
+{
+    const double *t = v[1];
+    v[1] = v[2];
+    v[2] = t;
+}
+
+/* Whether the sections of t1 and t2 on the common line are apart (a gap between them),
+ * decided on the input vertices alone (Devillers & Guigue 2002), before any point is
+ * constructed: most candidate pairs that cross each other's planes are rejected here.
+ * Name the corners p, q, r with p alone on its side of the other plane, q and r swapped
+ * where needed so that p1 is in front of plane (p2, q2, r2) and p2 in front of plane
+ * (p1, q1, r1). Along d = n1 x n2 the line then crosses t1 from its p1-r1 edge to its
+ * p1-q1 edge, and t2 from p2-q2 to p2-r2. The plane (p1, q1, p2) holds t1's last end
+ * and has normal . d = -((q1 - p1) . n2) ((p2 - p1) . n1) > 0, so orient(p1, q1, p2, q2)
+ * > 0 puts t2's first end strictly after t1's last; orient(p1, r1, p2, r2) < 0 likewise
+ * puts t2's last end strictly before t1's first. Every corner must be strictly off the
+ * other triangle's plane (so no three of these points are collinear). */
+static bool sections_apart(const mci_plane *t1, const int side1[3], const mci_plane *t2,
+                           const int side2[3])
+{
+    const double *v1[3], *v2[3];
+    int lone1 = lone_corner(side1), lone2 = lone_corner(side2);
+    corners_from(t1, lone1, v1);
+    corners_from(t2, lone2, v2);
+    if (side1[lone1] < 0)
+        swap_last_two(v2);
+    if (side2[lone2] < 0)
+        swap_last_two(v1);
+    return mci_orient3d_vertices(v1[0], v1[1], v2[0], v2[1]) > 0 ||
+           mci_orient3d_vertices(v1[0], v1[2], v2[0], v2[2]) < 0;
 }
 
 /* The edge line through u and v, defined in a canonical vertex order. */
@@ -146,6 +194,9 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
         return;
     vertex_sides(t2, t1, side2);
     if (all_strictly_one_side(side2))
+        return;
+    if (all_sides_strict(side1) && all_sides_strict(side2) &&
+        sections_apart(t1, side1, t2, side2))
         return;
     if (side1[0] == 0 && side1[1] == 0 && side1[2] == 0) {
         out->kind = MCI_TT_COPLANAR;
