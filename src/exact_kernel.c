@@ -562,18 +562,44 @@ int mci_orient3d(const mci_point *p, const mci_plane *plane)
     return s != MCI_UNCERTAIN ? s : mci_orient3d_exact(p, plane);
 }
 
-/* The same predicate for an input vertex, without building a point: the pair test
- * asks it six times per candidate pair. */
+/* The double filters of the two vertex predicates below, written out rather than with
+ * the running bounds of mci_fv: the pair test asks them six and two times per candidate
+ * pair. Differences of doubles are rounded by at most u = 2^-53 relative (exact when
+ * subnormal); each product and sum adds u relative and, through underflow, at most
+ * 2^-1074 absolute. Any overflow makes the value or the bound inf or NaN, and the
+ * comparison in filter_sign is then false: uncertain. */
+static int filter_sign(double value, double bound)
+{
+    if (fabs(value) > bound * BOUND_SAFETY)
+        return value > 0 ? 1 : -1;
+    return MCI_UNCERTAIN;
+}
+
+/* value = n.(x - a) from the plane's cached normal (n_k with error e_k). With d_k the
+ * rounded differences and N, D the exact ones: |N.D - n.d| <= (1 + 2u) sum e_k |d_k| +
+ * 2u (1 + 2u) sum |n_k d_k|, and rounding the three products and two sums adds
+ * 3u (1 + 3u) sum |n_k d_k| + 5 * 2^-1074: 2^-50 (8u) covers both coefficients of
+ * sum |n_k d_k|; the (1 + 2u) on the error terms is taken as 1 + 2^-50. */
+int mci_orient3d_vertex_filtered(const double *x, const mci_plane *plane)
+{
+    const mci_fv *n = plane->n;
+    double d0 = x[0] - plane->a[0], d1 = x[1] - plane->a[1], d2 = x[2] - plane->a[2];
+    double p0 = n[0].v * d0, p1 = n[1].v * d1, p2 = n[2].v * d2;
+    double value = p0 + p1 + p2;
+    double errors = n[0].e * fabs(d0) + n[1].e * fabs(d1) + n[2].e * fabs(d2);
+    double bound = errors * (1 + 0x1p-50) + (fabs(p0) + fabs(p1) + fabs(p2)) * 0x1p-50 +
+                   16 * UNDERFLOW_ERROR;
+    return filter_sign(value, bound);
+}
+
+/* The same predicate for an input vertex, without building a point. */
 int mci_orient3d_vertex(const double *x, const mci_plane *plane)
 {
-    mci_fv d[3];
     int s;
     if (same_coordinates(x, plane->a) || same_coordinates(x, plane->b) ||
         same_coordinates(x, plane->c))
         return 0;
-    for (int k = 0; k < 3; k++)
-        d[k] = fv_diff(x[k], plane->a[k]);
-    s = fv_sign(fv_dot(plane->n, d));
+    s = mci_orient3d_vertex_filtered(x, plane);
     if (s == MCI_UNCERTAIN) {
         mci_point p;
         mci_point_explicit(&p, x);
@@ -582,17 +608,36 @@ int mci_orient3d_vertex(const double *x, const mci_plane *plane)
     return s;
 }
 
+/* det[b - a, c - a, d - a] in doubles with Shewchuk's bound for orient3d (errboundA =
+ * (7 + 56u) u times the permanent, for the same expression from rounded differences;
+ * 2^-50 = 8u covers it) plus underflow: a 2x2 minor's products may each lose 2^-1074,
+ * which the outer product scales by |r0_k|. */
+int mci_orient3d_vertices_filtered(const double *a, const double *b, const double *c,
+                                   const double *d)
+{
+    double r0[3], r1[3], r2[3], m[3], mabs[3], value = 0, permanent = 0, outer = 0;
+    for (int k = 0; k < 3; k++) {
+        r0[k] = b[k] - a[k];
+        r1[k] = c[k] - a[k];
+        r2[k] = d[k] - a[k];
+    }
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        double x = r1[i] * r2[j], y = r1[j] * r2[i];
+        m[k] = x - y;
+        mabs[k] = fabs(x) + fabs(y);
+    }
+    for (int k = 0; k < 3; k++) {
+        value += r0[k] * m[k];
+        permanent += fabs(r0[k]) * mabs[k];
+        outer += fabs(r0[k]);
+    }
+    return filter_sign(value, permanent * 0x1p-50 + (outer + 1) * 16 * UNDERFLOW_ERROR);
+}
+
 int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d)
 {
-    mci_fv rows[3][3];
-    int s;
-    for (int k = 0; k < 3; k++) {
-        rows[0][k] = fv_diff(b[k], a[k]);
-        rows[1][k] = fv_diff(c[k], a[k]);
-        rows[2][k] = fv_diff(d[k], a[k]);
-    }
-    /* (b - a) x (c - a) . (d - a), as the cyclic det[b - a, c - a, d - a]. */
-    s = fv_sign(fv_det3(rows[0], rows[1], rows[2]));
+    int s = mci_orient3d_vertices_filtered(a, b, c, d);
     if (s == MCI_UNCERTAIN) {
         mci_plane plane;
         mci_point p;

@@ -180,6 +180,9 @@ void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);
 #define MCI_UNCERTAIN 2
 
 int mci_orient3d_filtered(const mci_point *p, const mci_plane *plane);
+int mci_orient3d_vertex_filtered(const double *x, const mci_plane *plane);
+int mci_orient3d_vertices_filtered(const double *a, const double *b, const double *c,
+                                   const double *d);
 int mci_orient3d_exact(const mci_point *p, const mci_plane *plane);
 int mci_compare_coord_filtered(const mci_point *a, const mci_point *b, int axis);
 int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis);

@@ -1159,6 +1159,32 @@ static void check_orient2d_dd(const scenario *s, const query *q, int filtered, i
     }
 }
 
+/* The vertex forms of orient3d (an input vertex against a plane, and against the plane
+ * of three input vertices): full predicate equal to the reference, filter never wrong. */
+static long vertex_filter_cases, vertex_filter_decided;
+
+static void check_orient3d_vertex(const scenario *s, const query *q, int ref)
+{
+    const mci_point *a = &ws.kpt[q->pt[0]];
+    const mci_plane *p = &ws.kpl[q->pl[0]];
+    const double *x = a->v[0];
+    int f1, f2;
+    if (a->kind != MCI_POINT_EXPLICIT)
+        return;
+    f1 = mci_orient3d_vertex_filtered(x, p);
+    f2 = mci_orient3d_vertices_filtered(p->a, p->b, p->c, x);
+    CHECK_MSG(mci_orient3d_vertex(x, p) == ref, "mci_orient3d_vertex (%s): reference %d",
+              class_names[s->cls], ref);
+    CHECK_MSG(mci_orient3d_vertices(p->a, p->b, p->c, x) == ref,
+              "mci_orient3d_vertices (%s): reference %d", class_names[s->cls], ref);
+    CHECK_MSG(f1 == MCI_UNCERTAIN || f1 == ref, "mci_orient3d_vertex_filtered (%s): %d, "
+              "reference %d", class_names[s->cls], f1, ref);
+    CHECK_MSG(f2 == MCI_UNCERTAIN || f2 == ref, "mci_orient3d_vertices_filtered (%s): %d, "
+              "reference %d", class_names[s->cls], f2, ref);
+    vertex_filter_cases += 2;
+    vertex_filter_decided += (f1 != MCI_UNCERTAIN) + (f2 != MCI_UNCERTAIN);
+}
+
 static void run_query(const scenario *s, const query *q)
 {
     int got[3], ref = ref_eval(q);
@@ -1168,6 +1194,8 @@ static void run_query(const scenario *s, const query *q)
     check_case(s, q, got, ref);
     if (q->pred == PR_ORIENT2D)
         check_orient2d_dd(s, q, got[2], ref);
+    if (q->pred == PR_ORIENT3D)
+        check_orient3d_vertex(s, q, ref);
 }
 
 /* Indices of the points that exist; returns their count. */
@@ -1825,6 +1853,8 @@ static void print_predicate_table(void)
            dd_round_tries);
     printf("orient2d cases the first filter left: %ld, double-double stage decided %ld\n",
            dd_after_filter, dd_decided);
+    printf("orient3d of input vertices: %ld filter cases, %ld decided by the filter\n",
+           vertex_filter_cases, vertex_filter_decided);
     printf("implicit point boxes: %ld, infinite %ld, tight (1e-10) %ld\n\n", box_points,
            box_infinite, box_tight);
 }
