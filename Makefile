@@ -4,7 +4,8 @@
 #   make test       gcc build with -Werror + the whole suite, then again under ASan+UBSan,
 #                   and a clang -Werror compile check
 #   make sanitize   only the ASan+UBSan build and suite
-#   make bench      Release build and the benchmarks in bench/
+#   make bench      Release build and the benchmarks in bench/ (with the CGAL comparison
+#                   when libcgal-dev is installed)
 #   make fuzz       libFuzzer (clang) on every parser and the evaluator for FUZZ_SECONDS
 #                   each (default 60)
 #   make fuzz-csg   differential CSG fuzzing against the winding-number oracle for SECONDS
@@ -51,7 +52,7 @@ clang-check:
 	cmake --build $(BUILD)/clang -j $(JOBS)
 
 bench: deps
-	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
+	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release -DMCSG_CGAL_BENCH=ON $(CMAKE_FLAGS) >/dev/null
 	cmake --build $(BUILD)/release -j $(JOBS)
 	bash bench/run.sh $(BUILD)/release
 

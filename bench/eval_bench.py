@@ -282,11 +282,12 @@ def ring_growth(rows):
     return ''
 
 
-def write_doc(doc, text):
+def write_doc(doc, text, begin=BEGIN, end=END):
+    """Replaces the block between the markers begin and end (appends it if absent)."""
     old = open(doc).read() if os.path.exists(doc) else ''
-    block = BEGIN + '\n' + text + '\n' + END
-    if BEGIN in old and END in old:
-        new = old[:old.index(BEGIN)] + block + old[old.index(END) + len(END):]
+    block = begin + '\n' + text + '\n' + end
+    if begin in old and end in old:
+        new = old[:old.index(begin)] + block + old[old.index(end) + len(end):]
     else:
         new = old.rstrip('\n') + '\n\n' + block + '\n'
     open(doc, 'w').write(new)
