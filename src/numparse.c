@@ -487,9 +487,43 @@ static bool scaled_decimal(double value, int scale, u128 *out)
     return true;
 }
 
+/* Whether the decimal digits * 10^-scale reads back as the nonzero double value
+ * (nearest double, ties to even), decided on integers: with |value| = m 2^(e-53),
+ * m in [2^52, 2^53), one ulp times 10^scale is 5^scale 2^shift (shift = e - 53 + scale),
+ * and everything is scaled by 2^(2 - shift) to stay integral: the value is 4 m 5^scale,
+ * the half gap above 2 * 5^scale, below the same or half of it when m = 2^52 (the next
+ * double down is in the binade below). A decimal exactly halfway would read back as value
+ * when m is even (a midpoint between doubles needs 17 or more significant digits where
+ * this test applies, so this stays a statement of the rule). Returns -1 when the
+ * integers would not fit (the caller then parses). */
+static int reads_back(double value, u128 digits, int scale)
+{
+    int e;
+    double fraction = frexp(fabs(value), &e);
+    uint64_t m = (uint64_t)ldexp(fraction, 53);
+    int shift = e - 53 + scale;
+    u128 five, exact, text_value, diff, gap;
+    if (scale < 0 || scale > 27 || shift > 0 || shift < -60 || e < -1000 ||
+        digits >= ((u128)1 << 57))
+        return -1;
+    five = pow10_u128(scale) >> scale; /* 5^scale < 2^63 */
+    exact = (u128)m * five * 4;        /* < 2^118 */
+    text_value = digits << (2 - shift); /* < 2^119 */
+    if (text_value >= exact) {
+        diff = text_value - exact;
+        gap = five * 2;
+    } else {
+        diff = exact - text_value;
+        gap = m == ((uint64_t)1 << 52) ? five : five * 2;
+    }
+    return diff < gap || (diff == gap && m % 2 == 0);
+}
+
 /* printf's "%.*g" of a nonzero finite value, from the exact digits above; 0 when the
- * value's decimal exponent is outside their range (then printf is used). */
-static size_t format_g_exact(char *text, double value, int precision)
+ * value's decimal exponent is outside their range (then printf is used). The digits and
+ * their scale (the text is digits * 10^-scale) go to *digits_out and *scale_out. */
+static size_t format_g_exact(char *text, double value, int precision, u128 *digits_out,
+                             int *scale_out)
 {
     int exponent = (int)floor(log10(fabs(value))), tries = 0;
     u128 digits, low = pow10_u128(precision - 1), high = pow10_u128(precision);
@@ -515,8 +549,12 @@ static size_t format_g_exact(char *text, double value, int precision)
             digits = below;
         }
     }
-    for (int k = 0; k < precision; k++, digits /= 10)
-        d[precision - 1 - k] = (char)('0' + (int)(digits % 10));
+    *digits_out = digits;
+    *scale_out = precision - 1 - exponent;
+    /* digits < 10^precision <= 10^17 < 2^64: 64-bit division by 10 is a multiplication,
+     * the 128-bit one a library call. */
+    for (uint64_t rest = (uint64_t)digits, k = 0; k < (uint64_t)precision; k++, rest /= 10)
+        d[precision - 1 - (int)k] = (char)('0' + (int)(rest % 10));
     count = (size_t)precision;
     while (count > 1 && d[count - 1] == '0')
         count--; /* %g drops trailing zeros */
@@ -559,7 +597,9 @@ static bool format_round_trips(double value, int precision, char text[64], size_
 {
     double back;
     const char *next;
-    int n = value != 0 ? (int)format_g_exact(text, value, precision) : 0;
+    u128 digits = 0;
+    int scale = 0, exact;
+    int n = value != 0 ? (int)format_g_exact(text, value, precision, &digits, &scale) : 0;
     if (n == 0)
         n = snprintf(text, 64, "%.*g", precision, value);
     if (n < 0 || n >= 64) { /* cannot happen for a finite double */
@@ -568,8 +608,11 @@ static bool format_round_trips(double value, int precision, char text[64], size_
         return false;
     }
     *len = normalise_decimal_point(text, (size_t)n);
-    return precision == 17 ||
-           (mci_parse_double(text, text + *len, &back, &next) && back == value);
+    if (precision == 17)
+        return true;
+    if (digits != 0 && (exact = reads_back(value, digits, scale)) >= 0)
+        return exact;
+    return mci_parse_double(text, text + *len, &back, &next) && back == value;
 }
 
 /* Whether %.15g writes |value| without an exponent (decimal exponent -4 .. 14). */

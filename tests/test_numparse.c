@@ -377,6 +377,15 @@ TEST(format_typical_range)
         mci_format_double(out, d);
         CHECK_MSG(shortest_is_right(d, out), "%a formatted as %s", d, out);
     }
+    /* Powers of two: the gap to the next double down is half the gap up, which the
+     * exact read-back test must take into account. */
+    for (int k = -70; k <= 70; k++) {
+        double p = ldexp(1.0, k), near[3] = {p, nextafter(p, 0), nextafter(p, INFINITY)};
+        for (int j = 0; j < 3; j++) {
+            mci_format_double(out, near[j]);
+            CHECK_MSG(shortest_is_right(near[j], out), "%a formatted as %s", near[j], out);
+        }
+    }
     for (int k = -25; k <= 25; k++) {
         double p = pow(10, k), near[5] = {p, nextafter(p, 0), nextafter(p, INFINITY),
                                           nextafter(nextafter(p, 0), 0),
