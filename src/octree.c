@@ -15,7 +15,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define DEFAULT_MAX_CELL_FACES 24
+/* 48 rather than 24: fewer cells to build for some 10% more candidate pairs, now that a
+ * pair apart is rejected cheaply (ring-300 -3%, 700 spheres -4.5%, bunny x bunny -3%
+ * instructions, cylinder +0.2%; same pairs that intersect, same outputs). */
+#define DEFAULT_MAX_CELL_FACES 48
 #define DEFAULT_MAX_DEPTH 14
 #define NO_CHILD UINT32_MAX
 
