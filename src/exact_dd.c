@@ -195,7 +195,7 @@ static int side_of(const dd_point *e, int w_sign, int k, dd m)
 static bool round_coordinate(const dd_point *e, int w_sign, int k, double c, double *out)
 {
     for (int step = 0; step < 3; step++) {
-        double up = nextafter(c, INFINITY), down = nextafter(c, -INFINITY);
+        double up = mci_next_up(c), down = mci_next_down(c);
         int above, below;
         /* Far from underflow (half gaps stay exact) and from overflow. */
         if (!(fabs(c) >= 0x1p-900) || !isfinite(up) || !isfinite(down))

@@ -449,7 +449,7 @@ static bool round_filtered(const mci_point *p, int k, double *out, double *guess
     *guess = hi;
     bv = hi - base;
     lo = (base - (hi - bv)) + (q - bv);
-    gap = fmin(nextafter(hi, INFINITY) - hi, hi - nextafter(hi, -INFINITY)) / 2;
+    gap = fmin(mci_next_up(hi) - hi, hi - mci_next_down(hi)) / 2;
     if (!isfinite(hi) || !(fabs(hi) >= 0x1p-900) || !((fabs(lo) + err) * (1 + 0x1p-50) < gap))
         return false;
     *out = hi;
@@ -490,8 +490,8 @@ void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
             lo[k] = hi[k] = p->c[k];
         } else {
             /* one step outward covers the rounding of c -+ r */
-            lo[k] = nextafter(p->c[k] - p->r, -INFINITY);
-            hi[k] = nextafter(p->c[k] + p->r, INFINITY);
+            lo[k] = mci_next_down(p->c[k] - p->r);
+            hi[k] = mci_next_up(p->c[k] + p->r);
         }
     }
 }

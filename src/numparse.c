@@ -487,6 +487,21 @@ static bool scaled_decimal(double value, int scale, u128 *out)
     return true;
 }
 
+static const char digit_pairs[] = /* "00" "01" ... "99" */
+    "00010203040506070809101112131415161718192021222324"
+    "25262728293031323334353637383940414243444546474849"
+    "50515253545556575859606162636465666768697071727374"
+    "75767778798081828384858687888990919293949596979899";
+
+/* The `count` decimal digits of n (with leading zeros) into out, two at a time. */
+static void write_digits(char *out, uint64_t n, int count)
+{
+    for (; count >= 2; count -= 2, n /= 100)
+        memcpy(out + count - 2, digit_pairs + 2 * (n % 100), 2);
+    if (count == 1)
+        out[0] = (char)('0' + (int)(n % 10));
+}
+
 /* Whether the decimal digits * 10^-scale reads back as the nonzero double value
  * (nearest double, ties to even), decided on integers: with |value| = m 2^(e-53),
  * m in [2^52, 2^53), one ulp times 10^scale is 5^scale 2^shift (shift = e - 53 + scale),
@@ -551,10 +566,9 @@ static size_t format_g_exact(char *text, double value, int precision, u128 *digi
     }
     *digits_out = digits;
     *scale_out = precision - 1 - exponent;
-    /* digits < 10^precision <= 10^17 < 2^64: 64-bit division by 10 is a multiplication,
-     * the 128-bit one a library call. */
-    for (uint64_t rest = (uint64_t)digits, k = 0; k < (uint64_t)precision; k++, rest /= 10)
-        d[precision - 1 - (int)k] = (char)('0' + (int)(rest % 10));
+    /* digits < 10^precision <= 10^17 < 2^64: 64-bit division is a multiplication, the
+     * 128-bit one a library call. */
+    write_digits(d, (uint64_t)digits, precision);
     count = (size_t)precision;
     while (count > 1 && d[count - 1] == '0')
         count--; /* %g drops trailing zeros */
@@ -600,14 +614,16 @@ static bool format_round_trips(double value, int precision, char text[64], size_
     u128 digits = 0;
     int scale = 0, exact;
     int n = value != 0 ? (int)format_g_exact(text, value, precision, &digits, &scale) : 0;
-    if (n == 0)
+    bool from_printf = n == 0;
+    if (from_printf)
         n = snprintf(text, 64, "%.*g", precision, value);
     if (n < 0 || n >= 64) { /* cannot happen for a finite double */
         memcpy(text, "0", 2);
         *len = 1;
         return false;
     }
-    *len = normalise_decimal_point(text, (size_t)n);
+    /* Only printf's text can hold the locale's decimal point. */
+    *len = from_printf ? normalise_decimal_point(text, (size_t)n) : (size_t)n;
     if (precision == 17)
         return true;
     if (digits != 0 && (exact = reads_back(value, digits, scale)) >= 0)

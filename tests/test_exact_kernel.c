@@ -27,6 +27,7 @@
 #include "exact_kernel.h"
 #include "testlib.h"
 
+#include <float.h>
 #include <gmp.h>
 #include <math.h>
 #include <stdint.h>
@@ -1859,6 +1860,33 @@ static void print_predicate_table(void)
            box_infinite, box_tight);
 }
 
+static bool same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+/* The inline steps agree with nextafter on special values and random bit patterns. */
+TEST(next_double)
+{
+    static const double special[] = {0.0, -0.0, 0x1p-1074, -0x1p-1074, 0x1p-1022, -0x1p-1022,
+                                     1.0, -1.0, DBL_MAX, -DBL_MAX, INFINITY, -INFINITY};
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++) {
+        double x = special[i];
+        CHECK_MSG(same_bits(mci_next_up(x), nextafter(x, INFINITY)), "next_up(%a)", x);
+        CHECK_MSG(same_bits(mci_next_down(x), nextafter(x, -INFINITY)), "next_down(%a)", x);
+    }
+    CHECK(isnan(mci_next_up(NAN)) && isnan(mci_next_down(NAN)));
+    for (int i = 0; i < 200000; i++) {
+        uint64_t bits = rng_next();
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        if (isnan(x))
+            continue;
+        CHECK_MSG(same_bits(mci_next_up(x), nextafter(x, INFINITY)), "next_up(%a)", x);
+        CHECK_MSG(same_bits(mci_next_down(x), nextafter(x, -INFINITY)), "next_down(%a)", x);
+    }
+}
+
 int main(void)
 {
     const char *seed = getenv("MCSG_TEST_SEED");
@@ -1866,6 +1894,7 @@ int main(void)
         rng_state = strtoull(seed, NULL, 0);
     printf("seed 0x%llx, scale %g\n", (unsigned long long)rng_state, test_scale());
     ws_init();
+    RUN(next_double);
     RUN(reference_sanity);
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);
