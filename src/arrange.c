@@ -154,12 +154,23 @@ bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point
 /* ---------------------------------------------------------------------------------- */
 /* Coplanar faces: clip each of their edges to this face                               */
 
+/* Corner i as a point: points 0..2 are the corners (merging keeps them there), stored
+ * as built unless merging chose a coincident copy; the sign of a predicate does not
+ * depend on which definition of a point it gets, only its cost does. */
+static const mci_point *corner_point(const mci_face_arr *arr, int i, mci_point *scratch)
+{
+    const mci_point *p = arr->point_count > (size_t)i ? &arr->points[i] : NULL;
+    if (p && p->kind == MCI_POINT_EXPLICIT && p->v[0] == corner(arr, i))
+        return p;
+    mci_point_explicit(scratch, corner(arr, i));
+    return scratch;
+}
+
 static int side_of_edge(const mci_face_arr *arr, int e, const mci_point *p)
 {
-    mci_point c0, c1;
-    mci_point_explicit(&c0, corner(arr, e));
-    mci_point_explicit(&c1, corner(arr, (e + 1) % 3));
-    return arr->sign * mci_orient2d_projected(&c0, &c1, p, arr->axis);
+    mci_point s0, s1;
+    const mci_point *c0 = corner_point(arr, e, &s0), *c1 = corner_point(arr, (e + 1) % 3, &s1);
+    return arr->sign * mci_orient2d_projected(c0, c1, p, arr->axis);
 }
 
 /* The part of the line u->v inside the face is [*start, *end]: each face edge the
