@@ -335,14 +335,27 @@ static uint8_t locate_in_face(const mci_face_arr *arr, const mci_point *p)
     return UINT8_MAX;
 }
 
-static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
+#define WHERE_UNKNOWN UINT8_C(0xfe)
+
+/* MCI_AT_* of every point after a merge. Points of the previous merge (old ids below
+ * `known_count`, locations `known`) keep theirs through remap: a location depends on
+ * the point alone, not on which of its copies is stored. */
+static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr,
+                                   const uint8_t *known, size_t known_count,
+                                   const uint32_t *remap, mcsg_error *err)
 {
-    uint8_t *where = mci_realloc_array(ctx, arr->where, arr->point_count, 1);
+    uint8_t *where = mci_malloc_array(ctx, arr->point_count + 1, 1);
     if (!where)
         return mci_fail_nomem(err, "arranging a face");
+    memset(where, WHERE_UNKNOWN, arr->point_count);
+    for (size_t i = 0; i < known_count; i++)
+        where[remap[i]] = known[i];
+    mci_free(ctx, arr->where);
     arr->where = where;
     arr->where_count = arr->point_count;
     for (size_t i = 0; i < arr->point_count; i++) {
+        if (where[i] != WHERE_UNKNOWN)
+            continue;
         where[i] = i < 3 ? (uint8_t)(MCI_AT_CORNER + i) : locate_in_face(arr, &arr->points[i]);
         if (i >= 3 && where[i] < MCI_AT_EDGE)
             return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a corner "
@@ -352,6 +365,40 @@ static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr, mcsg_e
                             "the face", arr->face);
     }
     return MCSG_OK;
+}
+
+/* Merges two runs of point ids sorted by mci_compare_lex (a before b on ties, as a
+ * stable sort keeps the lower ids of run a first) into out. */
+static void merge_runs(const mci_point *const *table, const uint32_t *a, size_t na,
+                       const uint32_t *b, size_t nb, uint32_t *out)
+{
+    size_t i = 0, j = 0, k = 0;
+    while (i < na && j < nb)
+        out[k++] = mci_compare_lex(table[b[j]], table[a[i]]) < 0 ? b[j++] : a[i++];
+    while (i < na)
+        out[k++] = a[i++];
+    while (j < nb)
+        out[k++] = b[j++];
+}
+
+/* The order mci_sort_point_ids gives all n points when the first `merged` are the
+ * result of the previous merge (corners 0..2, then distinct points in lexicographic
+ * order) and the rest were added since: the corners are merged into the sorted run,
+ * the new points sorted alone, and the two runs merged. The same stable order for far
+ * fewer comparisons: faces receiving a few points from their neighbours' edges are
+ * merged again. idx and tmp hold n ids. */
+static void sort_after_merge(const mci_point *const *table, size_t merged, size_t n,
+                             uint32_t *idx, uint32_t *tmp)
+{
+    uint32_t corners[3] = {0, 1, 2}, scratch[3];
+    for (size_t i = 3; i < n; i++)
+        tmp[i] = (uint32_t)i;
+    mci_sort_point_ids(table, corners, scratch, 3);
+    merge_runs(table, corners, 3, tmp + 3, merged - 3, idx);
+    mci_sort_point_ids(table, tmp + merged, idx + merged, n - merged);
+    /* Into tmp itself: output slot i + j never passes the unread new ids at merged + j. */
+    merge_runs(table, idx, merged, tmp + merged, n - merged, tmp);
+    memcpy(idx, tmp, n * sizeof *idx);
 }
 
 /* Merge, and return the id map (old -> new) through *remap_out if wanted. */
@@ -367,10 +414,16 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     mci_point_lines *merged_lines = NULL;
     mcsg_status st = table && idx && tmp && remap ? MCSG_OK
                                                   : mci_fail_nomem(err, "arranging a face");
+    /* After a merge, where_count is its point count and only appends follow. */
+    size_t before = arr->where_count >= 3 && arr->where_count <= n ? arr->where_count : 0;
     if (st == MCSG_OK) {
-        for (size_t i = 0; i < n; i++)
-            idx[i] = (uint32_t)i;
-        mci_sort_point_ids(table, idx, tmp, n);
+        if (before) {
+            sort_after_merge(table, before, n, idx, tmp);
+        } else {
+            for (size_t i = 0; i < n; i++)
+                idx[i] = (uint32_t)i;
+            mci_sort_point_ids(table, idx, tmp, n);
+        }
         kept = merge_ids(arr, idx, remap);
         /* Sized after merging: faces with twins or many neighbours along their edges
          * collect several copies of each point, and the arrangement keeps this array. */
@@ -403,7 +456,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         arr->point_count = arr->point_capacity = kept;
         merged = NULL;
         merged_lines = NULL;
-        st = classify_points(ctx, arr, err);
+        st = classify_points(ctx, arr, arr->where, before, remap, err);
         arr->dirty = false;
     }
     if (remap_out && st == MCSG_OK)
