@@ -253,19 +253,27 @@ bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
 /* ---------------------------------------------------------------------------------- */
 /* Exact merging                                                                       */
 
+/* Merges two runs of point ids sorted by mci_compare_lex (a before b on ties, as a
+ * stable sort keeps the lower ids of run a first) into out. */
+static void merge_runs(const mci_point *const *table, const uint32_t *a, size_t na,
+                       const uint32_t *b, size_t nb, uint32_t *out)
+{
+    size_t i = 0, j = 0, k = 0;
+    while (i < na && j < nb)
+        out[k++] = mci_compare_lex(table[b[j]], table[a[i]]) < 0 ? b[j++] : a[i++];
+    while (i < na)
+        out[k++] = a[i++];
+    while (j < nb)
+        out[k++] = b[j++];
+}
+
 void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n)
 {
     for (size_t width = 1; width < n; width *= 2) {
         for (size_t lo = 0; lo < n; lo += 2 * width) {
             size_t mid = lo + width < n ? lo + width : n;
             size_t hi = lo + 2 * width < n ? lo + 2 * width : n;
-            size_t i = lo, j = mid, k = lo;
-            while (i < mid && j < hi)
-                tmp[k++] = mci_compare_lex(table[ids[j]], table[ids[i]]) < 0 ? ids[j++] : ids[i++];
-            while (i < mid)
-                tmp[k++] = ids[i++];
-            while (j < hi)
-                tmp[k++] = ids[j++];
+            merge_runs(table, ids + lo, mid - lo, ids + mid, hi - mid, tmp + lo);
         }
         memcpy(ids, tmp, n * sizeof *ids);
     }
@@ -365,20 +373,6 @@ static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr,
                             "the face", arr->face);
     }
     return MCSG_OK;
-}
-
-/* Merges two runs of point ids sorted by mci_compare_lex (a before b on ties, as a
- * stable sort keeps the lower ids of run a first) into out. */
-static void merge_runs(const mci_point *const *table, const uint32_t *a, size_t na,
-                       const uint32_t *b, size_t nb, uint32_t *out)
-{
-    size_t i = 0, j = 0, k = 0;
-    while (i < na && j < nb)
-        out[k++] = mci_compare_lex(table[b[j]], table[a[i]]) < 0 ? b[j++] : a[i++];
-    while (i < na)
-        out[k++] = a[i++];
-    while (j < nb)
-        out[k++] = b[j++];
 }
 
 /* The order mci_sort_point_ids gives all n points when the first `merged` are the
