@@ -514,9 +514,12 @@ static void intro_sort_keyed(mci_keyed *items, size_t n, int depth)
     insertion_sort_keyed(items, n);
 }
 
+/* Byte `shift` / 8 of the 96-bit rank. Shifts are multiples of 8, so a digit lies
+ * wholly in the key (shift >= 32) or in the ref: no 128-bit shift. */
 static size_t keyed_digit(const mci_keyed *item, int shift)
 {
-    return (size_t)(keyed_rank(item) >> shift) & 255;
+    uint64_t word = shift >= 32 ? item->key >> (shift - 32) : (uint64_t)item->ref >> shift;
+    return (size_t)(word & 255);
 }
 
 /* In-place most-significant-digit radix sort (American flag sort) on the 96-bit rank,
