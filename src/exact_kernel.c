@@ -532,32 +532,19 @@ static bool same_coordinates(const double *a, const double *b)
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
 }
 
-/* An explicit point equal to an input vertex that defines the plane lies on it: the
- * common case of shared and duplicated vertices (identical operands), which the filter
- * cannot decide (the value is exactly zero). */
-static bool explicit_on_plane(const mci_point *p, const mci_plane *plane)
-{
-    return p->kind == MCI_POINT_EXPLICIT &&
-           (same_coordinates(p->v[0], plane->a) || same_coordinates(p->v[0], plane->b) ||
-            same_coordinates(p->v[0], plane->c));
-}
-
 /* An explicit point at p's exact coordinates (p must be exact on every axis). */
 static void exact_twin(const mci_point *p, mci_point *twin)
 {
     mci_point_explicit(twin, p->c);
 }
 
+/* A point at known coordinates (explicit, or exact on every axis) is an input vertex
+ * for the predicate: the vertex form decides it without the running bounds. */
 int mci_orient3d(const mci_point *p, const mci_plane *plane)
 {
     int s;
-    if (p->kind != MCI_POINT_EXPLICIT && p->exact_axes == 7) {
-        mci_point twin;
-        exact_twin(p, &twin);
-        return mci_orient3d(&twin, plane);
-    }
-    if (explicit_on_plane(p, plane))
-        return 0;
+    if (p->kind == MCI_POINT_EXPLICIT || p->exact_axes == 7)
+        return mci_orient3d_vertex(p->c, plane);
     s = mci_orient3d_filtered(p, plane);
     return s != MCI_UNCERTAIN ? s : mci_orient3d_exact(p, plane);
 }
@@ -592,7 +579,9 @@ int mci_orient3d_vertex_filtered(const double *x, const mci_plane *plane)
     return filter_sign(value, bound);
 }
 
-/* The same predicate for an input vertex, without building a point. */
+/* The same predicate for an input vertex, without building a point. A vertex equal to
+ * one that defines the plane lies on it: the common case of shared and duplicated
+ * vertices (identical operands), which the filter cannot decide (the value is 0). */
 int mci_orient3d_vertex(const double *x, const mci_plane *plane)
 {
     int s;
