@@ -110,11 +110,6 @@ static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point 
     return true;
 }
 
-bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
-{
-    return add_point_on(ctx, arr, p, 0);
-}
-
 static void add_line(mci_point_lines *l, uint64_t line)
 {
     for (int i = 0; i < l->count; i++)
@@ -124,17 +119,54 @@ static void add_line(mci_point_lines *l, uint64_t line)
         l->id[l->count++] = line;
 }
 
+/* The corner an explicit point coincides with, or -1. */
+static int coinciding_corner(const mci_face_arr *arr, const mci_point *p)
+{
+    const double *x = p->v[0];
+    if (p->kind != MCI_POINT_EXPLICIT || arr->point_count < 3)
+        return -1;
+    for (int i = 0; i < 3; i++) {
+        const double *c = corner(arr, i);
+        if (x[0] == c[0] && x[1] == c[1] && x[2] == c[2])
+            return i;
+    }
+    return -1;
+}
+
+/* add_point_on, except that a copy of a corner replaces the corner's stored copy instead
+ * of being appended: merging would join them and keep the last copy and every line, so
+ * the result is the same, without sorting the copies (a face with a coplanar twin and
+ * touching neighbours receives each corner a dozen times). Returns the point's index,
+ * or UINT32_MAX when out of memory. */
+static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
+                               uint64_t line)
+{
+    int k = coinciding_corner(arr, p);
+    if (k < 0)
+        return add_point_on(ctx, arr, p, line) ? (uint32_t)arr->point_count - 1 : UINT32_MAX;
+    arr->points[k] = *p;
+    add_line(&arr->lines[k], line);
+    arr->dirty = true;
+    return (uint32_t)k;
+}
+
+bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    return add_point_once(ctx, arr, p, 0) != UINT32_MAX;
+}
+
 static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
                         const mci_point *b, const mci_arr_segment *s)
 {
-    uint32_t ia = (uint32_t)arr->point_count;
-    if (!add_point_on(ctx, arr, a, s->line) || !add_point_on(ctx, arr, b, s->line) ||
+    uint32_t ia = add_point_once(ctx, arr, a, s->line);
+    uint32_t ib = ia == UINT32_MAX ? UINT32_MAX : add_point_once(ctx, arr, b, s->line);
+    if (ib == UINT32_MAX ||
         !mci_grow_array(ctx, (void **)&arr->segments, &arr->segment_capacity,
                         arr->segment_count + 1, sizeof *arr->segments, 8))
         return false;
     arr->segments[arr->segment_count] = *s;
     arr->segments[arr->segment_count].a = ia;
-    arr->segments[arr->segment_count++].b = ia + 1;
+    arr->segments[arr->segment_count++].b = ib;
     return true;
 }
 
