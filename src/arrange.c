@@ -186,13 +186,14 @@ bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point
 /* ---------------------------------------------------------------------------------- */
 /* Coplanar faces: clip each of their edges to this face                               */
 
-/* Corner i as a point: points 0..2 are the corners (merging keeps them there), stored
- * as built unless merging chose a coincident copy; the sign of a predicate does not
- * depend on which definition of a point it gets, only its cost does. */
+/* Corner i as a point: points 0..2 are the corners (merging and add_point_once keep
+ * them there), stored as built or as a coincident copy; the sign of a predicate does not
+ * depend on which definition of a point it gets, only its cost does, so any explicit
+ * copy will do. */
 static const mci_point *corner_point(const mci_face_arr *arr, int i, mci_point *scratch)
 {
     const mci_point *p = arr->point_count > (size_t)i ? &arr->points[i] : NULL;
-    if (p && p->kind == MCI_POINT_EXPLICIT && p->v[0] == corner(arr, i))
+    if (p && p->kind == MCI_POINT_EXPLICIT)
         return p;
     mci_point_explicit(scratch, corner(arr, i));
     return scratch;

@@ -142,13 +142,23 @@ static bool join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks, si
     return true;
 }
 
-static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
-                                   size_t count, hit_list *hits, mcsg_error *err)
+static void free_plane_cache(const mci_ctx *ctx, plane_cache *c)
 {
-    plane_cache cache = {NULL, NULL};
+    mci_free(ctx, c->slot);
+    mci_free(ctx, c->planes);
+    c->slot = NULL;
+    c->planes = NULL;
+}
+
+/* The hits of the candidate pairs, and in *cache the planes of their faces (the
+ * arrangements use them again). */
+static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
+                                   size_t count, plane_cache *cache, hit_list *hits,
+                                   mcsg_error *err)
+{
     size_t n = (count + PAIR_CHUNK - 1) / PAIR_CHUNK;
-    pair_job job = {ctx, pairs, count, &cache, mci_calloc_array(ctx, n + 1, sizeof *job.chunks)};
-    mcsg_status st = job.chunks && cache_planes(ctx, s, pairs, count, &cache)
+    pair_job job = {ctx, pairs, count, cache, mci_calloc_array(ctx, n + 1, sizeof *job.chunks)};
+    mcsg_status st = job.chunks && cache_planes(ctx, s, pairs, count, cache)
                          ? MCSG_OK
                          : mci_fail_nomem(err, "intersecting faces");
     if (st == MCSG_OK)
@@ -158,8 +168,6 @@ static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint6
     for (size_t c = 0; job.chunks && c < n; c++)
         mci_free(ctx, job.chunks[c].hits.v);
     mci_free(ctx, job.chunks);
-    mci_free(ctx, cache.slot);
-    mci_free(ctx, cache.planes);
     return st;
 }
 
@@ -372,15 +380,14 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit
 }
 
 static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
-                    const pair_hit *h, const face_facts *ff)
+                    const pair_hit *h, const face_facts *ff, const plane_cache *planes)
 {
     uint32_t other = h->f == arr->face ? h->g : h->f;
-    mci_plane plane;
+    const mci_plane *plane = &planes->planes[planes->slot[other]];
     bool crease[3];
-    face_plane(s, other, &plane);
     switch (h->kind) {
     case MCI_TT_SEGMENT:
-        return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, &plane,
+        return mci_arr_add_crossing(ctx, arr, &h->end[0], &h->end[1], other, plane,
                                     ff->plane_rep[other], s->octree.face_leaf[other],
                                     h->along_edge[h->f == arr->face ? 1 : 0]);
     case MCI_TT_POINT:
@@ -388,13 +395,14 @@ static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
     default:
         for (int i = 0; i < 3; i++)
             crease[i] = (ff->crease[other] >> i) & 1;
-        return mci_arr_add_coplanar(ctx, arr, other, &plane, crease, s->octree.face_leaf[other]);
+        return mci_arr_add_coplanar(ctx, arr, other, plane, crease, s->octree.face_leaf[other]);
     }
 }
 
 static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t f,
                                 const hit_list *hits, const uint32_t *ids, size_t n,
-                                const face_facts *ff, mci_face_arr *arr, mcsg_error *err)
+                                const face_facts *ff, const plane_cache *planes,
+                                mci_face_arr *arr, mcsg_error *err)
 {
     size_t coplanar = 0;
     mcsg_status st;
@@ -403,7 +411,7 @@ static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t
     st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
                       mci_scene_corner(s, f, 2), coplanar, err);
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
-        if (!add_hit(ctx, s, arr, &hits->v[ids[i]], ff))
+        if (!add_hit(ctx, s, arr, &hits->v[ids[i]], ff, planes))
             st = mci_fail_nomem(err, "arranging faces");
     return st == MCSG_OK ? mci_arr_merge(ctx, arr, err) : st;
 }
@@ -488,6 +496,7 @@ typedef struct arrange_job {
     const hit_list *hits;
     const uint32_t *start, *list, *face_of;
     const face_facts *ff;
+    const plane_cache *planes;
 } arrange_job;
 
 static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
@@ -495,7 +504,7 @@ static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
     const arrange_job *j = user;
     uint32_t f = j->face_of[k];
     return arrange_face(j->ctx, j->s, f, j->hits, j->list + j->start[f],
-                        j->start[f + 1] - j->start[f], j->ff, &j->s->arrs[k], err);
+                        j->start[f + 1] - j->start[f], j->ff, j->planes, &j->s->arrs[k], err);
 }
 
 static mcsg_status split_one(void *user, size_t k, mcsg_error *err)
@@ -524,11 +533,11 @@ static bool number_arranged_faces(const mci_ctx *ctx, mci_scene *s, const uint32
 }
 
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
-                                      mcsg_error *err)
+                                      const plane_cache *planes, mcsg_error *err)
 {
     uint32_t *start = NULL, *list = NULL, *face_of = NULL;
     face_facts ff = {NULL, NULL};
-    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff};
+    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes};
     mcsg_status st = MCSG_OK;
     if (!compute_face_facts(ctx, s, hits, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
         !number_arranged_faces(ctx, s, start, &face_of))
@@ -557,20 +566,22 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     uint64_t *pairs = NULL;
     size_t count = 0;
     hit_list hits = {NULL, 0, 0};
+    plane_cache planes = {NULL, NULL};
     double t0 = mci_seconds_now(), t1, t2;
     mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);
     if (st != MCSG_OK)
         return st;
     t1 = mci_seconds_now();
     s->stats.candidate_pairs = count;
-    st = intersect_pairs(ctx, s, pairs, count, &hits, err);
+    st = intersect_pairs(ctx, s, pairs, count, &planes, &hits, err);
     mci_free(ctx, pairs);
     t2 = mci_seconds_now();
     if (st == MCSG_OK && !build_neighbours(ctx, s, &hits))
         st = mci_fail_nomem(err, "finding neighbouring faces");
     if (st == MCSG_OK)
-        st = build_arrangements(ctx, s, &hits, err);
+        st = build_arrangements(ctx, s, &hits, &planes, err);
     mci_free(ctx, hits.v);
+    free_plane_cache(ctx, &planes);
     s->stats.seconds_pairs = t1 - t0;
     s->stats.seconds_intersect = t2 - t1;
     s->stats.seconds_arrange = mci_seconds_now() - t2;
