@@ -41,14 +41,26 @@ static uint32_t slot_from(const mcsg_mesh *m, uint32_t s)
     return m->triangles[s];
 }
 
+/* The next and the previous corner of slot s's triangle (no division: these run for
+ * every corner of the output several times). */
+static uint32_t next_in_triangle(uint32_t s)
+{
+    return s % 3 == 2 ? s - 2 : s + 1;
+}
+
+static uint32_t prev_in_triangle(uint32_t s)
+{
+    return s % 3 == 0 ? s + 2 : s - 1;
+}
+
 static uint32_t slot_to(const mcsg_mesh *m, uint32_t s)
 {
-    return m->triangles[s - s % 3 + (s % 3 + 1) % 3];
+    return m->triangles[next_in_triangle(s)];
 }
 
 static uint32_t slot_third(const mcsg_mesh *m, uint32_t s)
 {
-    return m->triangles[s - s % 3 + (s % 3 + 2) % 3];
+    return m->triangles[prev_in_triangle(s)];
 }
 
 /* Sign of the turn from half-plane a to half-plane b about the axis u -> v: +1 when b
@@ -128,20 +140,21 @@ static uint32_t find(uint32_t *parent, uint32_t x)
     return x;
 }
 
-/* One stable counting sort of corners by key(corner) (a vertex id): in[] (NULL: all
- * corners in order) into out[], with start[v] the first position of key v. */
-static void sort_corners_by(const mcsg_mesh *m, uint32_t (*key)(const mcsg_mesh *, uint32_t),
-                            const uint32_t *in, uint32_t *out, uint32_t *start)
+/* One stable counting sort of corners by their edge's target vertex (by_target) or by
+ * their own vertex: in[] (NULL: all corners in order) into out[], with start[v] the first
+ * position of key v. */
+static void sort_corners_by(const mcsg_mesh *m, bool by_target, const uint32_t *in,
+                            uint32_t *out, uint32_t *start)
 {
     size_t n = 3 * m->triangle_count;
     memset(start, 0, (m->vertex_count + 2) * sizeof *start);
     for (size_t c = 0; c < n; c++)
-        start[key(m, (uint32_t)c) + 2]++;
+        start[(by_target ? slot_to(m, (uint32_t)c) : slot_from(m, (uint32_t)c)) + 2]++;
     for (size_t v = 2; v < m->vertex_count + 2; v++)
         start[v] += start[v - 1];
     for (size_t k = 0; k < n; k++) {
         uint32_t c = in ? in[k] : (uint32_t)k;
-        out[start[key(m, c) + 1]++] = c;
+        out[start[(by_target ? slot_to(m, c) : slot_from(m, c)) + 1]++] = c;
     }
 }
 
@@ -160,64 +173,73 @@ static bool corners_by_vertex(splitter *sp)
     sp->start = start;
     sp->corner = corner;
     if (start && corner && by_target) {
-        sort_corners_by(m, slot_to, NULL, by_target, start);
-        sort_corners_by(m, slot_from, by_target, corner, start);
+        sort_corners_by(m, true, NULL, by_target, start);
+        sort_corners_by(m, false, by_target, corner, start);
     }
     mci_free(sp->ctx, by_target);
     return start && corner && by_target;
 }
 
-/* Append the slots from u to v to slots[*n]; returns how many there were. */
-static size_t slots_between(const splitter *sp, uint32_t u, uint32_t v, uint32_t *slots,
-                            size_t *n, size_t room)
+/* The run of vertex u's corners whose edge goes to v, from *cursor on: cursor[u] only
+ * moves forward, which is enough because the queries to each vertex come with
+ * increasing targets (pair_edges walks u in order and asks v for its edges back to u).
+ * Returns the run's start; *count is its length. */
+static uint32_t run_to(const splitter *sp, uint32_t *cursor, uint32_t u, uint32_t v,
+                       size_t *count)
 {
-    uint32_t lo = sp->start[u], hi = sp->start[u + 1];
-    size_t found = 0;
-    while (lo < hi) { /* first corner of u whose edge goes to v or beyond */
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (slot_to(sp->m, sp->corner[mid]) < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    for (uint32_t k = lo; k < sp->start[u + 1] && slot_to(sp->m, sp->corner[k]) == v; k++) {
-        if (*n < room)
-            slots[(*n)++] = sp->corner[k];
-        found++;
-    }
-    return found;
+    uint32_t k = cursor[u], end = sp->start[u + 1], first;
+    while (k < end && slot_to(sp->m, sp->corner[k]) < v)
+        k++;
+    cursor[u] = first = k;
+    while (k < end && slot_to(sp->m, sp->corner[k]) == v)
+        k++;
+    *count = k - first;
+    return first;
 }
 
 /* Pair every edge's slots: the two opposite ones of a manifold edge directly, the 2k
- * of a non-manifold edge by angle. Each edge is handled once, from the first slot that
- * leaves its smaller vertex. */
+ * of a non-manifold edge by angle. Each edge is handled once, from its smaller vertex:
+ * the corners of u (ordered by target) come in runs u -> v, and the run v -> u is found
+ * with v's cursor. */
 static bool pair_edges(splitter *sp)
 {
     const mcsg_mesh *m = sp->m;
     size_t room = 64;
     uint32_t *slots = mci_malloc_array(sp->ctx, room, sizeof *slots);
-    if (!slots)
+    uint32_t *cursor = mci_malloc_array(sp->ctx, m->vertex_count + 1, sizeof *cursor);
+    if (!slots || !cursor) {
+        mci_free(sp->ctx, slots);
+        mci_free(sp->ctx, cursor);
         return false;
+    }
     for (size_t s = 0; s < 3 * m->triangle_count; s++)
         sp->mate[s] = MCI_NONE;
+    memcpy(cursor, sp->start, m->vertex_count * sizeof *cursor);
     for (uint32_t u = 0; u < m->vertex_count; u++)
-        for (uint32_t k = sp->start[u]; k < sp->start[u + 1]; k++) {
-            uint32_t s = sp->corner[k], v = slot_to(m, s);
-            size_t n = 0, ahead, back;
-            if (v < u || sp->mate[s] != MCI_NONE)
+        for (uint32_t k = sp->start[u]; k < sp->start[u + 1];) {
+            uint32_t v = slot_to(m, sp->corner[k]), back_first;
+            size_t ahead, back;
+            uint32_t ahead_first = run_to(sp, cursor, u, v, &ahead);
+            k = ahead_first + (uint32_t)ahead;
+            if (v < u)
                 continue;
-            ahead = slots_between(sp, u, v, slots, &n, room);
-            if (slots[0] != s)
-                continue; /* handled from the first slot u -> v */
-            back = slots_between(sp, v, u, slots, &n, room);
+            back_first = run_to(sp, cursor, v, u, &back);
             if (ahead == 1 && back == 1) {
-                sp->mate[slots[0]] = slots[1];
-                sp->mate[slots[1]] = slots[0];
-            } else if (ahead != back || ahead + back > room || !pair_around_edge(sp, slots, n)) {
-                sp->bad_edges++;
+                sp->mate[sp->corner[ahead_first]] = sp->corner[back_first];
+                sp->mate[sp->corner[back_first]] = sp->corner[ahead_first];
+                continue;
             }
+            if (ahead != back || ahead + back > room) {
+                sp->bad_edges++;
+                continue;
+            }
+            memcpy(slots, sp->corner + ahead_first, ahead * sizeof *slots);
+            memcpy(slots + ahead, sp->corner + back_first, back * sizeof *slots);
+            if (!pair_around_edge(sp, slots, ahead + back))
+                sp->bad_edges++;
         }
     mci_free(sp->ctx, slots);
+    mci_free(sp->ctx, cursor);
     return true;
 }
 
@@ -269,15 +291,17 @@ static bool split_vertices(splitter *sp, size_t *added)
         parent[c] = (uint32_t)c, copy[c] = MCI_NONE;
     for (size_t v = 0; v < nv; v++)
         group_corners(sp, corner + start[v], start[v + 1] - start[v], parent);
-    for (size_t v = 0; v < nv; v++)
+    for (size_t v = 0; v < nv; v++) {
+        uint32_t first_root = start[v] < start[v + 1] ? find(parent, corner[start[v]]) : 0;
         for (uint32_t k = start[v]; k < start[v + 1]; k++) {
             uint32_t c = corner[k], root = find(parent, c);
-            if (root == find(parent, corner[start[v]]))
+            if (root == first_root)
                 continue;
             if (copy[root] == MCI_NONE)
                 copy[root] = (uint32_t)(nv + extra++);
             m->triangles[c] = copy[root];
         }
+    }
     /* Second pass over the roots to fill the new vertices' coordinates. */
     if (extra > 0) {
         double *grown = mci_realloc_array(sp->ctx, m->vertices, nv + extra, 3 * sizeof(double));

@@ -146,6 +146,12 @@ TEST(touching_solids)
     expect_touching("union() { cube(1); translate([1,1,0]) cube(1); }", 2, 2);
     expect_touching("difference() { cube(2); translate([1,1,0]) cube([1,1,2]);"
                     " translate([0,0,0]) cube([1,1,2]); }", 4, 2);
+    /* An L-shaped solid touching a cube along two edges that meet at a corner: around
+     * that corner the cube's triangles stay one umbrella only when the four triangles at
+     * each touching edge are paired by angle (an unpaired edge leaves the cube's corner
+     * in two groups and gives five vertex copies instead of three). */
+    expect_touching("union() { cube(1); translate([1,1,0]) cube(1); translate([0,1,1]) cube(1);"
+                    " translate([1,1,1]) cube(1); }", 4, 3);
     /* A box carved from the inside of a face: a pocket. */
     expect_solid("difference() { cube(2); translate([0.5,0.5,1]) cube([1,1,1]); }", 7, 1);
 }
