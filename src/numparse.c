@@ -17,9 +17,9 @@
  *
  * Formatting writes the text printf's %.15g, %.16g or %.17g would (17 digits always
  * round-trip), the first that parses back to the same double, with '.' whatever the
- * locale. printf itself is the fallback only: short decimals are found by a double
- * division test, and 16 or 17 digits come from an exact 128-bit product m 5^k 2^j,
- * correctly rounded (printf's multi-precision path cost ~5,000 instructions per number,
+ * locale. printf itself is the fallback only: the 15, 16 or 17 digits come from an exact
+ * 128-bit product m 5^k 2^j, correctly rounded, and whether they read back is decided on
+ * the same integers (printf's multi-precision path cost ~5,000 instructions per number,
  * most of the time of writing a mesh).
  */
 #include "numparse.h"
@@ -458,14 +458,34 @@ static size_t normalise_decimal_point(char *text, size_t len)
     return out;
 }
 
+/* |value| = m 2^(e - 53) with m in [2^52, 2^53) (e is frexp's exponent), for a nonzero
+ * finite value. Normal values are read from their bits (frexp and ldexp are library
+ * calls, and this runs several times for every number written). */
+static void split_double(double value, uint64_t *m, int *e)
+{
+    uint64_t bits;
+    int biased;
+    memcpy(&bits, &value, sizeof bits);
+    biased = (int)((bits >> 52) & 0x7ff);
+    if (biased == 0) { /* subnormal: normalise through frexp */
+        double fraction = frexp(fabs(value), e);
+        *m = (uint64_t)ldexp(fraction, 53);
+        return;
+    }
+    *m = (bits & ((UINT64_C(1) << 52) - 1)) | (UINT64_C(1) << 52);
+    *e = biased - 1022;
+}
+
 /* round_half_even(|value| * 10^scale) for 0 <= scale <= 32, exactly: |value| = m 2^e,
  * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
 static bool scaled_decimal(double value, int scale, u128 *out)
 {
     int e;
-    double fraction = frexp(fabs(value), &e);
-    u128 m = (u128)(uint64_t)ldexp(fraction, 53), q, rest, half;
+    uint64_t mantissa;
+    u128 m, q, rest, half;
     int shift;
+    split_double(value, &mantissa, &e);
+    m = mantissa;
     if (scale < 0 || scale > 32)
         return false;
     m *= pow10_u128(scale) >> scale; /* 5^scale: 10^scale / 2^scale */
@@ -513,11 +533,11 @@ static void write_digits(char *out, uint64_t n, int count)
  * integers would not fit (the caller then parses). */
 static int reads_back(double value, u128 digits, int scale)
 {
-    int e;
-    double fraction = frexp(fabs(value), &e);
-    uint64_t m = (uint64_t)ldexp(fraction, 53);
-    int shift = e - 53 + scale;
+    int e, shift;
+    uint64_t m;
     u128 five, exact, text_value, diff, gap;
+    split_double(value, &m, &e);
+    shift = e - 53 + scale;
     if (scale < 0 || scale > 27 || shift > 0 || shift < -60 || e < -1000 ||
         digits >= ((u128)1 << 57))
         return -1;
@@ -534,20 +554,30 @@ static int reads_back(double value, u128 digits, int scale)
     return diff < gap || (diff == gap && m % 2 == 0);
 }
 
-/* printf's "%.*g" of a nonzero finite value, from the exact digits above; 0 when the
- * value's decimal exponent is outside their range (then printf is used). The digits and
- * their scale (the text is digits * 10^-scale) go to *digits_out and *scale_out. */
-static size_t format_g_exact(char *text, double value, int precision, u128 *digits_out,
-                             int *scale_out)
+/* floor(log10(|value|)) or one less, from the binary exponent alone: |value| is in
+ * [2^(e-1), 2^e), and 78913 / 2^18 is log10(2) to 7 digits (floor division by hand: a
+ * right shift of a negative number is implementation-defined). */
+static int decimal_exponent_estimate(double value)
 {
-    int exponent = (int)floor(log10(fabs(value))), tries = 0;
+    uint64_t m;
+    int e;
+    long t;
+    split_double(value, &m, &e);
+    t = (long)(e - 1) * 78913;
+    return (int)(t >= 0 ? t / 262144 : -((-t + 262143) / 262144));
+}
+
+/* The `precision` significant digits of a nonzero finite value, correctly rounded as
+ * printf's %.*g gives them, and the decimal exponent of the first: |value| ~ digits *
+ * 10^(exponent - precision + 1). False when the value's decimal exponent is outside the
+ * range of these integers (then printf is used). */
+static bool exact_digits(double value, int precision, u128 *digits_out, int *exponent_out)
+{
+    int exponent = decimal_exponent_estimate(value), tries = 0;
     u128 digits, low = pow10_u128(precision - 1), high = pow10_u128(precision);
-    char d[40];
-    size_t len = 0, count = 0;
-    int decimals;
-    for (;;) { /* the estimate can be one off near powers of 10 (and after rounding) */
+    for (;;) { /* the estimate can be one off (and rounding can carry into a new digit) */
         if (++tries > 4 || !scaled_decimal(value, precision - 1 - exponent, &digits))
-            return 0;
+            return false;
         if (digits >= high)
             exponent++;
         else if (digits < low)
@@ -558,14 +588,23 @@ static size_t format_g_exact(char *text, double value, int precision, u128 *digi
     if (digits == low) { /* 10^(p-1) may be a value just below 10^exponent rounded up */
         u128 below;
         if (!scaled_decimal(value, precision - exponent, &below))
-            return 0;
+            return false;
         if (below < high) {
             exponent--;
             digits = below;
         }
     }
     *digits_out = digits;
-    *scale_out = precision - 1 - exponent;
+    *exponent_out = exponent;
+    return true;
+}
+
+/* printf's "%.*g" text of value from its exact digits (exact_digits). */
+static size_t layout_g(char *text, double value, u128 digits, int precision, int exponent)
+{
+    char d[40];
+    size_t len = 0, count;
+    int decimals;
     /* digits < 10^precision <= 10^17 < 2^64: 64-bit division is a multiplication, the
      * 128-bit one a library call. */
     write_digits(d, (uint64_t)digits, precision);
@@ -605,85 +644,31 @@ static size_t format_g_exact(char *text, double value, int precision, u128 *digi
     return len;
 }
 
-/* text = value with `precision` significant digits; whether it reads back as value
- * (17 digits always do, and are not checked). */
+/* text = value with `precision` significant digits, written only when it reads back as
+ * value (17 digits always do, and are not checked); whether it did. */
 static bool format_round_trips(double value, int precision, char text[64], size_t *len)
 {
     double back;
     const char *next;
-    u128 digits = 0;
-    int scale = 0, exact;
-    int n = value != 0 ? (int)format_g_exact(text, value, precision, &digits, &scale) : 0;
-    bool from_printf = n == 0;
-    if (from_printf)
-        n = snprintf(text, 64, "%.*g", precision, value);
+    u128 digits;
+    int exponent, exact = 1, n;
+    if (value != 0 && exact_digits(value, precision, &digits, &exponent)) {
+        if (precision < 17 && (exact = reads_back(value, digits, precision - 1 - exponent)) == 0)
+            return false;
+        *len = layout_g(text, value, digits, precision, exponent);
+        return exact == 1 ||
+               (mci_parse_double(text, text + *len, &back, &next) && back == value);
+    }
+    n = snprintf(text, 64, "%.*g", precision, value);
     if (n < 0 || n >= 64) { /* cannot happen for a finite double */
         memcpy(text, "0", 2);
         *len = 1;
         return false;
     }
     /* Only printf's text can hold the locale's decimal point. */
-    *len = from_printf ? normalise_decimal_point(text, (size_t)n) : (size_t)n;
-    if (precision == 17)
-        return true;
-    if (digits != 0 && (exact = reads_back(value, digits, scale)) >= 0)
-        return exact;
-    return mci_parse_double(text, text + *len, &back, &next) && back == value;
-}
-
-/* Whether %.15g writes |value| without an exponent (decimal exponent -4 .. 14). */
-static bool in_fixed_range(double value)
-{
-    return fabs(value) >= 1e-4 && fabs(value) < 1e15;
-}
-
-/* Writes |n| < 10^15 with `decimals` digits after the point (and a sign). */
-static size_t write_fixed(char *buf, double value, uint64_t n, int decimals)
-{
-    char digits[24];
-    size_t count = 0, len = 0;
-    do {
-        digits[count++] = (char)('0' + n % 10);
-        n /= 10;
-    } while (n > 0);
-    while (count <= (size_t)decimals)
-        digits[count++] = '0'; /* leading zeros of 0.000ddd */
-    if (value < 0)
-        buf[len++] = '-';
-    while (count > 0) {
-        if (count == (size_t)decimals)
-            buf[len++] = '.';
-        buf[len++] = digits[--count];
-    }
-    buf[len] = '\0';
-    return len;
-}
-
-/* The %.15g text of value when it is a decimal of at most 15 significant digits in the
- * range %g writes without an exponent (1e-4 <= |value| < 1e15), else 0, decided without
- * printf: for k = 0, 1, ... the integer n nearest value * 10^k (within 1/4: n < 2^50) is
- * tried while n < 10^15, and n / 10^k == value (an IEEE division of exact operands,
- * rounded like a correctly rounded decimal reader) means that the decimal n e-k reads
- * back as value. A decimal of at most 15 digits that reads back as a double is the
- * double's %.15g text (DBL_DIG is 15, and a midpoint between doubles needs more bits
- * than n / 10^k has), so the result is the same text as printf's. */
-static size_t format_short_decimal(char *buf, double value)
-{
-    static const double power[19] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,
-                                      1e7,  1e8,  1e9,  1e10, 1e11, 1e12, 1e13,
-                                      1e14, 1e15, 1e16, 1e17, 1e18};
-    double magnitude = fabs(value);
-    if (!in_fixed_range(value))
-        return 0;
-    for (int k = 0; k < 19; k++) {
-        double scaled = magnitude * power[k], n;
-        if (scaled >= 1e15)
-            return 0;
-        n = nearbyint(scaled);
-        if (n / power[k] == magnitude)
-            return write_fixed(buf, value, (uint64_t)n, k);
-    }
-    return 0;
+    *len = normalise_decimal_point(text, (size_t)n);
+    return precision == 17 ||
+           (mci_parse_double(text, text + *len, &back, &next) && back == value);
 }
 
 size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
@@ -696,22 +681,12 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
         memcpy(buf, word, len + 1);
         return len;
     }
-    /* The shortest of 15, 16 and 17 significant digits that reads back as value. Short
-     * decimals (input coordinates) first, without printf; then 16 digits: most computed
-     * coordinates need 16 or 17, and if 15 digits read back, so do 16 (the nearest
-     * 16-digit decimal is at least as close as the 15-digit one). */
-    if ((len = format_short_decimal(buf, value)) > 0)
-        return len;
-    if (!format_round_trips(value, 16, text, &len))
-        format_round_trips(value, 17, text, &len);
-    else if (!in_fixed_range(value)) { /* in range, format_short_decimal tried 15 digits */
-        char shorter[64];
-        size_t shorter_len;
-        if (format_round_trips(value, 15, shorter, &shorter_len)) {
-            memcpy(text, shorter, shorter_len + 1);
-            len = shorter_len;
-        }
-    }
+    /* The shortest of 15, 16 and 17 significant digits that reads back as value: each
+     * try costs two 128-bit products (the digits and the read-back test), and the text is
+     * laid out once. */
+    for (int precision = 15; precision <= 17; precision++)
+        if (format_round_trips(value, precision, text, &len))
+            break;
     memcpy(buf, text, len + 1);
     return len;
 }
