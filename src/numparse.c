@@ -140,7 +140,14 @@ static double round_to_double(uint64_t top, int64_t e2, bool sticky)
     if (rest > half || (rest == half && (sticky || (kept & 1))))
         kept++;
     /* kept <= 2^53 is exact as a double, and so is the scaled result unless it
-     * overflows, where ldexp returns the correctly rounded infinity. */
+     * overflows, where the product (or ldexp) gives the correctly rounded infinity. A
+     * power of two in the normal range is built from its bits (ldexp is a library call). */
+    if (e2 + drop >= -1022 && e2 + drop <= 1023) {
+        uint64_t bits = (uint64_t)(e2 + drop + 1023) << 52;
+        double scale;
+        memcpy(&scale, &bits, sizeof scale);
+        return (double)(uint64_t)kept * scale;
+    }
     return ldexp((double)(uint64_t)kept, (int)(e2 + drop));
 }
 
