@@ -688,31 +688,42 @@ typedef struct boxed_slot {
     uint32_t slot;
 } boxed_slot;
 
-static int compare_boxed(const void *x, const void *y)
+/* A key whose unsigned order is the numeric order of x (not NaN; -0 counts as +0). */
+static uint64_t orderable(double x)
 {
-    const boxed_slot *a = x, *b = y;
-    if (a->lo[0] != b->lo[0])
-        return a->lo[0] < b->lo[0] ? -1 : 1;
-    return (a->slot > b->slot) - (a->slot < b->slot);
+    uint64_t bits;
+    x += 0.0; /* -0 -> +0 */
+    memcpy(&bits, &x, sizeof bits);
+    return bits >> 63 ? ~bits : bits | (UINT64_C(1) << 63);
 }
 
+/* Distinct definitions of one point: a sweep along x over the certified boxes (sorted by
+ * their low x with the keyed radix sort; equal lows in slot order), each pair whose
+ * boxes overlap tested exactly. The joins do not depend on the order, only on the pairs. */
 static bool join_equal_points(const mci_ctx *ctx, numbering *nb)
 {
     size_t n = 0;
     boxed_slot *items = mci_malloc_array(ctx, nb->total + 1, sizeof *items);
-    if (!items)
+    mci_keyed *order = mci_malloc_array(ctx, nb->total + 1, sizeof *order);
+    if (!items || !order) {
+        mci_free(ctx, items);
+        mci_free(ctx, order);
         return false;
+    }
     for (uint32_t slot = 0; slot < nb->total; slot++) {
         if (nb->parent[slot] != slot)
             continue; /* a copy of an earlier definition */
         mci_point_bounds(nb->table[slot], items[n].lo, items[n].hi);
-        items[n++].slot = slot;
+        items[n].slot = slot;
+        order[n].key = orderable(items[n].lo[0]);
+        order[n].ref = (uint32_t)n;
+        n++;
     }
-    if (n > 0)
-        qsort(items, n, sizeof *items, compare_boxed);
+    mci_sort_keyed(order, n);
     for (size_t i = 0; i < n; i++) {
-        for (size_t j = i + 1; j < n && items[j].lo[0] <= items[i].hi[0]; j++) {
-            const boxed_slot *a = &items[i], *b = &items[j];
+        const boxed_slot *a = &items[order[i].ref];
+        for (size_t j = i + 1; j < n && items[order[j].ref].lo[0] <= a->hi[0]; j++) {
+            const boxed_slot *b = &items[order[j].ref];
             if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
                 b->lo[2] > a->hi[2])
                 continue;
@@ -721,6 +732,7 @@ static bool join_equal_points(const mci_ctx *ctx, numbering *nb)
         }
     }
     mci_free(ctx, items);
+    mci_free(ctx, order);
     return true;
 }
 
