@@ -139,19 +139,52 @@ static void dd_lpi(dd_point *out, const mci_point *p, const double *origin)
         out->x[k] = dd_add(dd_mul(dd_diff(v[0][k], origin[k]), out->w), dd_mul(u[k], s));
 }
 
-/* False for TPIs (not evaluated in this stage). */
-static bool dd_point_at(dd_point *out, const mci_point *p, const double *origin)
+static void dd_cross(const dd a[3], const dd b[3], dd out[3])
+{
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        out[k] = dd_sub(dd_mul(a[i], b[j]), dd_mul(a[j], b[i]));
+    }
+}
+
+/* TPI of planes (v[0], v[1], v[2]), (v[3], v[4], v[5]), (v[6], v[7], v[8]): with normals
+ * n_i and s_i = n_i.(a_i - origin) (a_i the plane's first vertex), the offset from the
+ * origin is (s_0 n_1 x n_2 + s_1 n_2 x n_0 + s_2 n_0 x n_1) / W, W = n_0.(n_1 x n_2)
+ * (Cramer's rule; the orientation of each normal cancels). */
+static void dd_tpi(dd_point *out, const mci_point *p, const double *origin)
+{
+    const double *const *v = p->v;
+    dd n[3][3], s[3], c[3][3];
+    for (int pl = 0; pl < 3; pl++) {
+        const double *a = v[3 * pl], *b = v[3 * pl + 1], *cc = v[3 * pl + 2];
+        dd d1[3], d2[3], to_plane[3];
+        for (int k = 0; k < 3; k++) {
+            d1[k] = dd_diff(b[k], a[k]);
+            d2[k] = dd_diff(cc[k], a[k]);
+            to_plane[k] = dd_diff(a[k], origin[k]);
+        }
+        dd_cross(d1, d2, n[pl]);
+        s[pl] = dd_dot(n[pl], to_plane);
+    }
+    for (int pl = 0; pl < 3; pl++)
+        dd_cross(n[(pl + 1) % 3], n[(pl + 2) % 3], c[pl]);
+    out->w = dd_dot(n[0], c[0]);
+    for (int k = 0; k < 3; k++)
+        out->x[k] = dd_add(dd_add(dd_mul(s[0], c[0][k]), dd_mul(s[1], c[1][k])),
+                           dd_mul(s[2], c[2][k]));
+}
+
+static void dd_point_at(dd_point *out, const mci_point *p, const double *origin)
 {
     if (p->kind == MCI_POINT_EXPLICIT) {
         for (int k = 0; k < 3; k++)
             out->x[k] = dd_diff(p->v[0][k], origin[k]);
         out->w = (dd){1, 0, 0};
-        return true;
+    } else if (p->kind == MCI_POINT_LPI) {
+        dd_lpi(out, p, origin);
+    } else {
+        dd_tpi(out, p, origin);
     }
-    if (p->kind != MCI_POINT_LPI)
-        return false;
-    dd_lpi(out, p, origin);
-    return true;
 }
 
 int mci_orient2d_projected_dd(const mci_point *p, const mci_point *q, const mci_point *r,
@@ -163,8 +196,7 @@ int mci_orient2d_projected_dd(const mci_point *p, const mci_point *q, const mci_
     dd det = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
         int w_sign;
-        if (!dd_point_at(&e[k], points[k], r->v[0]))
-            return MCI_UNCERTAIN;
+        dd_point_at(&e[k], points[k], r->v[0]);
         w_sign = dd_sign(e[k].w);
         if (w_sign == MCI_UNCERTAIN)
             return MCI_UNCERTAIN;
@@ -219,7 +251,8 @@ unsigned mci_point_round_dd(const mci_point *p, unsigned pending, const double g
     static const double origin[3] = {0, 0, 0};
     dd_point e;
     int w_sign;
-    if (!dd_point_at(&e, p, origin) || (w_sign = dd_sign(e.w)) == MCI_UNCERTAIN)
+    dd_point_at(&e, p, origin);
+    if ((w_sign = dd_sign(e.w)) == MCI_UNCERTAIN)
         return pending;
     for (int k = 0; k < 3; k++)
         if (((pending >> k) & 1) && round_coordinate(&e, w_sign, k, guess[k], &out[k]))

@@ -214,11 +214,10 @@ int mci_orient2d_projected_filtered(const mci_point *p, const mci_point *q,
 int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const mci_point *r,
                                  int axis);
 /* Between the two for orient2d: the same formulas in double-double arithmetic with an
- * error bound (exact_dd.c), for explicit and LPI points; MCI_UNCERTAIN when undecided
- * or a point is a TPI. */
+ * error bound (exact_dd.c), for every kind of point; MCI_UNCERTAIN when undecided. */
 int mci_orient2d_projected_dd(const mci_point *p, const mci_point *q, const mci_point *r,
                               int axis);
-/* The double-double stage of mci_point_round, for explicit and LPI points: rounds each
+/* The double-double stage of mci_point_round, for every kind of point: rounds each
  * coordinate k with bit k set in `pending`, starting from guess[k] (any nearby double),
  * into out[k] when it can prove the result; returns the bits it could not decide. */
 unsigned mci_point_round_dd(const mci_point *p, unsigned pending, const double guess[3],
