@@ -83,6 +83,7 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     mci_free(ctx, arr->edges);
     mci_free(ctx, arr->aux);
     mci_free(ctx, arr->tris);
+    mci_free(ctx, arr->adj);
     memset(arr, 0, sizeof *arr);
 }
 
@@ -901,7 +902,9 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
     if (arr->dirty)
         st = mci_fail(err, MCSG_ERR_INTERNAL, "face %u triangulated before splitting", arr->face);
     mci_free(ctx, arr->tris);
+    mci_free(ctx, arr->adj);
     arr->tris = NULL;
+    arr->adj = NULL;
     arr->tri_count = 0;
     if (st == MCSG_OK && (!mark || !insert || !pairs)) {
         st = mci_fail_nomem(err, "triangulating a face");
@@ -914,6 +917,7 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
         st = mci_triangulate(ctx, &in, &out, err);
         if (st == MCSG_OK) {
             arr->tris = out.tris;
+            arr->adj = out.adj;
             arr->tri_count = out.tri_count;
         }
     }

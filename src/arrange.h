@@ -65,6 +65,7 @@ typedef struct mci_face_arr {
     double (*aux)[3];    /* auxiliary vertices (stable: points refer to them) */
     size_t aux_count, aux_capacity;
     uint32_t *tris;      /* after mci_arr_triangulate: 3 point ids per triangle */
+    uint32_t *adj;       /* ... and the side across each side (mci_cdt_output.adj) */
     size_t tri_count;
     bool dirty;          /* points were added since the last merge */
 } mci_face_arr;

@@ -22,6 +22,7 @@
  * Only leaves whose bounding box meets this leaf's can have another label than OUT.
  */
 #include "classify.h"
+#include "triangulate.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -510,22 +511,60 @@ static uint32_t slot_to(const leaf_work *w, size_t slot)
     return w->pv[slot - slot % 3 + (slot % 3 + 1) % 3];
 }
 
+/* Sides inside an arranged face are paired by its triangulation (adj: the side across
+ * and whether it is a constraint, i.e. an elementary edge, i.e. a separator); returns
+ * the number of sides left to pair by sorting (those on face boundaries), with mate
+ * MCI_NONE. Most sides of a cut face are inside it, so the sort shrinks to the faces'
+ * borders. */
+static size_t pair_inside_faces(leaf_work *w)
+{
+    size_t left = 0, p = 0;
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++) {
+        const mci_face_arr *arr = arr_of_face(w->s, f);
+        if (!arr) {
+            for (int i = 0; i < 3; i++)
+                w->mate[3 * p + i] = MCI_NONE;
+            left += 3;
+            p++;
+            continue;
+        }
+        for (size_t k = 0; k < 3 * arr->tri_count; k++) {
+            uint32_t across = arr->adj[k];
+            size_t slot = 3 * p + k;
+            if (across == MCI_NONE) {
+                w->mate[slot] = MCI_NONE;
+                left++;
+                continue;
+            }
+            w->mate[slot] = (uint32_t)(3 * p) + (across & ~MCI_CDT_CONSTRAINT);
+            w->is_sep[slot] = (across & MCI_CDT_CONSTRAINT) != 0;
+        }
+        p += arr->tri_count;
+    }
+    return left;
+}
+
 /* Pair every directed piece edge with its opposite; a closed, consistently oriented
- * edge-manifold surface has exactly one. The sorted edges are walked along the sorted
- * separators (collect_separators), which marks the separator slots (is_sep). */
+ * edge-manifold surface has exactly one. Sides on face borders are sorted by edge key
+ * and walked along the sorted separators (collect_separators), which marks the
+ * separator slots (is_sep). */
 static mcsg_status pair_edges(leaf_work *w)
 {
-    size_t n = 3 * w->np, i = 0, sep = 0;
-    mci_keyed *e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
+    size_t n, i = 0, sep = 0, m = 0;
+    mci_keyed *e;
     mcsg_status st = MCSG_OK;
-    w->mate = mci_malloc_array(w->ctx, n + 1, sizeof *w->mate);
-    if (!e || !w->mate) {
-        mci_free(w->ctx, e);
+    w->mate = mci_malloc_array(w->ctx, 3 * w->np + 1, sizeof *w->mate);
+    if (!w->mate)
         return mci_fail_nomem(w->err, "classifying faces");
-    }
-    for (size_t k = 0; k < n; k++) {
-        e[k].key = mci_edge_key(slot_from(w, k), slot_to(w, k));
-        e[k].ref = (uint32_t)k;
+    n = pair_inside_faces(w);
+    e = mci_malloc_array(w->ctx, n + 1, sizeof *e);
+    if (!e)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t k = 0; k < 3 * w->np; k++) {
+        if (w->mate[k] != MCI_NONE)
+            continue;
+        e[m].key = mci_edge_key(slot_from(w, k), slot_to(w, k));
+        e[m++].ref = (uint32_t)k;
     }
     mci_sort_keyed(e, n);
     while (i < n && st == MCSG_OK) {

@@ -10,96 +10,123 @@
  * new triangulation's edges, flipping exactly across the valid constraints.
  */
 #include "arrange.h"
+#include "triangulate.h"
 
 #include <string.h>
 
-typedef mci_keyed side; /* key: local point ids of an edge; ref: 3 * triangle + edge */
+typedef mci_keyed side; /* key: local point ids of an edge; ref: see old_sides */
 
-/* The 3 * n edge sides of triangles tris[0 .. 3n), sorted by key. */
-static side *sorted_sides(const mci_ctx *ctx, const uint32_t *tris, size_t n)
+static uint64_t side_key(const uint32_t *tris, size_t r)
 {
-    side *s = mci_malloc_array(ctx, 3 * n + 1, sizeof *s);
-    if (!s)
-        return NULL;
-    for (size_t r = 0; r < 3 * n; r++) {
-        s[r].key = mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]);
-        s[r].ref = (uint32_t)r;
+    return mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]);
+}
+
+/* What the old tessellation (all constraints) tells the new one, from its adjacency:
+ * its sides on the face's boundary (ref: their triangle), and each interior constraint
+ * once (ref: 1 when valid, i.e. it separates a kept from a dropped piece). Both sorted by
+ * key. Only constraints can be valid: pieces joined across other edges are in one
+ * region, hence kept or dropped together. */
+typedef struct old_sides {
+    side *boundary, *constraint;
+    size_t boundary_count, constraint_count;
+} old_sides;
+
+static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
+                              const uint8_t *piece_keep, old_sides *o)
+{
+    size_t n = 3 * arr->tri_count, nb = 0, nc = 0;
+    for (size_t r = 0; r < n; r++) {
+        uint32_t across = arr->adj[r];
+        nb += across == UINT32_MAX;
+        nc += across != UINT32_MAX && (across & MCI_CDT_CONSTRAINT) &&
+              r < (across & ~MCI_CDT_CONSTRAINT);
     }
-    mci_sort_keyed(s, 3 * n);
-    return s;
+    o->boundary = mci_malloc_array(ctx, nb + 1, sizeof *o->boundary);
+    o->constraint = mci_malloc_array(ctx, nc + 1, sizeof *o->constraint);
+    o->boundary_count = o->constraint_count = 0;
+    if (!o->boundary || !o->constraint)
+        return false;
+    for (size_t r = 0; r < n; r++) {
+        uint32_t across = arr->adj[r], other = across & ~MCI_CDT_CONSTRAINT;
+        if (across == UINT32_MAX)
+            o->boundary[o->boundary_count++] = (side){side_key(arr->tris, r), (uint32_t)(r / 3)};
+        else if ((across & MCI_CDT_CONSTRAINT) && r < other)
+            o->constraint[o->constraint_count++] =
+                (side){side_key(arr->tris, r), piece_keep[r / 3] != piece_keep[other / 3]};
+    }
+    mci_sort_keyed(o->boundary, o->boundary_count);
+    mci_sort_keyed(o->constraint, o->constraint_count);
+    return true;
 }
 
-/* Whether the interior edge `key` of the old tessellation separates kept from dropped. */
-static bool is_valid_edge(const side *old, size_t n, const uint8_t *keep, uint64_t key)
+static void free_old_sides(const mci_ctx *ctx, old_sides *o)
 {
-    size_t i = mci_find_key(old, n, key);
-    return i + 1 < n && old[i + 1].key == key && keep[old[i].ref / 3] != keep[old[i + 1].ref / 3];
+    mci_free(ctx, o->boundary);
+    mci_free(ctx, o->constraint);
 }
 
-static void mate_sides(const side *s, size_t n, uint32_t *mate);
+/* Whether `key` is an interior constraint of the old tessellation, and a valid one. */
+static bool is_interior(const old_sides *o, uint64_t key, bool *valid)
+{
+    size_t i = mci_find_key(o->constraint, o->constraint_count, key);
+    *valid = i < o->constraint_count && o->constraint[i].ref;
+    return i < o->constraint_count;
+}
 
 /* Status of the new triangles: from the old pieces along the face's boundary, then
- * across edges, flipping across valid constraints. Fails if some triangle is unreached. */
-static mcsg_status spread_status(const mci_ctx *ctx, const side *old, size_t old_n,
+ * across edges (the new adjacency), flipping across valid constraints. Fails if some
+ * triangle is unreached. */
+static mcsg_status spread_status(const mci_ctx *ctx, const old_sides *old,
                                  const uint8_t *piece_keep, const mci_face_arr *arr,
                                  uint8_t *keep, mcsg_error *err)
 {
     const uint32_t *tris = arr->tris;
-    size_t n = arr->tri_count;
-    mcsg_status st;
-    side *fresh = sorted_sides(ctx, tris, n);
-    uint32_t *mate = mci_malloc_array(ctx, 3 * n + 1, sizeof *mate);
+    size_t n = arr->tri_count, tail = 0;
     uint32_t *queue = mci_malloc_array(ctx, n + 1, sizeof *queue);
-    size_t tail = 0;
-    bool ok = fresh && mate && queue;
-    for (size_t t = 0; ok && t < n; t++)
+    mcsg_status st;
+    for (size_t t = 0; queue && t < n; t++)
         keep[t] = 2;
-    if (ok)
-        mate_sides(fresh, 3 * n, mate);
-    for (size_t r = 0; ok && r < 3 * n; r++) {
+    for (size_t r = 0; queue && r < 3 * n; r++) {
         uint32_t t = (uint32_t)(r / 3);
         size_t j;
-        if (mate[r] != UINT32_MAX || keep[t] != 2)
+        if (arr->adj[r] != UINT32_MAX || keep[t] != 2)
             continue;
-        j = mci_find_key(old, old_n, mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]));
-        if (j < old_n) {
-            keep[t] = piece_keep[old[j].ref / 3];
+        j = mci_find_key(old->boundary, old->boundary_count, side_key(tris, r));
+        if (j < old->boundary_count) {
+            keep[t] = piece_keep[old->boundary[j].ref];
             queue[tail++] = t;
         }
     }
-    for (size_t head = 0; ok && head < tail; head++) {
+    for (size_t head = 0; queue && head < tail; head++) {
         uint32_t t = queue[head];
         for (uint32_t r = 3 * t; r < 3 * t + 3; r++) {
-            uint32_t u = mate[r] == UINT32_MAX ? UINT32_MAX : mate[r] / 3;
+            uint32_t u = arr->adj[r] == UINT32_MAX
+                             ? UINT32_MAX
+                             : (arr->adj[r] & ~MCI_CDT_CONSTRAINT) / 3;
+            bool valid;
             if (u == UINT32_MAX || keep[u] != 2)
                 continue;
-            keep[u] = is_valid_edge(old, old_n, piece_keep,
-                                    mci_edge_key(tris[r], tris[r - r % 3 + (r % 3 + 1) % 3]))
-                          ? !keep[t]
-                          : keep[t];
+            keep[u] = is_interior(old, side_key(tris, r), &valid) && valid ? !keep[t] : keep[t];
             queue[tail++] = u;
         }
     }
-    st = !ok ? mci_fail_nomem(err, "tessellating the result")
+    st = !queue ? mci_fail_nomem(err, "tessellating the result")
          : tail < n ? mci_fail(err, MCSG_ERR_INTERNAL,
                                "face %u: a part of its tessellation is unclassified", arr->face)
                     : MCSG_OK;
-    mci_free(ctx, fresh);
-    mci_free(ctx, mate);
     mci_free(ctx, queue);
     return st;
 }
 
 /* Choose the valid constraints; *droppable says whether any interior constraint is not. */
-static void choose_valid(const mci_face_arr *arr, const side *old, size_t old_n,
-                         const uint8_t *piece_keep, bool *use, bool *droppable)
+static void choose_valid(const mci_face_arr *arr, const old_sides *old, bool *use,
+                         bool *droppable)
 {
     *droppable = false;
     for (size_t e = 0; e < arr->edge_count; e++) {
-        uint64_t key = mci_edge_key(arr->edges[e].a, arr->edges[e].b);
-        size_t i = mci_find_key(old, old_n, key);
-        bool interior = i + 1 < old_n && old[i + 1].key == key;
-        use[e] = is_valid_edge(old, old_n, piece_keep, key);
+        bool valid, interior = is_interior(old, mci_edge_key(arr->edges[e].a, arr->edges[e].b),
+                                           &valid);
+        use[e] = interior && valid;
         *droppable = *droppable || (interior && !use[e]);
     }
 }
@@ -109,16 +136,18 @@ mcsg_status mci_arr_retessellate(const mci_ctx *ctx, mci_face_arr *arr,
                                  mcsg_error *err)
 {
     size_t n = arr->tri_count;
-    side *old = sorted_sides(ctx, arr->tris, n);
+    old_sides old = {NULL, NULL, 0, 0};
     bool *use = mci_malloc_array(ctx, arr->edge_count + 1, sizeof *use);
     uint8_t *keep = NULL;
     bool droppable = false, any_kept = false;
-    mcsg_status st = old && use ? MCSG_OK : mci_fail_nomem(err, "tessellating the result");
+    mcsg_status st = use && collect_old_sides(ctx, arr, piece_keep, &old)
+                         ? MCSG_OK
+                         : mci_fail_nomem(err, "tessellating the result");
     *tri_keep = NULL;
     for (size_t t = 0; t < n; t++)
         any_kept = any_kept || piece_keep[t];
     if (st == MCSG_OK && any_kept)
-        choose_valid(arr, old, 3 * n, piece_keep, use, &droppable);
+        choose_valid(arr, &old, use, &droppable);
     if (st == MCSG_OK && droppable)
         st = mci_arr_triangulate(ctx, arr, use, err);
     if (st == MCSG_OK) {
@@ -128,25 +157,16 @@ mcsg_status mci_arr_retessellate(const mci_ctx *ctx, mci_face_arr *arr,
         else if (!droppable)
             memcpy(keep, piece_keep, n);
         else
-            st = spread_status(ctx, old, 3 * n, piece_keep, arr, keep, err);
+            st = spread_status(ctx, &old, piece_keep, arr, keep, err);
     }
     if (st == MCSG_OK)
         *tri_keep = keep;
     else
         mci_free(ctx, keep);
-    mci_free(ctx, old);
+    free_old_sides(ctx, &old);
     mci_free(ctx, use);
+    /* Nothing reads the adjacency after this; the face's triangles stay until assembly. */
+    mci_free(ctx, arr->adj);
+    arr->adj = NULL;
     return st;
-}
-
-/* mate[r]: the side of another triangle sharing side r, or UINT32_MAX on the boundary. */
-static void mate_sides(const side *s, size_t n, uint32_t *mate)
-{
-    for (size_t i = 0; i < n; i++)
-        mate[s[i].ref] = UINT32_MAX;
-    for (size_t i = 0; i + 1 < n; i++)
-        if (s[i].key == s[i + 1].key) {
-            mate[s[i].ref] = s[i + 1].ref;
-            mate[s[i + 1].ref] = s[i].ref;
-        }
 }

@@ -504,6 +504,19 @@ static mcsg_status setup(cdt *c, const mci_ctx *ctx, const mci_cdt_input *in, mc
     return MCSG_OK;
 }
 
+/* mci_cdt_output's adj entry for side i of triangle t (from v[i] to v[i + 1], which is
+ * edge prev3(i) here: the edge opposite v[i + 2]). */
+static uint32_t side_across(const cdt *c, uint32_t t, int i)
+{
+    const tri *a = &c->t[t];
+    int e = prev3(i), j;
+    uint32_t s = a->n[e];
+    if (s == NONE)
+        return NONE;
+    j = edge_index(&c->t[s], a->v[next3(i)], a->v[i]); /* the same edge, reversed */
+    return (uint32_t)(3 * s + (uint32_t)next3(j)) | ((a->fixed >> e) & 1 ? MCI_CDT_CONSTRAINT : 0);
+}
+
 mcsg_status mci_triangulate(const mci_ctx *ctx, const mci_cdt_input *in, mci_cdt_output *out,
                             mcsg_error *err)
 {
@@ -514,13 +527,24 @@ mcsg_status mci_triangulate(const mci_ctx *ctx, const mci_cdt_input *in, mci_cdt
     for (size_t k = 0; st == MCSG_OK && k < in->edge_count; k++)
         st = insert_constraint(&c, in->edges[2 * k], in->edges[2 * k + 1], err);
     out->tris = NULL;
+    out->adj = NULL;
     out->tri_count = 0;
+    if (st == MCSG_OK && c.count >= MCI_CDT_CONSTRAINT / 3)
+        st = mci_fail(err, MCSG_ERR_LIMIT, "too many triangles in one face (%zu)", c.count);
     if (st == MCSG_OK) {
         out->tris = mci_malloc_array(ctx, c.count, 3 * sizeof *out->tris);
-        if (!out->tris)
+        out->adj = mci_malloc_array(ctx, c.count, 3 * sizeof *out->adj);
+        if (!out->tris || !out->adj) {
+            mci_free(ctx, out->tris);
+            mci_free(ctx, out->adj);
+            out->tris = out->adj = NULL;
             st = mci_fail_nomem(err, "triangulating a face");
-        for (size_t k = 0; st == MCSG_OK && k < c.count; k++)
+        }
+        for (size_t k = 0; st == MCSG_OK && k < c.count; k++) {
             memcpy(out->tris + 3 * k, c.t[k].v, sizeof c.t[k].v);
+            for (int i = 0; i < 3; i++)
+                out->adj[3 * k + i] = side_across(&c, (uint32_t)k, i);
+        }
         out->tri_count = st == MCSG_OK ? c.count : 0;
     }
     mci_free(ctx, c.t);

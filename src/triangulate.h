@@ -34,9 +34,16 @@ typedef struct mci_cdt_input {
 
 /* The triangles (point ids, counter-clockwise in the face's orientation) tile the face
  * exactly: every one is non-degenerate, and every constraint edge is an edge of the
- * triangulation. `tris` has 3 * tri_count ids, allocated with ctx (caller frees). */
+ * triangulation. `tris` has 3 * tri_count ids, allocated with ctx (caller frees).
+ * `adj` (same size, also the caller's) gives for side i of triangle t (tris[3t + i] ->
+ * tris[3t + (i + 1) % 3]) the side 3t' + j of the triangle across it, with the bit
+ * MCI_CDT_CONSTRAINT set when that edge is a constraint, or UINT32_MAX on the face's
+ * boundary: callers pair the sides inside the face without sorting them. */
+#define MCI_CDT_CONSTRAINT UINT32_C(0x80000000)
+
 typedef struct mci_cdt_output {
     uint32_t *tris;
+    uint32_t *adj;
     size_t tri_count;
 } mci_cdt_output;
 

@@ -207,6 +207,43 @@ static void check_tiling(const face_case *f, const mci_cdt_output *out)
     free(used);
 }
 
+/* Whether a-b (either direction) is one of the case's constraints. */
+static bool is_constraint(const face_case *f, uint32_t a, uint32_t b)
+{
+    for (size_t k = 0; k < f->edge_count; k++) {
+        uint32_t u = f->edges[2 * k], w = f->edges[2 * k + 1];
+        if ((u == a && w == b) || (u == b && w == a))
+            return true;
+    }
+    return false;
+}
+
+/* adj: every side inside the face names the side running the other way (which names it
+ * back), the constraint bit says whether the edge is a constraint, and only sides on
+ * the face's boundary have no neighbour. */
+static void check_adjacency(const face_case *f, const mci_cdt_output *out)
+{
+    for (size_t s = 0; s < 3 * out->tri_count; s++) {
+        uint32_t u = out->tris[s], w = out->tris[s - s % 3 + (s % 3 + 1) % 3], other, back;
+        if (out->adj[s] == UINT32_MAX) {
+            CHECK_MSG(on_face_edge(f, u, w), "side %u-%u has no neighbour inside the face",
+                      u, w);
+            continue;
+        }
+        other = out->adj[s] & ~MCI_CDT_CONSTRAINT;
+        CHECK(other < 3 * out->tri_count && other / 3 != s / 3);
+        if (other >= 3 * out->tri_count)
+            continue;
+        back = out->adj[other];
+        CHECK_MSG(out->tris[other] == w &&
+                      out->tris[other - other % 3 + (other % 3 + 1) % 3] == u,
+                  "side %zu: neighbour side %u is not its reverse", s, other);
+        CHECK(back != UINT32_MAX && (back & ~MCI_CDT_CONSTRAINT) == s);
+        CHECK_MSG(((out->adj[s] & MCI_CDT_CONSTRAINT) != 0) == is_constraint(f, u, w),
+                  "side %u-%u: constraint bit wrong", u, w);
+    }
+}
+
 static void run_case(face_case *f)
 {
     mci_ctx ctx;
@@ -219,9 +256,12 @@ static void run_case(face_case *f)
     for (size_t i = 3; i < f->count; i++)
         insert[i - 3] = (uint32_t)i;
     CHECK_OK(mci_triangulate(&ctx, &in, &out, &err), &err);
-    if (out.tris)
+    if (out.tris) {
         check_tiling(f, &out);
+        check_adjacency(f, &out);
+    }
     free(out.tris);
+    free(out.adj);
     free(insert);
     free(f->edges);
     free(f->aux);
@@ -287,7 +327,7 @@ TEST(contract_violations_are_reported)
     mci_ctx_init(&ctx, NULL);
     in = (mci_cdt_input){f.points, f.count, f.axis, f.sign, insert, 2, NULL, 0, NULL, NULL};
     CHECK(mci_triangulate(&ctx, &in, &out, &err) == MCSG_ERR_INTERNAL);
-    CHECK(out.tris == NULL);
+    CHECK(out.tris == NULL && out.adj == NULL);
 }
 
 TEST(allocation_failures)
@@ -312,8 +352,10 @@ TEST(allocation_failures)
             mci_ctx_init(&ctx, &opts);
             st = mci_triangulate(&ctx, &in, &out, &err);
             CHECK(st == MCSG_OK || st == MCSG_ERR_NOMEM);
-            if (st == MCSG_OK)
+            if (st == MCSG_OK) {
                 mci_free(&ctx, out.tris);
+                mci_free(&ctx, out.adj);
+            }
             CHECK_EQ_SIZE(a.live, 0);
         }
     }
