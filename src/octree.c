@@ -606,38 +606,103 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const do
     return true;
 }
 
+/* Pairs are collected in parallel, in chunks of critical leaf cells fixed in advance
+ * (not by the thread count); the chunks' lists are joined and then sorted, so the
+ * result does not depend on the threads. */
+#define PAIR_CELLS_PER_CHUNK 256
+
+typedef struct pair_chunk_list {
+    uint64_t *pairs;
+    size_t count, capacity;
+} pair_chunk_list;
+
+typedef struct pair_job {
+    const mci_ctx *ctx;
+    const mci_octree *tree;
+    double *box;
+    uint32_t *cells; /* the critical leaf cells */
+    size_t cell_count;
+    pair_chunk_list *chunks;
+} pair_job;
+
+static mcsg_status collect_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const pair_job *j = user;
+    pair_chunk_list *out = &j->chunks[chunk];
+    size_t end = (chunk + 1) * PAIR_CELLS_PER_CHUNK;
+    for (size_t k = chunk * PAIR_CELLS_PER_CHUNK; k < end && k < j->cell_count; k++)
+        if (!collect_cell_pairs(j->ctx, j->tree, j->box, &j->tree->cells[j->cells[k]],
+                                &out->pairs, &out->count, &out->capacity))
+            return mci_fail_nomem(err, "collecting candidate pairs");
+    return MCSG_OK;
+}
+
+/* The critical leaf cells, in cell order. */
+static uint32_t *critical_leaves(const mci_ctx *ctx, const mci_octree *tree, size_t *count)
+{
+    uint32_t *cells = mci_malloc_array(ctx, tree->cell_count + 1, sizeof *cells);
+    *count = 0;
+    for (size_t c = 0; cells && c < tree->cell_count; c++)
+        if (tree->cells[c].child == NO_CHILD && tree->cells[c].critical)
+            cells[(*count)++] = (uint32_t)c;
+    return cells;
+}
+
+/* The chunks' lists one after the other in *pairs (each freed once copied). */
+static bool join_pair_chunks(const mci_ctx *ctx, pair_chunk_list *chunks, size_t n,
+                             uint64_t **pairs, size_t *count)
+{
+    size_t total = 0;
+    for (size_t c = 0; c < n; c++)
+        total += chunks[c].count;
+    *pairs = mci_malloc_array(ctx, total + 1, sizeof **pairs);
+    if (!*pairs)
+        return false;
+    for (size_t c = 0; c < n; c++) {
+        if (chunks[c].count)
+            memcpy(*pairs + *count, chunks[c].pairs, chunks[c].count * sizeof **pairs);
+        *count += chunks[c].count;
+        mci_free(ctx, chunks[c].pairs);
+        chunks[c].pairs = NULL;
+    }
+    return true;
+}
+
 mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tree,
                                        uint64_t **pairs, size_t *count, mcsg_error *err)
 {
-    size_t capacity = 0, unique = 0;
+    size_t unique = 0, chunk_count = 0;
     /* Contiguous boxes: a pair's test reads 96 bytes instead of 12 vertices. The build
      * computed them too (a pass over the faces, ~1 ms per 100K); they are not kept in
      * the tree, which lives through the whole evaluation, to spare 48 bytes per face. */
-    double *box = face_boxes(ctx, tree);
+    pair_job job = {ctx, tree, face_boxes(ctx, tree), NULL, 0, NULL};
+    mcsg_status st = MCSG_OK;
     *pairs = NULL;
     *count = 0;
-    for (size_t c = 0; box && c < tree->cell_count; c++) {
-        const mci_cell *cell = &tree->cells[c];
-        if (cell->child != NO_CHILD || !cell->critical)
-            continue;
-        if (!collect_cell_pairs(ctx, tree, box, cell, pairs, count, &capacity)) {
-            mci_free(ctx, box);
-            box = NULL;
-        }
-    }
-    if (!box) {
-        mci_free(ctx, *pairs);
-        *pairs = NULL;
-        *count = 0;
-        return mci_fail_nomem(err, "collecting candidate pairs");
-    }
-    mci_free(ctx, box);
+    if (job.box)
+        job.cells = critical_leaves(ctx, tree, &job.cell_count);
+    chunk_count = (job.cell_count + PAIR_CELLS_PER_CHUNK - 1) / PAIR_CELLS_PER_CHUNK;
+    if (job.cells)
+        job.chunks = mci_calloc_array(ctx, chunk_count + 1, sizeof *job.chunks);
+    if (!job.box || !job.cells || !job.chunks)
+        st = mci_fail_nomem(err, "collecting candidate pairs");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, chunk_count, collect_chunk, &job, err);
+    if (st == MCSG_OK && !join_pair_chunks(ctx, job.chunks, chunk_count, pairs, count))
+        st = mci_fail_nomem(err, "collecting candidate pairs");
+    for (size_t c = 0; job.chunks && c < chunk_count; c++)
+        mci_free(ctx, job.chunks[c].pairs);
+    mci_free(ctx, job.chunks);
+    mci_free(ctx, job.cells);
+    mci_free(ctx, job.box);
     /* A pair sharing several cells was collected once per cell: keep one. */
-    if (*count && !radix_sort_u64(ctx, *pairs, *count)) {
+    if (st == MCSG_OK && *count && !radix_sort_u64(ctx, *pairs, *count))
+        st = mci_fail_nomem(err, "collecting candidate pairs");
+    if (st != MCSG_OK) {
         mci_free(ctx, *pairs);
         *pairs = NULL;
         *count = 0;
-        return mci_fail_nomem(err, "collecting candidate pairs");
+        return st;
     }
     for (size_t i = 0; i < *count; i++) {
         if (i == 0 || (*pairs)[i] != (*pairs)[i - 1])
