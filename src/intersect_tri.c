@@ -83,6 +83,29 @@ static bool sections_apart(const mci_plane *t1, const int side1[3], const mci_pl
            mci_orient3d_vertices(v1[0], v1[2], v2[0], v2[2]) < 0;
 }
 
+/* The corner of t1 that is t1's only contact with t2's plane (one side 0, the other two
+ * strictly on one side) and is also a corner of t2 (same coordinates), or NULL. Then
+ * the triangles meet in that point and nowhere else: t1 touches the plane there only,
+ * and t2 holds it. The general path would find the same point through the sections,
+ * and keep t1's copy of it (the overlap starts and ends at t1's section on ties). */
+static const double *shared_lone_corner(const mci_plane *t1, const int side1[3],
+                                        const mci_plane *t2)
+{
+    for (int i = 0; i < 3; i++) {
+        const double *v = corner(t1, i);
+        int a = side1[(i + 1) % 3], b = side1[(i + 2) % 3];
+        if (side1[i] != 0 || a == 0 || a != b)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            const double *w = corner(t2, k);
+            if (v[0] == w[0] && v[1] == w[1] && v[2] == w[2])
+                return v;
+        }
+        return NULL;
+    }
+    return NULL;
+}
+
 /* The edge line through u and v, defined in a canonical vertex order. */
 static void edge_crossing(mci_point *out, const double *u, const double *v,
                           const mci_plane *plane)
@@ -186,6 +209,7 @@ static bool coplanar_interiors_overlap(const mci_plane *t1, const mci_plane *t2)
 void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out)
 {
     int side1[3], side2[3], n1, n2;
+    const double *lone;
     mci_point s1[2], s2[2];
     line_order line;
     memset(out, 0, sizeof *out);
@@ -205,6 +229,11 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
     }
     out->along_edge[0] = (side1[0] == 0) + (side1[1] == 0) + (side1[2] == 0) == 2;
     out->along_edge[1] = (side2[0] == 0) + (side2[1] == 0) + (side2[2] == 0) == 2;
+    if ((lone = shared_lone_corner(t1, side1, t2)) != NULL) {
+        out->kind = MCI_TT_POINT;
+        mci_point_explicit(&out->end[0], lone);
+        return;
+    }
     n1 = plane_section(t1, t2, side1, s1);
     n2 = plane_section(t2, t1, side2, s2);
     /* Not coplanar and both meet the other's plane: the planes are not parallel. */
