@@ -149,8 +149,8 @@ static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
 }
 
 /* Moves the chunks' hits into *hits (in chunk order) and frees the chunks' lists. */
-static bool join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks, size_t n,
-                        hit_list *hits)
+static mcsg_status join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks,
+                               size_t n, hit_list *hits, mcsg_error *err)
 {
     size_t total = 0, total_points = 0;
     for (size_t c = 0; c < n; c++) {
@@ -158,11 +158,11 @@ static bool join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks, si
         total_points += chunks[c].hits.point_count;
     }
     if (total_points >= UINT32_MAX)
-        return false;
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total_points);
     hits->v = mci_malloc_array(ctx, total + 1, sizeof *hits->v);
     hits->points = mci_malloc_array(ctx, total_points + 1, sizeof *hits->points);
     if (!hits->v || !hits->points)
-        return false;
+        return mci_fail_nomem(err, "intersecting faces");
     hits->capacity = total + 1;
     hits->point_capacity = total_points + 1;
     for (size_t c = 0; c < n; c++) {
@@ -186,7 +186,7 @@ static bool join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chunks, si
         from->v = NULL;
         from->points = NULL;
     }
-    return true;
+    return MCSG_OK;
 }
 
 static void free_plane_cache(const mci_ctx *ctx, plane_cache *c)
@@ -210,10 +210,9 @@ static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint6
                          : mci_fail_nomem(err, "intersecting faces");
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, n, intersect_chunk, &job, err);
-    if (st == MCSG_OK && !join_chunks(ctx, s, job.chunks, n, hits))
-        st = mci_fail_nomem(err, "intersecting faces");
-    for (size_t c = 0; job.chunks && c < n; c++)
-    {
+    if (st == MCSG_OK)
+        st = join_chunks(ctx, s, job.chunks, n, hits, err);
+    for (size_t c = 0; job.chunks && c < n; c++) {
         mci_free(ctx, job.chunks[c].hits.v);
         mci_free(ctx, job.chunks[c].hits.points);
     }
