@@ -108,8 +108,6 @@ static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point 
     arr->lines[arr->point_count].id[0] = line;
     arr->points[arr->point_count++] = *p;
     arr->dirty = true;
-    if (p->kind != MCI_POINT_EXPLICIT)
-        arr->implicit_pending = true;
     return true;
 }
 
@@ -137,16 +135,14 @@ static int coinciding_corner(const mci_face_arr *arr, const mci_point *p)
 }
 
 /* add_point_on, except that an explicit copy of a corner replaces the corner's stored
- * copy instead of being appended: merging would join them and keep the last copy and
+ * copy instead of being appended: merging would join them, keep an explicit copy and
  * every line, so the result is the same, without sorting the copies (a face with a
- * coplanar twin and touching neighbours receives each corner a dozen times). Only while
- * no implicit point waits for the next merge: one may be the same corner (an LPI exactly
- * there), and then a later explicit copy must come after it to stay the last one.
+ * coplanar twin and touching neighbours receives each corner a dozen times).
  * Returns the point's index, or UINT32_MAX when out of memory. */
 static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
                                uint64_t line)
 {
-    int k = arr->implicit_pending ? -1 : coinciding_corner(arr, p);
+    int k = coinciding_corner(arr, p);
     if (k < 0)
         return add_point_on(ctx, arr, p, line) ? (uint32_t)arr->point_count - 1 : UINT32_MAX;
     arr->points[k] = *p;
@@ -473,7 +469,11 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         for (size_t i = 0; i < kept; i++)
             merged_lines[i].count = 0;
         for (size_t i = 0; i < n; i++) {
-            merged[remap[i]] = arr->points[i];
+            /* A corner stays explicit: an implicit copy (an LPI exactly there) has the
+             * same value, but rounding it would lose the input's sign of zero. Other
+             * points keep their last copy. */
+            if (remap[i] >= 3 || arr->points[i].kind == MCI_POINT_EXPLICIT)
+                merged[remap[i]] = arr->points[i];
             for (int l = 0; l < arr->lines[i].count; l++)
                 add_line(&merged_lines[remap[i]], arr->lines[i].id[l]);
         }
@@ -494,7 +494,6 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         merged_lines = NULL;
         st = classify_points(ctx, arr, arr->where, before, remap, err);
         arr->dirty = false;
-        arr->implicit_pending = false;
     }
     if (remap_out && st == MCSG_OK)
         *remap_out = remap;
