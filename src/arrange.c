@@ -549,10 +549,13 @@ static bool known_collinear(const void *user, uint32_t a, uint32_t b, uint32_t c
 /* Orientation of three points of the face in its own orientation. */
 static int orient_ids(const mci_face_arr *arr, uint32_t a, uint32_t b, uint32_t c)
 {
+    const mci_point *p = arr->points;
+    int s = mci_orient2d_projected_quick(&p[a], &p[b], &p[c], arr->axis);
+    if (s != MCI_UNCERTAIN)
+        return arr->sign * s; /* never where known_collinear holds: the filter is exact */
     if (known_collinear(arr, a, b, c))
         return 0;
-    return arr->sign * mci_orient2d_projected(&arr->points[a], &arr->points[b],
-                                              &arr->points[c], arr->axis);
+    return arr->sign * mci_orient2d_projected_rest(&p[a], &p[b], &p[c], arr->axis);
 }
 
 /* A sweep item: a segment or a lone point, with a certified box in the projection. */

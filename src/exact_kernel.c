@@ -766,19 +766,26 @@ static bool lpi_on_line(const mci_point *x, const mci_point *a, const mci_point 
             (same_coordinates(x->v[0], b->v[0]) && same_coordinates(x->v[1], a->v[0])));
 }
 
-int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
-                           int axis)
+int mci_orient2d_projected_quick(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis)
+{
+    return orient2d_boxes(p, q, r, axis);
+}
+
+/* Collinear by definition: an exact zero, which only the slow exact stage could confirm
+ * (a repeated explicit point; a crossing point on a face edge, tested against the edge's
+ * ends). */
+static bool collinear_by_definition(const mci_point *p, const mci_point *q, const mci_point *r)
+{
+    return explicit_twins(p, q) || explicit_twins(q, r) || explicit_twins(p, r) ||
+           lpi_on_line(r, p, q) || lpi_on_line(q, p, r) || lpi_on_line(p, q, r);
+}
+
+/* The stages after the box filter. */
+static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis)
 {
     int s;
-    if (explicit_twins(p, q) || explicit_twins(q, r) || explicit_twins(p, r))
-        return 0;
-    /* Collinear by definition: an exact zero, which only the slow exact stage could
-     * confirm (a crossing point on a face edge, tested against the edge's ends). */
-    if (lpi_on_line(r, p, q) || lpi_on_line(q, p, r) || lpi_on_line(p, q, r))
-        return 0;
-    s = orient2d_boxes(p, q, r, axis);
-    if (s != MCI_UNCERTAIN)
-        return s;
     if (exact_in_projection(p, axis) && exact_in_projection(q, axis) &&
         exact_in_projection(r, axis))
         return orient2d_exact_centres(p, q, r, axis);
@@ -786,6 +793,26 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
     if (s == MCI_UNCERTAIN)
         s = mci_orient2d_projected_dd(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
+}
+
+/* The definitional zeros first: callers like the edge tests of arrangements meet them
+ * more often than anything else. */
+int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
+                           int axis)
+{
+    int s;
+    if (collinear_by_definition(p, q, r))
+        return 0;
+    s = orient2d_boxes(p, q, r, axis);
+    return s != MCI_UNCERTAIN ? s : orient2d_beyond_boxes(p, q, r, axis);
+}
+
+/* After mci_orient2d_projected_quick: its box filter never returns 0 (the error bound is
+ * positive), so skipping the definitional zeros before it changes no answer. */
+int mci_orient2d_projected_rest(const mci_point *p, const mci_point *q, const mci_point *r,
+                                int axis)
+{
+    return collinear_by_definition(p, q, r) ? 0 : orient2d_beyond_boxes(p, q, r, axis);
 }
 
 /* ---------------------------------------------------------------------------------- */

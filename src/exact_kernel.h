@@ -143,6 +143,13 @@ bool mci_points_equal(const mci_point *a, const mci_point *b);
  * clockwise, 0 collinear in the projection. */
 int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_point *r,
                            int axis);
+/* mci_orient2d_projected in two halves, for callers that know collinear cases of their
+ * own (a face's lines): the first, a few operations on the cached boxes, decides most
+ * calls (+1 or -1) and returns MCI_UNCERTAIN otherwise; the second decides the rest. */
+int mci_orient2d_projected_quick(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis);
+int mci_orient2d_projected_rest(const mci_point *p, const mci_point *q, const mci_point *r,
+                                int axis);
 
 /* Order of two points lying on the line of intersection of two planes, along the
  * direction n1 x n2 (paper Eq. 1): sign((a - b) . (n1 x n2)). +1: a is ahead of b. The

@@ -60,12 +60,17 @@ static int prev3(int i)
     return i == 0 ? 2 : i - 1;
 }
 
+/* The quick filter first: it decides most calls, and never where the points are known
+ * to be collinear (it does not return 0). */
 static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
     const mci_point *pts = c->in->points;
+    int s = mci_orient2d_projected_quick(&pts[a], &pts[b], &pts[p], c->in->axis);
+    if (s != MCI_UNCERTAIN)
+        return c->in->sign * s;
     if (c->in->known_collinear && c->in->known_collinear(c->in->user, a, b, p))
         return 0;
-    return c->in->sign * mci_orient2d_projected(&pts[a], &pts[b], &pts[p], c->in->axis);
+    return c->in->sign * mci_orient2d_projected_rest(&pts[a], &pts[b], &pts[p], c->in->axis);
 }
 
 static int vertex_index(const tri *t, uint32_t v)
@@ -96,75 +101,80 @@ static uint32_t random_below(cdt *c, uint32_t n)
     return (uint32_t)(c->rng % n);
 }
 
-static void set_vertices(cdt *c, uint32_t t, uint32_t a, uint32_t b, uint32_t d)
+/* Edge i of fresh triangle t lies against triangle s (NONE on the face's boundary),
+ * which is not being rebuilt: link both ways; the constraint flag is s's (a triangle on
+ * the boundary side keeps none, as nothing reads it there). */
+static void link_outer(cdt *c, uint32_t t, int i, uint32_t s)
 {
-    c->t[t].v[0] = a;
-    c->t[t].v[1] = b;
-    c->t[t].v[2] = d;
-}
-
-/* Link each edge of each fresh triangle to the triangle holding the reversed edge, among
- * the fresh ones and their outer neighbours (NONE entries allowed). Constraint flags of
- * edges shared with outer triangles are taken from those. */
-static void stitch(cdt *c, const uint32_t *fresh, int nf, const uint32_t *outer, int no)
-{
-    for (int k = 0; k < nf; k++)
-        c->t[fresh[k]].fixed = 0;
-    for (int k = 0; k < nf; k++) {
-        tri *t = &c->t[fresh[k]];
-        for (int i = 0; i < 3; i++) {
-            uint32_t u = t->v[next3(i)], w = t->v[prev3(i)];
-            t->n[i] = NONE;
-            for (int m = 0; m < nf + no && t->n[i] == NONE; m++) {
-                uint32_t s = m < nf ? fresh[m] : outer[m - nf];
-                int j = s == NONE || s == fresh[k] ? -1 : edge_index(&c->t[s], w, u);
-                if (j < 0)
-                    continue;
-                t->n[i] = s;
-                c->t[s].n[j] = fresh[k];
-                if (m >= nf)
-                    t->fixed |= (uint8_t)(((c->t[s].fixed >> j) & 1) << i);
-            }
-        }
+    tri *a = &c->t[t];
+    a->n[i] = s;
+    if (s != NONE) {
+        int j = known_edge(&c->t[s], a->v[prev3(i)], a->v[next3(i)]);
+        c->t[s].n[j] = t;
+        a->fixed |= (uint8_t)(((c->t[s].fixed >> j) & 1) << i);
     }
 }
 
+/* Edge i of fresh triangle t and edge j of fresh triangle s are the same edge. */
+static void link_fresh(cdt *c, uint32_t t, int i, uint32_t s, int j)
+{
+    c->t[t].n[i] = s;
+    c->t[s].n[j] = t;
+}
+
+static void set_triangle(cdt *c, uint32_t t, uint32_t a, uint32_t b, uint32_t d)
+{
+    c->t[t] = (tri){{a, b, d}, {NONE, NONE, NONE}, 0};
+}
+
+/* p inside t = (v0, v1, v2): t becomes (v0, v1, p), and (v1, v2, p), (v2, v0, p) are
+ * added; the edge opposite p in each is an old edge of t. */
 static void split_triangle(cdt *c, uint32_t t, uint32_t p)
 {
     tri old = c->t[t];
-    uint32_t fresh[3] = {t, (uint32_t)c->count, (uint32_t)c->count + 1};
+    uint32_t t1 = (uint32_t)c->count, t2 = (uint32_t)c->count + 1;
     c->count += 2;
-    set_vertices(c, fresh[0], old.v[0], old.v[1], p);
-    set_vertices(c, fresh[1], old.v[1], old.v[2], p);
-    set_vertices(c, fresh[2], old.v[2], old.v[0], p);
-    stitch(c, fresh, 3, old.n, 3);
-    c->vt[old.v[0]] = c->vt[old.v[1]] = c->vt[p] = fresh[0];
-    c->vt[old.v[2]] = fresh[1];
+    set_triangle(c, t, old.v[0], old.v[1], p);
+    set_triangle(c, t1, old.v[1], old.v[2], p);
+    set_triangle(c, t2, old.v[2], old.v[0], p);
+    link_fresh(c, t, 0, t1, 1);
+    link_fresh(c, t, 1, t2, 0);
+    link_fresh(c, t1, 0, t2, 1);
+    link_outer(c, t, 2, old.n[2]);
+    link_outer(c, t1, 2, old.n[0]);
+    link_outer(c, t2, 2, old.n[1]);
+    c->vt[old.v[0]] = c->vt[old.v[1]] = c->vt[p] = t;
+    c->vt[old.v[2]] = t1;
 }
 
-/* p lies inside edge i of t: split t, and the triangle across if there is one. */
+/* p lies inside edge i of t = (x, u, w) (edge u-w): t becomes (x, u, p) and (x, p, w) is
+ * added; the triangle s = (y, w, u) across, if any, becomes (y, w, p) and (y, p, u) is
+ * added. */
 static void split_edge(cdt *c, uint32_t t, int i, uint32_t p)
 {
     tri ot = c->t[t];
     uint32_t x = ot.v[i], u = ot.v[next3(i)], w = ot.v[prev3(i)], s = ot.n[i];
-    uint32_t fresh[4] = {t, (uint32_t)c->count++, s, NONE};
-    uint32_t outer[4] = {ot.n[next3(i)], ot.n[prev3(i)], NONE, NONE};
-    set_vertices(c, fresh[0], x, u, p);
-    set_vertices(c, fresh[1], x, p, w);
-    c->vt[x] = c->vt[u] = c->vt[p] = fresh[0];
-    c->vt[w] = fresh[1];
+    uint32_t t1 = (uint32_t)c->count++;
+    set_triangle(c, t, x, u, p);
+    set_triangle(c, t1, x, p, w);
+    link_fresh(c, t, 1, t1, 2);
+    link_outer(c, t, 2, ot.n[prev3(i)]);
+    link_outer(c, t1, 1, ot.n[next3(i)]);
+    c->vt[x] = c->vt[u] = c->vt[p] = t;
+    c->vt[w] = t1;
     if (s != NONE) {
         tri os = c->t[s];
         int j = known_edge(&os, w, u);
-        uint32_t y = os.v[j];
-        fresh[3] = (uint32_t)c->count++;
-        outer[2] = os.n[next3(j)];
-        outer[3] = os.n[prev3(j)];
-        set_vertices(c, s, y, w, p);
-        set_vertices(c, fresh[3], y, p, u);
+        uint32_t y = os.v[j], s1 = (uint32_t)c->count++;
+        set_triangle(c, s, y, w, p);
+        set_triangle(c, s1, y, p, u);
+        link_fresh(c, t, 0, s1, 0);
+        link_fresh(c, t1, 0, s, 0);
+        link_fresh(c, s, 1, s1, 2);
+        link_outer(c, s, 2, os.n[prev3(j)]);
+        link_outer(c, s1, 1, os.n[next3(j)]);
         c->vt[y] = s;
     }
-    stitch(c, fresh, s != NONE ? 4 : 2, outer, 4);
 }
 
 /* Find the triangle containing p by the remembering stochastic walk from `t`. On
@@ -204,13 +214,20 @@ static mcsg_status locate(cdt *c, uint32_t p, uint32_t t, uint32_t *found, int *
     return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: point location did not end");
 }
 
-/* Interleave the bits of two 16-bit values. */
+/* The 16 low bits of x, spread to the even bit positions. */
+static uint32_t spread_bits(uint32_t x)
+{
+    x &= 0xffffu;
+    x = (x | x << 8) & 0x00ff00ffu;
+    x = (x | x << 4) & 0x0f0f0f0fu;
+    x = (x | x << 2) & 0x33333333u;
+    return (x | x << 1) & 0x55555555u;
+}
+
+/* Interleave the bits of two 16-bit values (x in the even positions). */
 static uint32_t morton(uint32_t x, uint32_t y)
 {
-    uint32_t r = 0;
-    for (int b = 0; b < 16; b++)
-        r |= ((x >> b) & 1u) << (2 * b) | ((y >> b) & 1u) << (2 * b + 1);
-    return r;
+    return spread_bits(x) | spread_bits(y) << 1;
 }
 
 static int compare_u64(const void *a, const void *b)
@@ -396,6 +413,8 @@ static mcsg_status queue_crossed_edges(cdt *c, uint32_t a, uint32_t b, uint32_t 
     }
 }
 
+/* Flip edge i of t = (x, u, w) (edge u-w) with s = (y, w, u) across: t becomes
+ * (x, u, y) and s becomes (y, w, x). */
 static void flip(cdt *c, uint32_t t, int i)
 {
     tri ot = c->t[t];
@@ -404,11 +423,13 @@ static void flip(cdt *c, uint32_t t, int i)
     uint32_t x = ot.v[i], u = ot.v[next3(i)], w = ot.v[prev3(i)];
     int j = known_edge(&os, w, u);
     uint32_t y = os.v[j];
-    uint32_t fresh[2] = {t, s};
-    uint32_t outer[4] = {ot.n[next3(i)], ot.n[prev3(i)], os.n[next3(j)], os.n[prev3(j)]};
-    set_vertices(c, t, x, u, y);
-    set_vertices(c, s, y, w, x);
-    stitch(c, fresh, 2, outer, 4);
+    set_triangle(c, t, x, u, y);
+    set_triangle(c, s, y, w, x);
+    link_fresh(c, t, 1, s, 1);
+    link_outer(c, t, 0, os.n[next3(j)]);
+    link_outer(c, t, 2, ot.n[prev3(i)]);
+    link_outer(c, s, 0, ot.n[next3(i)]);
+    link_outer(c, s, 2, os.n[prev3(j)]);
     c->vt[x] = c->vt[u] = t;
     c->vt[y] = c->vt[w] = s;
 }
