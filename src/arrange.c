@@ -287,21 +287,51 @@ bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
 /* ---------------------------------------------------------------------------------- */
 /* Exact merging                                                                       */
 
+/* A point for sorting, with certified bounds of its x coordinate: points whose bounds
+ * are apart (most pairs) are ordered without reading the point. */
+typedef struct point_key {
+    const mci_point *p;
+    double lo, hi;
+} point_key;
+
+static void set_key(point_key *k, const mci_point *p)
+{
+    k->p = p;
+    if (p->exact_axes & 1) {
+        k->lo = k->hi = p->c[0];
+    } else { /* as mci_point_bounds: one step outward covers the rounding of c -+ r */
+        k->lo = mci_next_down(p->c[0] - p->r);
+        k->hi = mci_next_up(p->c[0] + p->r);
+    }
+}
+
+/* mci_compare_lex of the two points. */
+static int compare_keys(const point_key *a, const point_key *b)
+{
+    if (a->hi < b->lo)
+        return -1;
+    if (a->lo > b->hi)
+        return 1;
+    return mci_compare_lex(a->p, b->p);
+}
+
 /* Merges two runs of point ids sorted by mci_compare_lex (a before b on ties, as a
  * stable sort keeps the lower ids of run a first) into out. */
-static void merge_runs(const mci_point *const *table, const uint32_t *a, size_t na,
+static void merge_runs(const point_key *table, const uint32_t *a, size_t na,
                        const uint32_t *b, size_t nb, uint32_t *out)
 {
     size_t i = 0, j = 0, k = 0;
     while (i < na && j < nb)
-        out[k++] = mci_compare_lex(table[b[j]], table[a[i]]) < 0 ? b[j++] : a[i++];
+        out[k++] = compare_keys(&table[b[j]], &table[a[i]]) < 0 ? b[j++] : a[i++];
     while (i < na)
         out[k++] = a[i++];
     while (j < nb)
         out[k++] = b[j++];
 }
 
-void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n)
+/* Sort ids by the exact lexicographic order of the points table[id] (stable merge sort;
+ * tmp has n entries). */
+static void sort_point_ids(const point_key *table, uint32_t *ids, uint32_t *tmp, size_t n)
 {
     for (size_t width = 1; width < n; width *= 2) {
         for (size_t lo = 0; lo < n; lo += 2 * width) {
@@ -313,12 +343,12 @@ void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *
     }
 }
 
-/* A table of pointers to the face's points, for mci_sort_point_ids. */
-static const mci_point **point_table(const mci_ctx *ctx, const mci_face_arr *arr)
+/* Sort keys of the face's points, by id. */
+static point_key *point_table(const mci_ctx *ctx, const mci_face_arr *arr)
 {
-    const mci_point **table = mci_malloc_array(ctx, arr->point_count + 1, sizeof *table);
+    point_key *table = mci_malloc_array(ctx, arr->point_count + 1, sizeof *table);
     for (size_t i = 0; table && i < arr->point_count; i++)
-        table[i] = &arr->points[i];
+        set_key(&table[i], &arr->points[i]);
     return table;
 }
 
@@ -409,21 +439,21 @@ static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr,
     return MCSG_OK;
 }
 
-/* The order mci_sort_point_ids gives all n points when the first `merged` are the
+/* The order sort_point_ids gives all n points when the first `merged` are the
  * result of the previous merge (corners 0..2, then distinct points in lexicographic
  * order) and the rest were added since: the corners are merged into the sorted run,
  * the new points sorted alone, and the two runs merged. The same stable order for far
  * fewer comparisons: faces receiving a few points from their neighbours' edges are
  * merged again. idx and tmp hold n ids. */
-static void sort_after_merge(const mci_point *const *table, size_t merged, size_t n,
+static void sort_after_merge(const point_key *table, size_t merged, size_t n,
                              uint32_t *idx, uint32_t *tmp)
 {
     uint32_t corners[3] = {0, 1, 2}, scratch[3];
     for (size_t i = 3; i < n; i++)
         tmp[i] = (uint32_t)i;
-    mci_sort_point_ids(table, corners, scratch, 3);
+    sort_point_ids(table, corners, scratch, 3);
     merge_runs(table, corners, 3, tmp + 3, merged - 3, idx);
-    mci_sort_point_ids(table, tmp + merged, idx + merged, n - merged);
+    sort_point_ids(table, tmp + merged, idx + merged, n - merged);
     /* Into tmp itself: output slot i + j never passes the unread new ids at merged + j. */
     merge_runs(table, idx, merged, tmp + merged, n - merged, tmp);
     memcpy(idx, tmp, n * sizeof *idx);
@@ -434,9 +464,9 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
                                 mcsg_error *err)
 {
     size_t n = arr->point_count, kept = 0;
-    /* One block for the pointer table and the two id arrays of the sort (three
+    /* One block for the key table and the two id arrays of the sort (three
      * allocations per merge were a tenth of the merge's cost on small faces). */
-    const mci_point **table = mci_malloc_array(ctx, n + 1, sizeof *table + 2 * sizeof(uint32_t));
+    point_key *table = mci_malloc_array(ctx, n + 1, sizeof *table + 2 * sizeof(uint32_t));
     uint32_t *idx = table ? (uint32_t *)(void *)(table + n + 1) : NULL;
     uint32_t *tmp = idx ? idx + n + 1 : NULL;
     uint32_t *remap = mci_malloc_array(ctx, n, sizeof *remap);
@@ -447,14 +477,14 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     /* After a merge, where_count is its point count and only appends follow. */
     size_t before = arr->where_count >= 3 && arr->where_count <= n ? arr->where_count : 0;
     for (size_t i = 0; table && i < n; i++)
-        table[i] = &arr->points[i];
+        set_key(&table[i], &arr->points[i]);
     if (st == MCSG_OK) {
         if (before) {
             sort_after_merge(table, before, n, idx, tmp);
         } else {
             for (size_t i = 0; i < n; i++)
                 idx[i] = (uint32_t)i;
-            mci_sort_point_ids(table, idx, tmp, n);
+            sort_point_ids(table, idx, tmp, n);
         }
         kept = merge_ids(arr, idx, remap);
         /* Sized after merging: faces with twins or many neighbours along their edges
@@ -791,10 +821,10 @@ static int compare_edges(const void *x, const void *y)
 }
 
 /* The elementary edges of segment s: its ends and cuts (ids[0..n)) in order along it. */
-static void emit_pieces(mci_face_arr *arr, const mci_point *const *table,
+static void emit_pieces(mci_face_arr *arr, const point_key *table,
                         const mci_arr_segment *s, uint32_t *ids, uint32_t *tmp, size_t n)
 {
-    mci_sort_point_ids(table, ids, tmp, n);
+    sort_point_ids(table, ids, tmp, n);
     for (size_t k = 0; k + 1 < n; k++) {
         mci_arr_edge *e = &arr->edges[arr->edge_count];
         uint32_t u = ids[k], w = ids[k + 1];
@@ -814,7 +844,7 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
     size_t max_pieces = arr->segment_count + cut_count, c = 0, out = 0;
     uint32_t *ids = mci_malloc_array(ctx, 2 + cut_count, sizeof *ids);
     uint32_t *tmp = mci_malloc_array(ctx, 2 + cut_count, sizeof *tmp);
-    const mci_point **table = point_table(ctx, arr);
+    point_key *table = point_table(ctx, arr);
     mci_free(ctx, arr->edges);
     arr->edge_count = 0;
     arr->edges = mci_malloc_array(ctx, max_pieces ? max_pieces : 1, sizeof *arr->edges);

@@ -121,8 +121,5 @@ mcsg_status mci_arr_retessellate(const mci_ctx *ctx, mci_face_arr *arr,
                                  const uint8_t *piece_keep, uint8_t **tri_keep,
                                  mcsg_error *err);
 
-/* Sort ids by the exact lexicographic order of the points table[id] (stable merge sort;
- * tmp has n entries). */
-void mci_sort_point_ids(const mci_point *const *table, uint32_t *ids, uint32_t *tmp, size_t n);
 
 #endif

@@ -31,6 +31,10 @@ void mci_split_double(double x, uint64_t *significand, int *exponent);
  * integer multiple of 2^mci_lsb_exponent(x). Returns INT_MAX for 0. */
 int mci_lsb_exponent(double x);
 
+/* The exponents of the lowest and the highest set bit of x (finite, nonzero): x is an
+ * integer multiple of 2^lsb and 2^msb <= |x| < 2^(msb + 1) (msb is ilogb(x)). */
+void mci_bit_range(double x, int *lsb, int *msb);
+
 /* *r = x * 2^-e0 exactly; requires x finite and e0 <= mci_lsb_exponent(x). */
 void mci_big_from_double(mci_big *r, double x, int e0);
 void mci_big_set_int(mci_big *r, int value);

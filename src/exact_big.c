@@ -53,6 +53,24 @@ void mci_split_double(double x, uint64_t *significand, int *exponent)
     *exponent += tz;
 }
 
+void mci_bit_range(double x, int *lsb, int *msb)
+{
+    uint64_t bits, m;
+    int biased;
+    memcpy(&bits, &x, sizeof bits);
+    biased = (int)((bits >> 52) & 0x7ff);
+    m = bits & 0xfffffffffffffULL;
+    if (biased) {
+        m |= 1ULL << 52;
+        *msb = biased - 1023;
+        *lsb = biased - 1075 + trailing_zeros(m);
+        return;
+    }
+    *lsb = -1074 + trailing_zeros(m); /* subnormal */
+    for (*msb = -1074; m > 1; m >>= 1)
+        ++*msb;
+}
+
 int mci_lsb_exponent(double x)
 {
     uint64_t m;

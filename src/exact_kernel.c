@@ -132,8 +132,7 @@ static void scale_vertices(input_scale *s, const double *const *v, int n)
             int lsb, msb;
             if (x == 0)
                 continue;
-            lsb = mci_lsb_exponent(x);
-            msb = ilogb(x);
+            mci_bit_range(x, &lsb, &msb);
             s->e0 = lsb < s->e0 ? lsb : s->e0;
             s->top = msb > s->top ? msb : s->top;
         }
@@ -308,7 +307,7 @@ static int aligned_axis(const mci_plane *plane)
 static int exact_w_sign(const mci_point *p)
 {
     input_scale s = scale_of(&p, 1, NULL, 0);
-    /* point_at computes X as well as W, so X's degree decides. */
+    /* The degree bound is X's, as for the other predicates (W alone is of lower degree). */
     if (fits_i128(s, x_degree(p)))
         return i128_w_sign(p, s.e0);
     return big_w_sign(p, s.e0);
@@ -477,7 +476,7 @@ void mci_point_round(const mci_point *p, double out[3])
         return;
     /* X / W is the point in units of 2^e0 once X is measured from the origin. */
     s = scale_of(&p, 1, NULL, 0);
-    big_point_at(&exact, p, zero, s.e0);
+    big_point_at(&exact, p, zero, s.e0, pending);
     for (int k = 0; k < 3; k++)
         if ((pending >> k) & 1)
             out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
@@ -663,16 +662,19 @@ bool mci_points_same_definition(const mci_point *a, const mci_point *b)
            memcmp(a->v, b->v, (size_t)mci_point_vertex_count(a) * sizeof a->v[0]) == 0;
 }
 
+/* The box test first: it decides most comparisons of distinct points and never returns 0
+ * (its error bound is positive), so the same-definition test may follow it. */
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
 {
     int s;
     if ((a->exact_axes & b->exact_axes) >> axis & 1)
         return (a->c[axis] > b->c[axis]) - (a->c[axis] < b->c[axis]);
+    s = fv_sign(fv_sub((mci_fv){a->c[axis], a->r}, (mci_fv){b->c[axis], b->r}));
+    if (s != MCI_UNCERTAIN)
+        return s;
     if (mci_points_same_definition(a, b))
         return 0;
-    s = fv_sign(fv_sub((mci_fv){a->c[axis], a->r}, (mci_fv){b->c[axis], b->r}));
-    if (s == MCI_UNCERTAIN)
-        s = mci_compare_coord_filtered(a, b, axis);
+    s = mci_compare_coord_filtered(a, b, axis);
     return s != MCI_UNCERTAIN ? s : mci_compare_coord_exact(a, b, axis);
 }
 

@@ -24,6 +24,7 @@
  * MCSG_TEST_SCALE (default 1) multiplies the number of scenarios; MCSG_TEST_SEED sets the
  * random seed. The tables at the end count the cases and the filter's decisions.
  */
+#include "exact.h"
 #include "exact_kernel.h"
 #include "testlib.h"
 
@@ -1887,6 +1888,34 @@ TEST(next_double)
     }
 }
 
+/* The bit range read from a double's fields agrees with ilogb and with the lowest set
+ * bit of the significand, on special values and random bit patterns. */
+static void check_bit_range(double x)
+{
+    int lsb, msb;
+    double scaled;
+    mci_bit_range(x, &lsb, &msb);
+    CHECK_MSG(msb == ilogb(x), "msb of %a: %d, ilogb %d", x, msb, ilogb(x));
+    scaled = ldexp(x, -lsb); /* exact: an odd integer */
+    CHECK_MSG(scaled == trunc(scaled) && fmod(scaled, 2.0) != 0, "lsb of %a: %d", x, lsb);
+}
+
+TEST(bit_range)
+{
+    static const double special[] = {0x1p-1074, -0x1p-1074, 0x1.8p-1073, 0x1p-1022,
+                                     0x1.fffffffffffffp-1023, 1.0, -1.0, 0.1, 3.0, DBL_MAX,
+                                     -DBL_MAX, 0x1p1023};
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        check_bit_range(special[i]);
+    for (int i = 0; i < 200000; i++) {
+        uint64_t bits = rng_next();
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        if (isfinite(x) && x != 0)
+            check_bit_range(x);
+    }
+}
+
 int main(void)
 {
     const char *seed = getenv("MCSG_TEST_SEED");
@@ -1895,6 +1924,7 @@ int main(void)
     printf("seed 0x%llx, scale %g\n", (unsigned long long)rng_state, test_scale());
     ws_init();
     RUN(next_double);
+    RUN(bit_range);
     RUN(reference_sanity);
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);
