@@ -934,10 +934,15 @@ static size_t chosen_edges(const mci_face_arr *arr, const bool *use, uint32_t *p
 mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const bool *use,
                                 mcsg_error *err)
 {
-    bool *mark = mci_calloc_array(ctx, arr->point_count, sizeof *mark);
-    uint32_t *insert = mci_malloc_array(ctx, arr->point_count, sizeof *insert);
-    uint32_t *pairs = mci_malloc_array(ctx, 2 * arr->edge_count + 1, sizeof *pairs);
+    /* One block: insert (point_count ids), pairs (2 edge_count + 1 ids), then mark (one
+     * flag per point, in room for as many ids). */
+    size_t ids = arr->point_count + 2 * arr->edge_count + 1;
+    uint32_t *insert = mci_malloc_array(ctx, ids + arr->point_count, sizeof *insert);
+    uint32_t *pairs = insert ? insert + arr->point_count : NULL;
+    bool *mark = insert ? (bool *)(void *)(insert + ids) : NULL;
     mcsg_status st = MCSG_OK;
+    if (mark)
+        memset(mark, 0, arr->point_count * sizeof *mark);
     if (arr->dirty)
         st = mci_fail(err, MCSG_ERR_INTERNAL, "face %u triangulated before splitting", arr->face);
     mci_free(ctx, arr->tris);
@@ -960,8 +965,6 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
             arr->tri_count = out.tri_count;
         }
     }
-    mci_free(ctx, mark);
     mci_free(ctx, insert);
-    mci_free(ctx, pairs);
     return st;
 }

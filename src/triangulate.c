@@ -45,6 +45,8 @@ typedef struct cdt {
     tri *t;
     size_t count;
     uint32_t *vt; /* a triangle incident to each inserted point */
+    uint64_t *order; /* insertion order (see insertion_order) */
+    void *block;  /* t, vt and order in one allocation */
     uint64_t rng;
     queued_edge *queue;
     size_t queue_head, queue_len, queue_cap;
@@ -254,13 +256,10 @@ static uint32_t insertion_key(const mci_cdt_input *in, const double lo[2],
     return morton(cell[0], cell[1]);
 }
 
-static uint64_t *insertion_order(const mci_ctx *ctx, const mci_cdt_input *in)
+/* Fills order[0..insert_count) with the insertion order (key << 32 | index). */
+static void insertion_order(const mci_cdt_input *in, uint64_t *order)
 {
     double lo[2] = {0, 0}, hi[2] = {0, 0}, span[2];
-    uint64_t *order = mci_malloc_array(ctx, in->insert_count ? in->insert_count : 1,
-                                       sizeof *order);
-    if (!order)
-        return NULL;
     for (int i = 0; i < 3; i++) {
         double x[3];
         mci_point_approx(&in->points[i], x);
@@ -276,16 +275,15 @@ static uint64_t *insertion_order(const mci_ctx *ctx, const mci_cdt_input *in)
         order[i] = (uint64_t)insertion_key(in, lo, span, in->insert[i]) << 32 | i;
     if (in->insert_count > 0)
         qsort(order, in->insert_count, sizeof *order, compare_u64);
-    return order;
 }
 
 static mcsg_status insert_points(cdt *c, mcsg_error *err)
 {
-    uint64_t *order = insertion_order(c->ctx, c->in);
     uint32_t last = 0;
-    mcsg_status st = order ? MCSG_OK : mci_fail_nomem(err, "triangulating a face");
+    mcsg_status st = MCSG_OK;
+    insertion_order(c->in, c->order);
     for (size_t k = 0; st == MCSG_OK && k < c->in->insert_count; k++) {
-        uint32_t p = c->in->insert[(uint32_t)order[k]], t = 0;
+        uint32_t p = c->in->insert[(uint32_t)c->order[k]], t = 0;
         int edge = -1;
         if (p >= c->in->point_count || c->vt[p] != NONE) {
             st = mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad point id %u", p);
@@ -300,7 +298,6 @@ static mcsg_status insert_points(cdt *c, mcsg_error *err)
             split_edge(c, t, edge, p);
         last = p;
     }
-    mci_free(c->ctx, order);
     return st;
 }
 
@@ -514,10 +511,22 @@ static mcsg_status setup(cdt *c, const mci_ctx *ctx, const mci_cdt_input *in, mc
     c->rng = 0x9e3779b97f4a7c15u;
     if (in->point_count < 3 || in->insert_count > in->point_count)
         return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad point counts");
-    c->t = mci_malloc_array(ctx, 1 + 2 * in->insert_count, sizeof *c->t);
-    c->vt = mci_malloc_array(ctx, in->point_count, sizeof *c->vt);
-    if (!c->t || !c->vt)
-        return mci_fail_nomem(err, "triangulating a face");
+    if (in->point_count > SIZE_MAX / 64)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many points in one face (%zu)",
+                        in->point_count);
+    /* One block: order (64-bit keys), the triangles, vt. */
+    {
+        size_t tris = 1 + 2 * in->insert_count, words = in->insert_count + 1;
+        size_t tri_words = (tris * sizeof *c->t + sizeof *c->order - 1) / sizeof *c->order;
+        size_t vt_words = (in->point_count * sizeof *c->vt + sizeof *c->order - 1) /
+                          sizeof *c->order;
+        c->block = mci_malloc_array(ctx, words + tri_words + vt_words, sizeof *c->order);
+        if (!c->block)
+            return mci_fail_nomem(err, "triangulating a face");
+        c->order = c->block;
+        c->t = (tri *)(void *)(c->order + words);
+        c->vt = (uint32_t *)(void *)(c->order + words + tri_words);
+    }
     for (size_t i = 0; i < in->point_count; i++)
         c->vt[i] = i < 3 ? 0 : NONE;
     c->t[0] = (tri){{0, 1, 2}, {NONE, NONE, NONE}, 0};
@@ -568,8 +577,7 @@ mcsg_status mci_triangulate(const mci_ctx *ctx, const mci_cdt_input *in, mci_cdt
         }
         out->tri_count = st == MCSG_OK ? c.count : 0;
     }
-    mci_free(ctx, c.t);
-    mci_free(ctx, c.vt);
+    mci_free(ctx, c.block);
     mci_free(ctx, c.queue);
     return st;
 }
