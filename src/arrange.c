@@ -76,8 +76,7 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
 
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
 {
-    mci_free(ctx, arr->points);
-    mci_free(ctx, arr->lines);
+    mci_free(ctx, arr->points); /* and the lines, in the same block */
     mci_free(ctx, arr->where);
     mci_free(ctx, arr->segments);
     mci_free(ctx, arr->edges);
@@ -87,23 +86,41 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     memset(arr, 0, sizeof *arr);
 }
 
+/* A block for `capacity` points followed by their line lists (one allocation where
+ * there were two: arrangements are many and small). */
+static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lines **lines)
+{
+    mci_point *points = mci_malloc_array(ctx, capacity ? capacity : 1,
+                                         sizeof *points + sizeof **lines);
+    *lines = points ? (mci_point_lines *)(void *)(points + capacity) : NULL;
+    return points;
+}
+
+/* Room for one more point: the block doubles (at least 8), keeping points and lines. */
+static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
+{
+    size_t capacity = arr->point_capacity < 4 ? 8 : 2 * arr->point_capacity;
+    mci_point_lines *lines;
+    mci_point *points;
+    if (arr->point_count < arr->point_capacity)
+        return true;
+    if (capacity > SIZE_MAX / 2 || !(points = point_block(ctx, capacity, &lines)))
+        return false;
+    memcpy(points, arr->points, arr->point_count * sizeof *points);
+    memcpy(lines, arr->lines, arr->point_count * sizeof *lines);
+    mci_free(ctx, arr->points);
+    arr->points = points;
+    arr->lines = lines;
+    arr->point_capacity = capacity;
+    return true;
+}
+
 /* Add a point known to lie on `line` (0: none known). */
 static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
                          uint64_t line)
 {
-    size_t capacity = arr->point_capacity;
-    if (!mci_grow_array(ctx, (void **)&arr->points, &arr->point_capacity,
-                        arr->point_count + 1, sizeof *arr->points, 8))
+    if (!grow_points(ctx, arr))
         return false;
-    if (capacity != arr->point_capacity) {
-        mci_point_lines *grown = mci_realloc_array(ctx, arr->lines, arr->point_capacity,
-                                                   sizeof *grown);
-        if (!grown) {
-            arr->point_capacity = capacity; /* points grew; lines did not: stay consistent */
-            return false;
-        }
-        arr->lines = grown;
-    }
     arr->lines[arr->point_count].count = line != 0;
     arr->lines[arr->point_count].id[0] = line;
     arr->points[arr->point_count++] = *p;
@@ -343,15 +360,6 @@ static void sort_point_ids(const point_key *table, uint32_t *ids, uint32_t *tmp,
     }
 }
 
-/* Sort keys of the face's points, by id. */
-static point_key *point_table(const mci_ctx *ctx, const mci_face_arr *arr)
-{
-    point_key *table = mci_malloc_array(ctx, arr->point_count + 1, sizeof *table);
-    for (size_t i = 0; table && i < arr->point_count; i++)
-        set_key(&table[i], &arr->points[i]);
-    return table;
-}
-
 /* New id of every point after merging (corners keep 0..2, the rest follow in sorted
  * order). Returns the number of distinct points. */
 static size_t merge_ids(const mci_face_arr *arr, const uint32_t *sorted, uint32_t *remap)
@@ -459,21 +467,20 @@ static void sort_after_merge(const point_key *table, size_t merged, size_t n,
     memcpy(idx, tmp, n * sizeof *idx);
 }
 
-/* Merge, and return the id map (old -> new) through *remap_out if wanted. */
-static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t **remap_out,
-                                mcsg_error *err)
+/* Merge; the `cut_count` cuts (segment, point) given get their point ids renumbered. */
+static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[2],
+                                size_t cut_count, mcsg_error *err)
 {
     size_t n = arr->point_count, kept = 0;
-    /* One block for the key table and the two id arrays of the sort (three
+    /* One block for the key table, the two id arrays of the sort and the id map (four
      * allocations per merge were a tenth of the merge's cost on small faces). */
-    point_key *table = mci_malloc_array(ctx, n + 1, sizeof *table + 2 * sizeof(uint32_t));
+    point_key *table = mci_malloc_array(ctx, n + 1, sizeof *table + 3 * sizeof(uint32_t));
     uint32_t *idx = table ? (uint32_t *)(void *)(table + n + 1) : NULL;
     uint32_t *tmp = idx ? idx + n + 1 : NULL;
-    uint32_t *remap = mci_malloc_array(ctx, n, sizeof *remap);
+    uint32_t *remap = tmp ? tmp + n + 1 : NULL;
     mci_point *merged = NULL;
     mci_point_lines *merged_lines = NULL;
-    mcsg_status st = table && idx && tmp && remap ? MCSG_OK
-                                                  : mci_fail_nomem(err, "arranging a face");
+    mcsg_status st = table ? MCSG_OK : mci_fail_nomem(err, "arranging a face");
     /* After a merge, where_count is its point count and only appends follow. */
     size_t before = arr->where_count >= 3 && arr->where_count <= n ? arr->where_count : 0;
     for (size_t i = 0; table && i < n; i++)
@@ -489,9 +496,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         kept = merge_ids(arr, idx, remap);
         /* Sized after merging: faces with twins or many neighbours along their edges
          * collect several copies of each point, and the arrangement keeps this array. */
-        merged = mci_malloc_array(ctx, kept, sizeof *merged);
-        merged_lines = mci_malloc_array(ctx, kept, sizeof *merged_lines);
-        if (!merged || !merged_lines)
+        if (!(merged = point_block(ctx, kept, &merged_lines)))
             st = mci_fail_nomem(err, "arranging a face");
     }
     if (st == MCSG_OK) {
@@ -515,29 +520,24 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
                 arr->segments[out++] = seg;
         }
         arr->segment_count = out;
+        for (size_t k = 0; k < cut_count; k++)
+            cuts[k][1] = remap[cuts[k][1]];
         mci_free(ctx, arr->points);
-        mci_free(ctx, arr->lines);
         arr->points = merged;
         arr->lines = merged_lines;
         arr->point_count = arr->point_capacity = kept;
         merged = NULL;
-        merged_lines = NULL;
         st = classify_points(ctx, arr, arr->where, before, remap, err);
         arr->dirty = false;
     }
-    if (remap_out && st == MCSG_OK)
-        *remap_out = remap;
-    else
-        mci_free(ctx, remap);
     mci_free(ctx, table);
     mci_free(ctx, merged);
-    mci_free(ctx, merged_lines);
     return st;
 }
 
 mcsg_status mci_arr_merge(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
 {
-    return merge_points(ctx, arr, NULL, err);
+    return merge_points(ctx, arr, NULL, 0, err);
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -740,15 +740,13 @@ static int compare_items(const void *x, const void *y)
 static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size_t *count)
 {
     double face_lo[2], face_hi[2];
-    size_t n = 0;
-    bool *is_end = mci_calloc_array(ctx, arr->point_count, sizeof *is_end);
-    sweep_item *items = mci_malloc_array(ctx, arr->segment_count + arr->point_count,
-                                         sizeof *items);
-    if (!is_end || !items) {
-        mci_free(ctx, is_end);
-        mci_free(ctx, items);
+    size_t n = 0, slots = arr->segment_count + arr->point_count;
+    /* One block: the items, then a flag per point (in room for as many more items). */
+    sweep_item *items = mci_malloc_array(ctx, slots + arr->point_count, sizeof *items);
+    bool *is_end = items ? (bool *)(void *)(items + slots) : NULL;
+    if (!items)
         return NULL;
-    }
+    memset(is_end, 0, arr->point_count * sizeof *is_end);
     for (int k = 0; k < 2; k++) {
         int axis = (arr->axis + 1 + k) % 3;
         face_lo[k] = fmin(fmin(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
@@ -770,7 +768,6 @@ static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size
         item_bounds(arr, face_lo, face_hi, &arr->points[p], &items[n], true);
         n++;
     }
-    mci_free(ctx, is_end);
     if (n > 0)
         qsort(items, n, sizeof *items, compare_items);
     *count = n;
@@ -842,15 +839,17 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
                         size_t cut_count)
 {
     size_t max_pieces = arr->segment_count + cut_count, c = 0, out = 0;
-    uint32_t *ids = mci_malloc_array(ctx, 2 + cut_count, sizeof *ids);
-    uint32_t *tmp = mci_malloc_array(ctx, 2 + cut_count, sizeof *tmp);
-    point_key *table = point_table(ctx, arr);
+    /* One block: the key table, then two id arrays of 2 + cut_count each (in room for
+     * as many keys: a key is larger than two ids). */
+    point_key *table = mci_malloc_array(ctx, arr->point_count + 2 + cut_count, sizeof *table);
+    uint32_t *ids = table ? (uint32_t *)(void *)(table + arr->point_count) : NULL;
+    uint32_t *tmp = ids ? ids + 2 + cut_count : NULL;
+    for (size_t i = 0; table && i < arr->point_count; i++)
+        set_key(&table[i], &arr->points[i]);
     mci_free(ctx, arr->edges);
     arr->edge_count = 0;
     arr->edges = mci_malloc_array(ctx, max_pieces ? max_pieces : 1, sizeof *arr->edges);
-    if (!ids || !tmp || !table || !arr->edges) {
-        mci_free(ctx, ids);
-        mci_free(ctx, tmp);
+    if (!table || !arr->edges) {
         mci_free(ctx, table);
         return false;
     }
@@ -871,8 +870,6 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
         if (out == 0 || compare_edges(&arr->edges[e], &arr->edges[out - 1]) != 0)
             arr->edges[out++] = arr->edges[e];
     arr->edge_count = out;
-    mci_free(ctx, ids);
-    mci_free(ctx, tmp);
     mci_free(ctx, table);
     return true;
 }
@@ -880,22 +877,18 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
 mcsg_status mci_arr_split(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err)
 {
     splitter sp = {ctx, arr, NULL, 0, 0, true};
-    uint32_t *remap = NULL;
     mcsg_status st = MCSG_OK;
     size_t before;
-    if (arr->dirty && (st = merge_points(ctx, arr, NULL, err)) != MCSG_OK)
+    if (arr->dirty && (st = merge_points(ctx, arr, NULL, 0, err)) != MCSG_OK)
         return st;
     before = arr->point_count;
     if (!sweep(&sp))
         st = mci_fail_nomem(err, "arranging a face");
     /* Crossing points may coincide with each other or with earlier points. */
     if (st == MCSG_OK && arr->point_count > before)
-        st = merge_points(ctx, arr, &remap, err);
-    for (size_t k = 0; st == MCSG_OK && remap && k < sp.cut_count; k++)
-        sp.cuts[k][1] = remap[sp.cuts[k][1]];
+        st = merge_points(ctx, arr, sp.cuts, sp.cut_count, err);
     if (st == MCSG_OK && !build_edges(ctx, arr, sp.cuts, sp.cut_count))
         st = mci_fail_nomem(err, "arranging a face");
-    mci_free(ctx, remap);
     mci_free(ctx, sp.cuts);
     return st;
 }

@@ -41,10 +41,11 @@ static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
         nc += across != UINT32_MAX && (across & MCI_CDT_CONSTRAINT) &&
               r < (across & ~MCI_CDT_CONSTRAINT);
     }
-    o->boundary = mci_malloc_array(ctx, nb + 1, sizeof *o->boundary);
-    o->constraint = mci_malloc_array(ctx, nc + 1, sizeof *o->constraint);
+    /* One block for both lists (freed through o->boundary). */
+    o->boundary = mci_malloc_array(ctx, nb + nc + 1, sizeof *o->boundary);
+    o->constraint = o->boundary ? o->boundary + nb : NULL;
     o->boundary_count = o->constraint_count = 0;
-    if (!o->boundary || !o->constraint)
+    if (!o->boundary)
         return false;
     for (size_t r = 0; r < n; r++) {
         uint32_t across = arr->adj[r], other = across & ~MCI_CDT_CONSTRAINT;
@@ -61,8 +62,7 @@ static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
 
 static void free_old_sides(const mci_ctx *ctx, old_sides *o)
 {
-    mci_free(ctx, o->boundary);
-    mci_free(ctx, o->constraint);
+    mci_free(ctx, o->boundary); /* and the constraints, in the same block */
 }
 
 /* Whether `key` is an interior constraint of the old tessellation, and a valid one. */
