@@ -76,8 +76,7 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
 
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
 {
-    mci_free(ctx, arr->points); /* and the lines, in the same block */
-    mci_free(ctx, arr->where);
+    mci_free(ctx, arr->points); /* and the lines and locations, in the same block */
     mci_free(ctx, arr->segments);
     mci_free(ctx, arr->edges);
     mci_free(ctx, arr->aux);
@@ -86,31 +85,39 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     memset(arr, 0, sizeof *arr);
 }
 
-/* A block for `capacity` points followed by their line lists (one allocation where
- * there were two: arrangements are many and small). */
-static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lines **lines)
+/* A block for `capacity` points followed by their line lists and their locations (one
+ * allocation where there were three: arrangements are many and small). */
+static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lines **lines,
+                              uint8_t **where)
 {
     mci_point *points = mci_malloc_array(ctx, capacity ? capacity : 1,
-                                         sizeof *points + sizeof **lines);
+                                         sizeof *points + sizeof **lines + sizeof **where);
     *lines = points ? (mci_point_lines *)(void *)(points + capacity) : NULL;
+    *where = points ? (uint8_t *)(void *)(*lines + capacity) : NULL;
     return points;
 }
 
-/* Room for one more point: the block doubles (at least 8), keeping points and lines. */
+/* Room for one more point: the block doubles (at least 8), keeping its contents. */
 static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
 {
     size_t capacity = arr->point_capacity < 4 ? 8 : 2 * arr->point_capacity;
     mci_point_lines *lines;
     mci_point *points;
+    uint8_t *where;
     if (arr->point_count < arr->point_capacity)
         return true;
-    if (capacity > SIZE_MAX / 2 || !(points = point_block(ctx, capacity, &lines)))
+    if (capacity > SIZE_MAX / 2 || !(points = point_block(ctx, capacity, &lines, &where)))
         return false;
-    memcpy(points, arr->points, arr->point_count * sizeof *points);
-    memcpy(lines, arr->lines, arr->point_count * sizeof *lines);
+    if (arr->point_count) { /* the first block has nothing to copy (and memcpy no NULL) */
+        memcpy(points, arr->points, arr->point_count * sizeof *points);
+        memcpy(lines, arr->lines, arr->point_count * sizeof *lines);
+    }
+    if (arr->where_count)
+        memcpy(where, arr->where, arr->where_count * sizeof *where);
     mci_free(ctx, arr->points);
     arr->points = points;
     arr->lines = lines;
+    arr->where = where;
     arr->point_capacity = capacity;
     return true;
 }
@@ -417,22 +424,12 @@ static uint8_t locate_in_face(const mci_face_arr *arr, const mci_point *p)
 
 #define WHERE_UNKNOWN UINT8_C(0xfe)
 
-/* MCI_AT_* of every point after a merge. Points of the previous merge (old ids below
- * `known_count`, locations `known`) keep theirs through remap: a location depends on
- * the point alone, not on which of its copies is stored. */
-static mcsg_status classify_points(const mci_ctx *ctx, mci_face_arr *arr,
-                                   const uint8_t *known, size_t known_count,
-                                   const uint32_t *remap, mcsg_error *err)
+/* MCI_AT_* of the points whose location is not known yet (after a merge: the points
+ * added since the previous one; a location depends on the point alone, not on which of
+ * its copies is stored, so the others kept theirs). */
+static mcsg_status locate_new_points(mci_face_arr *arr, mcsg_error *err)
 {
-    uint8_t *where = mci_malloc_array(ctx, arr->point_count + 1, 1);
-    if (!where)
-        return mci_fail_nomem(err, "arranging a face");
-    memset(where, WHERE_UNKNOWN, arr->point_count);
-    for (size_t i = 0; i < known_count; i++)
-        where[remap[i]] = known[i];
-    mci_free(ctx, arr->where);
-    arr->where = where;
-    arr->where_count = arr->point_count;
+    uint8_t *where = arr->where;
     for (size_t i = 0; i < arr->point_count; i++) {
         if (where[i] != WHERE_UNKNOWN)
             continue;
@@ -480,6 +477,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     uint32_t *remap = tmp ? tmp + n + 1 : NULL;
     mci_point *merged = NULL;
     mci_point_lines *merged_lines = NULL;
+    uint8_t *merged_where = NULL;
     mcsg_status st = table ? MCSG_OK : mci_fail_nomem(err, "arranging a face");
     /* After a merge, where_count is its point count and only appends follow. */
     size_t before = arr->where_count >= 3 && arr->where_count <= n ? arr->where_count : 0;
@@ -496,7 +494,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         kept = merge_ids(arr, idx, remap);
         /* Sized after merging: faces with twins or many neighbours along their edges
          * collect several copies of each point, and the arrangement keeps this array. */
-        if (!(merged = point_block(ctx, kept, &merged_lines)))
+        if (!(merged = point_block(ctx, kept, &merged_lines, &merged_where)))
             st = mci_fail_nomem(err, "arranging a face");
     }
     if (st == MCSG_OK) {
@@ -522,12 +520,16 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         arr->segment_count = out;
         for (size_t k = 0; k < cut_count; k++)
             cuts[k][1] = remap[cuts[k][1]];
+        memset(merged_where, WHERE_UNKNOWN, kept);
+        for (size_t i = 0; i < before; i++)
+            merged_where[remap[i]] = arr->where[i];
         mci_free(ctx, arr->points);
         arr->points = merged;
         arr->lines = merged_lines;
-        arr->point_count = arr->point_capacity = kept;
+        arr->where = merged_where;
+        arr->point_count = arr->point_capacity = arr->where_count = kept;
         merged = NULL;
-        st = classify_points(ctx, arr, arr->where, before, remap, err);
+        st = locate_new_points(arr, err);
         arr->dirty = false;
     }
     mci_free(ctx, table);
