@@ -783,6 +783,20 @@ static bool collinear_by_definition(const mci_point *p, const mci_point *q, cons
            lpi_on_line(r, p, q) || lpi_on_line(q, p, r) || lpi_on_line(p, q, r);
 }
 
+/* Whether the coordinates of p's base vertex have at most 11 significant bits (the low
+ * 42 bits of each significand are zero): a quick guess that the exact stage may fit
+ * 128-bit integers, only used to choose the order of the stages. */
+static bool short_base(const mci_point *p)
+{
+    for (int k = 0; k < 3; k++) {
+        uint64_t bits;
+        memcpy(&bits, &p->v[0][k], sizeof bits);
+        if (bits & ((UINT64_C(1) << 42) - 1))
+            return false;
+    }
+    return true;
+}
+
 /* The stages after the box filter. */
 static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const mci_point *r,
                                  int axis)
@@ -792,8 +806,19 @@ static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const m
         exact_in_projection(r, axis))
         return orient2d_exact_centres(p, q, r, axis);
     s = mci_orient2d_projected_filtered(p, q, r, axis);
-    if (s == MCI_UNCERTAIN)
-        s = mci_orient2d_projected_dd(p, q, r, axis);
+    if (s != MCI_UNCERTAIN)
+        return s;
+    /* Inputs that fit 128-bit integers (short coordinates: CAD grids) skip the
+     * double-double stage: the exact one is cheaper there, and only it decides the exact
+     * zeros such inputs are full of. The scale is worth computing for that only when
+     * the points' base vertices have short coordinates. */
+    if (short_base(p) && short_base(q) && short_base(r)) {
+        const mci_point *points[3] = {p, q, r};
+        input_scale sc = scale_of(points, 3, NULL, 0);
+        if (fits_i128(sc, x_degree(p) + x_degree(q) + x_degree(r)))
+            return i128_orient2d(points, axis, sc.e0);
+    }
+    s = mci_orient2d_projected_dd(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 
