@@ -174,6 +174,16 @@ static i128 i128_from_double(double x, int e0)
     u128 magnitude;
     if (x == 0)
         return 0;
+    /* x 2^-e0 is an integer (e0 is at most x's lowest bit exponent); multiplying by a
+     * normal power of two is exact, and so is the conversion below 2^63. */
+    if (e0 >= -1023 && e0 <= 1022) {
+        uint64_t bits = (uint64_t)(1023 - e0) << 52;
+        double scale, scaled;
+        memcpy(&scale, &bits, sizeof scale);
+        scaled = x * scale;
+        if (scaled > -0x1p63 && scaled < 0x1p63)
+            return (i128)(int64_t)scaled;
+    }
     mci_split_double(x, &m, &e);
     magnitude = (u128)m << (e - e0);
     return x < 0 ? -(i128)magnitude : (i128)magnitude;
