@@ -196,7 +196,7 @@ def references(shared):
 STEPS = {  # the paper's steps: 1 octree, 2 intersection, 3 classification
     1: ('octree',),
     2: ('candidate pairs', 'intersect', 'arrange faces', 'number points'),
-    3: ('triangulate', 'classify', 'assemble'),
+    3: ('whole faces', 'triangulate', 'classify', 'assemble'),
 }
 
 
@@ -321,7 +321,7 @@ def main():
         'Whole process (`meshcsg eval tree.scad -o result.off --stats`: parse the leaves, '
         'evaluate, write OFF), median of %d runs; steps as in the paper\'s Table 1: step 1 '
         'octree, step 2 candidate pairs + intersection + per-face arrangement + point '
-        'numbering, step 3 triangulation + classification + assembly; "check + I/O" is the '
+        'numbering, step 3 whole-face decisions + triangulation + classification + assembly; "check + I/O" is the '
         'rest (input contract check, parsing, writing). Peak memory is the process\'s peak '
         'RSS on one thread.' % runs,
         '',

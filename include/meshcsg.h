@@ -422,6 +422,8 @@ typedef struct mcsg_eval_stats {
     size_t rays;              /* exact ray tests for first seeds (paper §5.5) */
     size_t local_tests;       /* exact label changes across intersection curves */
     size_t rejected_primitives; /* dropped whole by their first trimmed CSGlist (§5.3) */
+    size_t faces_dropped_whole; /* touched faces dropped whole by their labels with respect
+                                   to the leaves they do not meet, before being split */
     size_t output_vertices, output_triangles;
     size_t rounding_dropped_triangles; /* collapsed (two corners joined) or folded onto an
                                           opposite twin when distinct exact vertices that
@@ -435,6 +437,7 @@ typedef struct mcsg_eval_stats {
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */
+    double seconds_whole_faces; /* deciding faces dropped whole (in intersect's span) */
     double seconds_triangulate; /* tessellating the split faces */
     double seconds_classify;    /* regions, labels and selection */
     double seconds_assemble;    /* welding and rounding the output */

@@ -312,7 +312,7 @@ static uint32_t coord_lookup(coord_table *t, const double *x, uint32_t fresh)
     return fresh;
 }
 
-static void leaf_box(const mcsg_mesh *m, double box[6])
+void mci_leaf_box(const mcsg_mesh *m, double box[6])
 {
     for (int k = 0; k < 3; k++) {
         box[k] = m->vertex_count ? m->vertices[k] : 0;
@@ -377,7 +377,7 @@ mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
         return mci_fail_nomem(err, "classifying faces");
     }
     for (size_t l = 0; l < scene->octree.leaf_count; l++)
-        leaf_box(scene->octree.leaves[l], cl->box[l]);
+        mci_leaf_box(scene->octree.leaves[l], cl->box[l]);
     return MCSG_OK;
 }
 
@@ -413,6 +413,8 @@ typedef struct leaf_work {
     uint8_t *is_sep;  /* per edge slot */
     mci_keyed *sep;       /* separators: (edge key, face of another leaf holding it), sorted */
     size_t nsep;
+    mci_keyed *walls;     /* border sides of the leaf's faces dropped whole, sorted */
+    size_t nwalls;
     uint32_t *region; /* per piece */
     size_t nreg;
     uint32_t *reg_start, *reg_pieces; /* pieces by region (CSR) */
@@ -435,7 +437,7 @@ typedef struct leaf_work {
 
 static void free_work(leaf_work *w)
 {
-    void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->region,
+    void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->walls, w->region,
                    w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
                    w->slot_of_leaf, w->labels, w->needed, w->list, w->scratch,
                    w->leaf_labels};
@@ -544,6 +546,65 @@ static size_t pair_inside_faces(leaf_work *w)
     return left;
 }
 
+/* Whether the arrangement of face f was dropped whole (no pieces). */
+static bool dropped_whole(const mci_scene *s, uint32_t f)
+{
+    return s->arr_dropped && s->arr_of[f] != MCI_NONE && s->arr_dropped[s->arr_of[f]];
+}
+
+/* Appends the keys of the sides along edge e of arrangement arr (global ids gid): its
+ * points on that edge in order from corner e to corner e + 1. After a merge the points
+ * past the corners are in lexicographic order, which on a line is the order along it. */
+static void add_edge_sides(const mci_face_arr *arr, const uint32_t *gid, int e, mci_keyed *out,
+                           size_t *n)
+{
+    int a = e, b = (e + 1) % 3;
+    bool ascending = mci_compare_lex(&arr->points[a], &arr->points[b]) < 0;
+    uint32_t prev = (uint32_t)a;
+    for (size_t k = 3; k < arr->point_count; k++) {
+        size_t i = ascending ? k : arr->point_count + 2 - k;
+        if (arr->where[i] != MCI_AT_EDGE + e)
+            continue;
+        out[(*n)++] = (mci_keyed){mci_edge_key(gid[prev], gid[i]), 0};
+        prev = (uint32_t)i;
+    }
+    out[(*n)++] = (mci_keyed){mci_edge_key(gid[prev], gid[b]), 0};
+}
+
+/* Pieces next to a face dropped whole have no piece across their side there: those
+ * sides are walls (no region crosses them), known by their keys. */
+static mcsg_status collect_walls(leaf_work *w)
+{
+    const mci_scene *s = w->s;
+    size_t n = 0;
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++)
+        n += dropped_whole(s, f) ? arr_of_face(s, f)->point_count + 3 : 0;
+    if (n == 0)
+        return MCSG_OK;
+    w->walls = mci_malloc_array(w->ctx, n, sizeof *w->walls);
+    if (!w->walls)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++) {
+        const mci_face_arr *arr = arr_of_face(s, f);
+        if (!dropped_whole(s, f))
+            continue;
+        for (int e = 0; e < 3; e++)
+            add_edge_sides(arr, s->gid + s->gid_start[s->arr_of[f]], e, w->walls, &w->nwalls);
+    }
+    mci_sort_keyed(w->walls, w->nwalls);
+    return MCSG_OK;
+}
+
+/* A side with no opposite piece: a wall (marked as a separator without a mate) when it
+ * borders a face dropped whole, else the leaf does not close up. */
+static bool is_wall(leaf_work *w, size_t slot, uint64_t key)
+{
+    if (mci_find_key(w->walls, w->nwalls, key) == w->nwalls)
+        return false;
+    w->is_sep[slot] = 1;
+    return true;
+}
+
 /* Pair every directed piece edge with its opposite; a closed, consistently oriented
  * edge-manifold surface has exactly one. Sides on face borders are sorted by edge key
  * and walked along the sorted separators (collect_separators), which marks the
@@ -571,6 +632,10 @@ static mcsg_status pair_edges(leaf_work *w)
         size_t j = i;
         while (j < n && e[j].key == e[i].key)
             j++;
+        if (j - i == 1 && is_wall(w, e[i].ref, e[i].key)) {
+            i = j;
+            continue;
+        }
         if (j - i != 2 || slot_from(w, e[i].ref) != slot_to(w, e[i + 1].ref))
             st = mci_fail(w->err, MCSG_ERR_INTERNAL,
                           "leaf %u does not close up after splitting: an edge is shared by "
@@ -840,8 +905,12 @@ static void fill_unknown_labels(leaf_work *w)
             for (size_t c = 0; c < w->ncand; c++) {
                 for (uint32_t i = w->sep_start[r];
                      w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN && i < w->sep_start[r + 1]; i++) {
-                    uint32_t k = w->sep_slots[i], r2 = w->region[w->mate[k] / 3];
-                    uint8_t there = w->labels[(size_t)r2 * w->ncand + c];
+                    uint32_t k = w->sep_slots[i], r2;
+                    uint8_t there;
+                    if (w->mate[k] == MCI_NONE)
+                        continue; /* a wall */
+                    r2 = w->region[w->mate[k] / 3];
+                    there = w->labels[(size_t)r2 * w->ncand + c];
                     if (there != MCI_LABEL_UNKNOWN && !separator_on_leaf(w, k, w->cand[c])) {
                         lab[c] = there;
                         changed = true;
@@ -872,9 +941,9 @@ static mcsg_status label_regions(leaf_work *w)
         while (head < tail) {
             uint32_t r1 = queue[head++];
             for (uint32_t i = w->sep_start[r1]; i < w->sep_start[r1 + 1]; i++) {
-                uint32_t k = w->mate[w->sep_slots[i]], r2 = w->region[k / 3];
-                if (seen[r2])
-                    continue;
+                uint32_t k = w->mate[w->sep_slots[i]], r2;
+                if (k == MCI_NONE || seen[r2 = w->region[k / 3]])
+                    continue; /* a wall, or seen */
                 inherit_labels(w, r1, r2, k);
                 seen[r2] = 1;
                 queue[tail++] = r2;
@@ -970,7 +1039,6 @@ static mcsg_status trim_csglist(leaf_work *w)
 {
     const mci_ptree *t = w->cl->tree;
     int32_t *cover = mci_calloc_array(w->ctx, t->node_count + 2, sizeof *cover);
-    size_t kept = 0;
     w->list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->list);
     w->scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->scratch);
     w->leaf_labels = mci_malloc_array(w->ctx, t->leaf_count + 1, sizeof *w->leaf_labels);
@@ -983,19 +1051,12 @@ static mcsg_status trim_csglist(leaf_work *w)
         w->leaf_labels[l] = MCI_LABEL_OUT;
     for (size_t c = 0; c < w->ncand; c++)
         w->leaf_labels[w->cand[c]] = MCI_LABEL_UNKNOWN;
-    w->nlist = mci_csglist(t, w->leaf, w->list);
+    w->nlist = mci_csglist_trim(t, w->leaf, w->leaf_labels, w->scratch, w->list, &w->rejected);
     for (size_t i = 0; i < w->nlist && !w->rejected; i++) {
-        const mci_csg_entry *e = &w->list[i];
-        mci_label l = mci_ptree_eval(t, e->node, w->leaf_labels, w->scratch);
-        if (l == MCI_LABEL_UNKNOWN) {
-            w->list[kept++] = *e;
-            cover[e->node + 1 - t->nodes[e->node].size]++;
-            cover[e->node + 1]--;
-        } else if (!(e->desired & MCI_LABEL_BIT(l))) {
-            w->rejected = true;
-        }
+        uint32_t node = w->list[i].node;
+        cover[node + 1 - t->nodes[node].size]++;
+        cover[node + 1]--;
     }
-    w->nlist = kept;
     for (size_t n = 1; n <= t->node_count; n++)
         cover[n] += cover[n - 1];
     for (size_t c = 0; c < w->ncand; c++)
@@ -1052,6 +1113,8 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
     st = make_pieces(&w);
     if (st == MCSG_OK)
         st = collect_separators(&w);
+    if (st == MCSG_OK)
+        st = collect_walls(&w);
     if (st == MCSG_OK)
         st = pair_edges(&w);
     if (st == MCSG_OK)

@@ -36,6 +36,9 @@ typedef struct mci_classifier {
     double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
 } mci_classifier;
 
+/* The bounding box of a mesh's vertices: lo[3], hi[3] (zeros for an empty mesh). */
+void mci_leaf_box(const mcsg_mesh *m, double box[6]);
+
 mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err);
 void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl);

@@ -95,6 +95,14 @@ size_t mci_csglist(const mci_ptree *t, uint32_t leaf, mci_csg_entry *out);
 int mci_csglist_accepts(const mci_ptree *t, const mci_csg_entry *list, size_t n,
                         const mci_label *leaf_labels, mci_label *scratch);
 
+/* The CSGlist of `leaf` trimmed by labels known for all its faces (leaf_labels: IN or
+ * OUT where known, UNKNOWN elsewhere): writes into list (room for node_count entries)
+ * the entries still undecided and returns their number; *rejected when a decided entry
+ * has an undesired label, i.e. no face of the leaf belongs to the result. scratch holds
+ * node_count labels. */
+size_t mci_csglist_trim(const mci_ptree *t, uint32_t leaf, const mci_label *leaf_labels,
+                        mci_label *scratch, mci_csg_entry *list, bool *rejected);
+
 /* Blist (Hable and Rossignac; paper §5.4): a trimmed CSGlist compiled into a walk over
  * its undecided primitives. Each step reads one primitive's label and jumps to the next
  * step (or accepts, or rejects) on IN or OUT, so a region is decided after reading a few
@@ -125,5 +133,10 @@ void mci_blist_free(const mci_ctx *ctx, mci_blist *b);
 /* 1 if the face is kept, 0 if not, -1 if a label read is neither IN nor OUT (then ask
  * mci_csglist_accepts). */
 int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels);
+
+/* With some labels UNKNOWN (the others IN or OUT): false when the face is dropped
+ * whatever the unknown labels are, true when some of their values would keep it.
+ * scratch holds b->count bytes. */
+bool mci_blist_may_accept(const mci_blist *b, const mci_label *leaf_labels, uint8_t *scratch);
 
 #endif

@@ -9,6 +9,7 @@
 #include "leaf_check.h"
 #include "manifold_split.h"
 #include "rounding_repair.h"
+#include "whole_faces.h"
 
 #include <string.h>
 
@@ -35,6 +36,8 @@ static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
 static mcsg_status triangulate_one(void *user, size_t k, mcsg_error *err)
 {
     eval_state *e = user;
+    if (e->scene.arr_dropped && e->scene.arr_dropped[k])
+        return MCSG_OK; /* dropped whole: no pieces */
     return mci_arr_triangulate(&e->ctx, &e->scene.arrs[k], NULL, err);
 }
 
@@ -355,10 +358,19 @@ static mcsg_status step(eval_state *e, const char *name, step_fn fn, mcsg_error 
     return st;
 }
 
+/* Faces that the result drops whole are found before splitting, which they then skip. */
 static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
-                                     e->tree.leaf_count, &e->scene, err);
+    mcsg_status st = mci_scene_build_unsplit(&e->ctx,
+                                             (const mcsg_mesh *const *)e->tree.leaf_mesh,
+                                             e->tree.leaf_count, &e->scene, err);
+    double t0 = mci_seconds_now();
+    if (st == MCSG_OK)
+        st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,
+                                    err);
+    e->stats.seconds_whole_faces = mci_seconds_now() - t0;
+    if (st == MCSG_OK)
+        st = mci_scene_split(&e->ctx, &e->scene, e->scene.arr_dropped, err);
     if (st == MCSG_OK)
         st = mci_scene_number_points(&e->ctx, &e->scene, err);
     e->stats.intersect = e->scene.stats;

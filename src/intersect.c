@@ -559,10 +559,62 @@ static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
                         j->start[f + 1] - j->start[f], j->ff, j->planes, &j->s->arrs[k], err);
 }
 
+/* Splitting runs after arranging and sharing, possibly skipping some faces. */
+typedef struct split_job {
+    const mci_ctx *ctx;
+    mci_scene *s;
+    const uint8_t *skip;
+} split_job;
+
 static mcsg_status split_one(void *user, size_t k, mcsg_error *err)
 {
-    const arrange_job *j = user;
-    return mci_arr_split(j->ctx, &j->s->arrs[k], err);
+    const split_job *j = user;
+    mci_face_arr *arr = &j->s->arrs[k];
+    if (j->skip && j->skip[k])
+        return arr->dirty ? mci_arr_merge(j->ctx, arr, err) : MCSG_OK;
+    return mci_arr_split(j->ctx, arr, err);
+}
+
+/* touch_start / touch_leaf from the hits (each face's list once per leaf, in hit
+ * order). */
+static bool record_touches(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
+                           const uint32_t *start, const uint32_t *list)
+{
+    size_t out = 0;
+    s->touch_start = mci_malloc_array(ctx, s->face_count + 1, sizeof *s->touch_start);
+    s->touch_leaf = mci_malloc_array(ctx, 2 * hits->count + 1, sizeof *s->touch_leaf);
+    if (!s->touch_start || !s->touch_leaf)
+        return false;
+    for (uint32_t f = 0; f < s->face_count; f++) {
+        size_t first = out;
+        s->touch_start[f] = (uint32_t)out;
+        for (uint32_t i = start[f]; i < start[f + 1]; i++) {
+            const pair_hit *h = &hits->v[list[i]];
+            uint32_t leaf = s->octree.face_leaf[h->f == f ? h->g : h->f];
+            size_t k = first;
+            while (k < out && s->touch_leaf[k] != leaf)
+                k++;
+            if (k == out)
+                s->touch_leaf[out++] = leaf;
+        }
+    }
+    s->touch_start[s->face_count] = (uint32_t)out;
+    {
+        /* Sized for two entries per hit; most faces meet one leaf several times. */
+        uint32_t *fit = mci_realloc_array(ctx, s->touch_leaf, out + 1, sizeof *fit);
+        if (!fit)
+            return false;
+        s->touch_leaf = fit;
+    }
+    return true;
+}
+
+bool mci_scene_face_touches(const mci_scene *s, uint32_t f, uint32_t m)
+{
+    for (uint32_t i = s->touch_start[f]; i < s->touch_start[f + 1]; i++)
+        if (s->touch_leaf[i] == m)
+            return true;
+    return false;
 }
 
 /* arr_of, arr_count and face_of (arrangement index -> face) from the hit index. */
@@ -601,7 +653,8 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
     arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes};
     mcsg_status st = MCSG_OK;
     if (!compute_face_facts(ctx, s, hits, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
-        !number_arranged_faces(ctx, s, start, &face_of))
+        !number_arranged_faces(ctx, s, start, &face_of) ||
+        !record_touches(ctx, s, hits, start, list))
         st = mci_fail_nomem(err, "arranging faces");
     job.start = start;
     job.list = list;
@@ -616,8 +669,16 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
     mci_free(ctx, face_of);
     if (st == MCSG_OK)
         st = share_edge_points(ctx, s, err);
-    if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, s->arr_count, split_one, &job, err);
+    return st;
+}
+
+mcsg_status mci_scene_split(const mci_ctx *ctx, mci_scene *s, const uint8_t *skip,
+                            mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    split_job job = {ctx, s, skip};
+    mcsg_status st = mci_parallel_for(ctx, s->arr_count, split_one, &job, err);
+    s->stats.seconds_arrange += mci_seconds_now() - t0;
     return st;
 }
 
@@ -655,6 +716,15 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
+    mcsg_status st = mci_scene_build_unsplit(ctx, leaves, leaf_count, scene, err);
+    if (st == MCSG_OK && (st = mci_scene_split(ctx, scene, NULL, err)) != MCSG_OK)
+        mci_scene_free(ctx, scene);
+    return st;
+}
+
+mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+                                    size_t leaf_count, mci_scene *scene, mcsg_error *err)
+{
     double t0 = mci_seconds_now();
     mcsg_status st;
     memset(scene, 0, sizeof *scene);
@@ -681,6 +751,9 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->neighbour);
     mci_free(ctx, scene->gid_start);
     mci_free(ctx, scene->gid);
+    mci_free(ctx, scene->touch_start);
+    mci_free(ctx, scene->touch_leaf);
+    mci_free(ctx, scene->arr_dropped);
     mci_octree_free(ctx, &scene->octree);
     memset(scene, 0, sizeof *scene);
 }

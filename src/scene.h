@@ -23,6 +23,13 @@ typedef struct mci_scene {
      * i of arrs[k]; equal points have equal numbers, across all faces. */
     uint32_t *gid_start, *gid;
     size_t point_count;
+    /* Per face, the leaves whose surface it meets: touch_leaf[touch_start[f] ..
+     * touch_start[f + 1]), from the pair tests (which report every contact, so a face
+     * whose list lacks a leaf does not meet that leaf's surface). */
+    uint32_t *touch_start, *touch_leaf;
+    /* Per arrangement: 1 when the face is dropped whole (mci_decide_whole_faces; NULL
+     * before): it is not split nor tessellated, and has no pieces. */
+    uint8_t *arr_dropped;
     mcsg_intersect_stats stats;
 } mci_scene;
 
@@ -31,6 +38,18 @@ typedef struct mci_scene {
  * for the edge sharing to be complete. */
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err);
+
+/* mci_scene_build in two steps: everything but the splitting, then the splitting of
+ * the arrangements k without skip[k] (skip may be NULL); skipped ones are only merged,
+ * so that their points and locations are final (their faces will not be tessellated
+ * with their constraints: see mci_decide_whole_faces). */
+mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+                                    size_t leaf_count, mci_scene *scene, mcsg_error *err);
+mcsg_status mci_scene_split(const mci_ctx *ctx, mci_scene *scene, const uint8_t *skip,
+                            mcsg_error *err);
+
+/* Whether face f meets the surface of leaf m (see touch_start). */
+bool mci_scene_face_touches(const mci_scene *scene, uint32_t f, uint32_t m);
 
 /* Number all arrangement points by exact identity (fills gid_start, gid, point_count). */
 mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *scene, mcsg_error *err);

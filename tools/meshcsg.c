@@ -614,6 +614,8 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  intersect        %8.3f s  (%zu crossing, %zu coplanar pairs)\n",
            x->seconds_intersect, x->intersecting_pairs, x->coplanar_pairs);
     printf("  arrange faces    %8.3f s  (%zu faces)\n", x->seconds_arrange, x->arranged_faces);
+    printf("  whole faces      %8.3f s  (%zu touched faces dropped whole)\n",
+           s->seconds_whole_faces, s->faces_dropped_whole);
     printf("  number points    %8.3f s\n", x->seconds_merge);
     printf("  triangulate      %8.3f s  (%zu pieces)\n", s->seconds_triangulate, s->pieces);
     printf("  classify         %8.3f s  (%zu regions, %zu rays, %zu local tests, "

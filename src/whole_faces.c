@@ -1,0 +1,316 @@
+/*
+ * Faces dropped whole, decided before they are split (paper §5.2-5.3: the second trimmed
+ * tree of a group of faces decides it without sub-face work).
+ *
+ * A touched face meets the surfaces of a few leaves only (mci_scene's touch lists: the
+ * pair tests report every contact). With respect to any other leaf M the face lies wholly
+ * inside or wholly outside, and so does every face of its leaf connected to it through
+ * faces that do not meet M either (their union is connected and misses M's surface).
+ * Those labels alone often decide the face: buried in a leaf that a union adds, or
+ * outside one that an intersection keeps, it is dropped whatever the leaves crossing it
+ * say. Such a face needs no splitting, no tessellation with its constraints, and no
+ * classification of its pieces: on ring + 800 spheres, 44K of 92K touched faces.
+ *
+ * For a leaf P and each leaf M that P's trimmed CSGlist reads (mci_blist), the faces of
+ * P that do not meet M are joined by their shared vertices (union-find on vertex
+ * indices); a group is OUT when one of its vertices lies outside M's bounding box, and
+ * otherwise takes the label of an exact ray from one of its vertices (none lies on M's
+ * surface). A face is dropped when no value of its unknown labels (those of the leaves
+ * it meets) would keep it (mci_blist_may_accept). Everything is exact; a face that is not
+ * decided here goes through the whole classification as before.
+ */
+#include "whole_faces.h"
+#include "classify.h"
+
+#include <string.h>
+
+typedef struct decide_job {
+    const mci_ctx *ctx;
+    mci_scene *s;
+    const mci_ptree *t;
+    const double (*box)[6]; /* per leaf */
+    size_t *dropped;        /* per leaf: faces flagged */
+} decide_job;
+
+/* One leaf's decision. Vertex arrays are indexed by the leaf mesh's vertex index. */
+typedef struct leaf_decision {
+    const decide_job *j;
+    uint32_t leaf, face_base;
+    const mcsg_mesh *m;
+    uint32_t *faces;         /* the leaf's touched faces (global ids) ... */
+    size_t nfaces;
+    uint8_t *labels;         /* ... and their labels: nfaces x nreads */
+    mci_csg_entry *list;
+    mci_label *leaf_labels, *scratch;
+    mci_blist blist;
+    uint32_t *reads;         /* the distinct leaves the blist reads */
+    size_t nreads;
+    double (*face_box)[6];   /* per face of the leaf */
+    uint32_t *vf_start, *vf_face; /* faces around each vertex (CSR) */
+    uint32_t *seen;          /* per face: the last search that reached it */
+    uint32_t *labelled;      /* per face: the leaf read (r + 1) its group_label is for */
+    uint8_t *group_label;
+    uint32_t *queue, search;
+    uint8_t *step_scratch;
+    mci_ray_scratch ray;
+} leaf_decision;
+
+static bool boxes_meet(const double a[6], const double b[6])
+{
+    for (int k = 0; k < 3; k++)
+        if (a[3 + k] < b[k] || b[3 + k] < a[k])
+            return false;
+    return true;
+}
+
+static void triangle_box(const mcsg_mesh *m, const uint32_t *tri, double box[6])
+{
+    for (int k = 0; k < 3; k++) {
+        double a = m->vertices[3 * (size_t)tri[0] + k], b = m->vertices[3 * (size_t)tri[1] + k],
+               c = m->vertices[3 * (size_t)tri[2] + k];
+        box[k] = a < b ? (a < c ? a : c) : (b < c ? b : c);
+        box[3 + k] = a > b ? (a > c ? a : c) : (b > c ? b : c);
+    }
+}
+
+/* Strictly outside the closed box: outside the leaf it bounds. */
+static bool outside_box(const double *x, const double box[6])
+{
+    for (int k = 0; k < 3; k++)
+        if (x[k] < box[k] || x[k] > box[3 + k])
+            return true;
+    return false;
+}
+
+static void free_decision(leaf_decision *d)
+{
+    const mci_ctx *ctx = d->j->ctx;
+    void *all[] = {d->faces, d->labels, d->list, d->leaf_labels, d->scratch, d->reads,
+                   d->face_box, d->vf_start, d->vf_face, d->seen, d->labelled, d->group_label,
+                   d->queue, d->step_scratch};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        mci_free(ctx, all[i]);
+    mci_blist_free(ctx, &d->blist);
+    mci_ray_scratch_free(ctx, &d->ray);
+}
+
+/* The trimmed CSGlist of the leaf (every leaf whose box misses the leaf's is OUT), its
+ * blist and the leaves it reads. False when out of memory. */
+static bool trim_list(leaf_decision *d, bool *rejected)
+{
+    const mci_ptree *t = d->j->t;
+    const double (*box)[6] = d->j->box;
+    size_t nlist;
+    d->list = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->list);
+    d->scratch = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->scratch);
+    d->leaf_labels = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
+    d->reads = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->reads);
+    if (!d->list || !d->scratch || !d->leaf_labels || !d->reads)
+        return false;
+    for (uint32_t l = 0; l < t->leaf_count; l++)
+        d->leaf_labels[l] = l != d->leaf && boxes_meet(box[l], box[d->leaf]) ? MCI_LABEL_UNKNOWN
+                                                                            : MCI_LABEL_OUT;
+    nlist = mci_csglist_trim(t, d->leaf, d->leaf_labels, d->scratch, d->list, rejected);
+    if (*rejected)
+        return true;
+    if (!mci_blist_build(d->j->ctx, t, d->list, nlist, d->leaf_labels, &d->blist))
+        return false;
+    /* The distinct leaves of the steps, found with a mark per leaf (in step_scratch,
+     * which is large enough and free until the faces are tested). */
+    d->step_scratch = mci_calloc_array(d->j->ctx, t->leaf_count + d->blist.count + 1, 1);
+    if (!d->step_scratch)
+        return false;
+    for (size_t k = 0; k < d->blist.count; k++) {
+        uint32_t l = d->blist.steps[k].leaf;
+        if (!d->step_scratch[l]) {
+            d->step_scratch[l] = 1;
+            d->reads[d->nreads++] = l;
+        }
+    }
+    return true;
+}
+
+/* Faces around each vertex of the leaf mesh (CSR), for the searches below. */
+static bool index_vertex_faces(leaf_decision *d)
+{
+    const mcsg_mesh *m = d->m;
+    size_t nt = m->triangle_count;
+    d->vf_start = mci_calloc_array(d->j->ctx, m->vertex_count + 2, sizeof *d->vf_start);
+    d->vf_face = mci_malloc_array(d->j->ctx, 3 * nt + 1, sizeof *d->vf_face);
+    if (!d->vf_start || !d->vf_face)
+        return false;
+    for (size_t i = 0; i < 3 * nt; i++)
+        d->vf_start[m->triangles[i] + 2]++;
+    for (size_t v = 2; v < m->vertex_count + 2; v++)
+        d->vf_start[v] += d->vf_start[v - 1];
+    for (size_t i = 0; i < 3 * nt; i++)
+        d->vf_face[d->vf_start[m->triangles[i] + 1]++] = (uint32_t)(i / 3);
+    return true;
+}
+
+/* Whether face f (local) has a vertex outside leaf m's box: then f, and every face
+ * joined to it through faces that do not meet m, is outside m. */
+static bool reaches_outside(const leaf_decision *d, uint32_t f, const double mbox[6])
+{
+    const uint32_t *tri = d->m->triangles + 3 * (size_t)f;
+    for (int i = 0; i < 3; i++)
+        if (outside_box(d->m->vertices + 3 * (size_t)tri[i], mbox))
+            return true;
+    return false;
+}
+
+/* The label of local face f (which does not meet leaf m) with respect to m: a search
+ * over the faces joined to it by shared vertices, through faces that do not meet m,
+ * stops at the first one reaching outside m's box (OUT); a group wholly inside the box
+ * takes the label of a ray from one of its vertices (none lies on m's surface). Every
+ * face the search reaches gets the same label, so later faces of the group are free. */
+static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
+{
+    uint32_t m = d->reads[r];
+    const double *mbox = d->j->box[m];
+    size_t head = 0, tail = 0;
+    uint8_t result = MCI_LABEL_UNKNOWN;
+    if (d->labelled[f] == r + 1) {
+        *label = d->group_label[f];
+        return true;
+    }
+    d->search++; /* a fresh search: its marks are new */
+    d->seen[f] = d->search;
+    d->queue[tail++] = f;
+    while (head < tail && result == MCI_LABEL_UNKNOWN) {
+        uint32_t g = d->queue[head++];
+        const uint32_t *tri = d->m->triangles + 3 * (size_t)g;
+        if (reaches_outside(d, g, mbox)) {
+            result = MCI_LABEL_OUT;
+            break;
+        }
+        for (int i = 0; i < 3; i++)
+            for (uint32_t k = d->vf_start[tri[i]]; k < d->vf_start[tri[i] + 1]; k++) {
+                uint32_t h = d->vf_face[k];
+                if (d->seen[h] == d->search ||
+                    mci_scene_face_touches(d->j->s, d->face_base + h, m))
+                    continue;
+                d->seen[h] = d->search;
+                d->queue[tail++] = h;
+            }
+    }
+    if (result == MCI_LABEL_UNKNOWN) {
+        mci_point p;
+        mci_label l;
+        mci_point_explicit(&p, d->m->vertices + 3 * (size_t)d->m->triangles[3 * (size_t)f]);
+        if (!mci_ray_label_octree(d->j->ctx, &p, &d->j->s->octree, m, &d->ray, &l))
+            return false;
+        result = (uint8_t)l; /* UNKNOWN only on m's surface, which f does not meet */
+    }
+    for (size_t i = 0; i < tail; i++) {
+        d->group_label[d->queue[i]] = result;
+        d->labelled[d->queue[i]] = (uint32_t)r + 1;
+    }
+    *label = result;
+    return true;
+}
+
+/* labels[i][r] for every touched face i and read leaf r it does not meet: OUT when its
+ * box misses r's, else its group's. */
+static bool label_faces(leaf_decision *d)
+{
+    for (size_t r = 0; r < d->nreads; r++) {
+        uint32_t m = d->reads[r];
+        for (size_t i = 0; i < d->nfaces; i++) {
+            uint8_t *label = &d->labels[i * d->nreads + r];
+            uint32_t local = d->faces[i] - d->face_base;
+            *label = MCI_LABEL_UNKNOWN;
+            if (!boxes_meet(d->face_box[local], d->j->box[m]))
+                *label = MCI_LABEL_OUT; /* it is outside the box that holds m */
+            else if (!mci_scene_face_touches(d->j->s, d->faces[i], m) &&
+                     !group_label(d, local, r, label))
+                return false;
+        }
+    }
+    return true;
+}
+
+/* Flag the touched faces whose known labels reject them. */
+static size_t flag_dropped(leaf_decision *d)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < d->nfaces; i++) {
+        for (size_t r = 0; r < d->nreads; r++)
+            d->leaf_labels[d->reads[r]] = (mci_label)d->labels[i * d->nreads + r];
+        if (!mci_blist_may_accept(&d->blist, d->leaf_labels, d->step_scratch)) {
+            d->j->s->arr_dropped[d->j->s->arr_of[d->faces[i]]] = 1;
+            n++;
+        }
+    }
+    return n;
+}
+
+static bool collect_faces(leaf_decision *d)
+{
+    const mci_scene *s = d->j->s;
+    d->faces = mci_malloc_array(d->j->ctx, d->m->triangle_count + 1, sizeof *d->faces);
+    if (!d->faces)
+        return false;
+    for (uint32_t f = 0; f < d->m->triangle_count; f++)
+        if (s->arr_of[d->face_base + f] != MCI_NONE)
+            d->faces[d->nfaces++] = d->face_base + f;
+    return true;
+}
+
+static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
+{
+    const decide_job *j = user;
+    leaf_decision d;
+    bool rejected = false, ok;
+    memset(&d, 0, sizeof d);
+    d.j = j;
+    d.leaf = (uint32_t)leaf;
+    d.face_base = j->s->octree.face_base[leaf];
+    d.m = j->s->octree.leaves[leaf];
+    ok = collect_faces(&d) && (d.nfaces == 0 || trim_list(&d, &rejected));
+    if (ok && rejected) {
+        for (size_t i = 0; i < d.nfaces; i++)
+            j->s->arr_dropped[j->s->arr_of[d.faces[i]]] = 1;
+        j->dropped[leaf] = d.nfaces;
+    } else if (ok && d.nfaces > 0 && d.nreads > 0) {
+        size_t nt = d.m->triangle_count + 1;
+        d.labels = mci_malloc_array(j->ctx, d.nfaces, d.nreads);
+        d.face_box = mci_malloc_array(j->ctx, nt, sizeof *d.face_box);
+        d.seen = mci_calloc_array(j->ctx, nt, sizeof *d.seen);
+        d.labelled = mci_calloc_array(j->ctx, nt, sizeof *d.labelled);
+        d.group_label = mci_malloc_array(j->ctx, nt, 1);
+        d.queue = mci_malloc_array(j->ctx, nt, sizeof *d.queue);
+        ok = d.labels && d.face_box && d.seen && d.labelled && d.group_label && d.queue &&
+             index_vertex_faces(&d);
+        for (size_t f = 0; ok && f < d.m->triangle_count; f++)
+            triangle_box(d.m, d.m->triangles + 3 * f, d.face_box[f]);
+        ok = ok && label_faces(&d);
+        if (ok)
+            j->dropped[leaf] = flag_dropped(&d);
+    }
+    free_decision(&d);
+    return ok ? MCSG_OK : mci_fail_nomem(err, "deciding whole faces");
+}
+
+mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_ptree *t,
+                                   size_t *count, mcsg_error *err)
+{
+    size_t n = s->octree.leaf_count;
+    double (*box)[6] = mci_malloc_array(ctx, n + 1, sizeof *box);
+    size_t *dropped = mci_calloc_array(ctx, n + 1, sizeof *dropped);
+    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped};
+    mcsg_status st = MCSG_OK;
+    *count = 0;
+    s->arr_dropped = mci_calloc_array(ctx, s->arr_count + 1, 1);
+    if (!box || !dropped || !s->arr_dropped)
+        st = mci_fail_nomem(err, "deciding whole faces");
+    for (size_t l = 0; st == MCSG_OK && l < n; l++)
+        mci_leaf_box(s->octree.leaves[l], box[l]);
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, n, decide_leaf, &job, err);
+    for (size_t l = 0; st == MCSG_OK && l < n; l++)
+        *count += dropped[l];
+    mci_free(ctx, box);
+    mci_free(ctx, dropped);
+    return st;
+}
