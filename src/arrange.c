@@ -298,10 +298,37 @@ static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t o
     }
 }
 
+static bool same_point(const double *a, const double *b)
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+/* Whether the three vertices are this face's corners (in any order). */
+static bool is_twin(const mci_face_arr *arr, const double *const v[3])
+{
+    for (int i = 0; i < 3; i++)
+        if (!same_point(v[i], corner(arr, 0)) && !same_point(v[i], corner(arr, 1)) &&
+            !same_point(v[i], corner(arr, 2)))
+            return false;
+    return !same_point(v[0], v[1]) && !same_point(v[1], v[2]) && !same_point(v[0], v[2]);
+}
+
 bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
                           const mci_plane *other_plane, const bool crease[3], uint32_t group)
 {
     const double *v[3] = {other_plane->a, other_plane->b, other_plane->c};
+    /* An identical face (identical operands): every edge lies along an edge of this face,
+     * so clipping would only add its two ends; the same points, without the tests. */
+    if (is_twin(arr, v)) {
+        for (int i = 0; i < 3; i++) {
+            mci_point a, b;
+            mci_point_explicit(&a, v[i]);
+            mci_point_explicit(&b, v[(i + 1) % 3]);
+            if (!mci_arr_add_point(ctx, arr, &a) || !mci_arr_add_point(ctx, arr, &b))
+                return false;
+        }
+        return true;
+    }
     for (int i = 0; i < 3; i++)
         if (!clip_coplanar_edge(ctx, arr, other, group, i, v[i], v[(i + 1) % 3], crease[i]))
             return false;
