@@ -424,6 +424,8 @@ typedef struct mcsg_eval_stats {
     size_t rejected_primitives; /* dropped whole by their first trimmed CSGlist (§5.3) */
     size_t faces_dropped_whole; /* touched faces dropped whole by their labels with respect
                                    to the leaves they do not meet, before being split */
+    size_t copied_primitives;   /* primitives that are the same mesh as an earlier one
+                                   (same arrays): the earlier one is evaluated for both */
     size_t output_vertices, output_triangles;
     size_t rounding_dropped_triangles; /* collapsed (two corners joined) or folded onto an
                                           opposite twin when distinct exact vertices that

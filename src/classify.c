@@ -365,6 +365,27 @@ static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
     return ok;
 }
 
+/* copy_start / copy_of from scene->alias (a counting sort). */
+static bool index_copies(const mci_ctx *ctx, mci_classifier *cl)
+{
+    const mci_scene *s = cl->scene;
+    size_t n = s->octree.leaf_count;
+    if (!s->alias)
+        return true;
+    cl->copy_start = mci_calloc_array(ctx, n + 2, sizeof *cl->copy_start);
+    cl->copy_of = mci_malloc_array(ctx, n + 1, sizeof *cl->copy_of);
+    if (!cl->copy_start || !cl->copy_of)
+        return false;
+    for (size_t l = 0; l < n; l++)
+        cl->copy_start[s->alias[l] + 2] += s->alias[l] != l;
+    for (size_t l = 2; l < n + 2; l++)
+        cl->copy_start[l] += cl->copy_start[l - 1];
+    for (uint32_t l = 0; l < n; l++)
+        if (s->alias[l] != l)
+            cl->copy_of[cl->copy_start[s->alias[l] + 1]++] = l;
+    return true;
+}
+
 mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err)
 {
@@ -372,7 +393,7 @@ mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
     cl->scene = scene;
     cl->tree = tree;
     cl->box = mci_malloc_array(ctx, scene->octree.leaf_count + 1, sizeof *cl->box);
-    if (!cl->box || !assign_vertex_ids(ctx, cl)) {
+    if (!cl->box || !assign_vertex_ids(ctx, cl) || !index_copies(ctx, cl)) {
         mci_classifier_free(ctx, cl);
         return mci_fail_nomem(err, "classifying faces");
     }
@@ -387,6 +408,8 @@ void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl)
     mci_free(ctx, cl->vertex_id);
     mci_free(ctx, cl->new_vertex);
     mci_free(ctx, cl->box);
+    mci_free(ctx, cl->copy_start);
+    mci_free(ctx, cl->copy_of);
     memset(cl, 0, sizeof *cl);
 }
 
@@ -431,6 +454,12 @@ typedef struct leaf_work {
     mci_ray_scratch ray;
     bool out_of_memory; /* set by a ray test that could not allocate */
     mci_label *scratch, *leaf_labels;
+    const uint32_t *copies; /* leaves that are copies of this one (see eval.c) ... */
+    size_t ncopies;
+    mci_csg_entry **copy_list; /* ... their trimmed CSGlists */
+    size_t *copy_nlist;
+    uint8_t *borrowed;    /* per candidate: a copy of another leaf, labelled as that one */
+    mci_kept *kept_all;   /* per leaf: the kept triangles (copies' too) */
     mci_classify_stats *stats;
     mcsg_error *err;
 } leaf_work;
@@ -443,6 +472,11 @@ static void free_work(leaf_work *w)
                    w->leaf_labels};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
+    for (size_t k = 0; w->copy_list && k < w->ncopies; k++)
+        mci_free(w->ctx, w->copy_list[k]);
+    mci_free(w->ctx, w->copy_list);
+    mci_free(w->ctx, w->copy_nlist);
+    mci_free(w->ctx, w->borrowed);
     mci_blist_free(w->ctx, &w->blist);
     mci_ray_scratch_free(w->ctx, &w->ray);
 }
@@ -984,17 +1018,25 @@ static bool push_triangle(const mci_ctx *ctx, mci_kept *kept, const uint32_t *v,
     return true;
 }
 
+/* Who takes kept pieces of this leaf's regions: the leaf itself, and each copy of it
+ * (with its own decisions, orientation, output list, and face ids offset by its place). */
+typedef struct owner {
+    const uint8_t *keep; /* per region */
+    bool reversed;
+    mci_kept *kept;
+    uint32_t face_offset;
+} owner;
+
 /* The kept triangles of arranged face f, whose pieces start at piece `first`, after
  * re-tessellating it with its valid constraints only. */
-static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first,
-                                      const uint8_t *keep, bool reversed, mci_kept *kept)
+static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first, const owner *o)
 {
     mci_face_arr *arr = &w->cl->scene->arrs[w->s->arr_of[f]];
     const uint32_t *gid = w->s->gid + w->s->gid_start[w->s->arr_of[f]];
     uint8_t *piece_keep = mci_malloc_array(w->ctx, arr->tri_count + 1, 1), *tri_keep = NULL;
     mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
     for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
-        piece_keep[i] = keep[w->region[first + i]];
+        piece_keep[i] = o->keep[w->region[first + i]];
     if (st == MCSG_OK)
         st = mci_arr_retessellate(w->ctx, arr, piece_keep, &tri_keep, w->err);
     for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
@@ -1003,7 +1045,7 @@ static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first,
             continue;
         for (int i = 0; i < 3; i++)
             v[i] = gid[arr->tris[3 * t + i]];
-        if (!push_triangle(w->ctx, kept, v, reversed, f))
+        if (!push_triangle(w->ctx, o->kept, v, o->reversed, f + o->face_offset))
             st = mci_fail_nomem(w->err, "classifying faces");
     }
     mci_free(w->ctx, piece_keep);
@@ -1011,7 +1053,40 @@ static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first,
     return st;
 }
 
-static mcsg_status emit_kept(leaf_work *w, const uint8_t *keep, bool reversed, mci_kept *kept)
+/* A face whose pieces go to several owners (a leaf and a copy of it, each keeping a
+ * part): each takes its pieces as tessellated with all constraints (re-tessellating for
+ * one would change the pieces of the other). */
+static mcsg_status emit_shared_face(leaf_work *w, uint32_t f, size_t first,
+                                    const owner *owners, size_t n)
+{
+    const mci_face_arr *arr = arr_of_face(w->s, f);
+    for (size_t k = 0; k < n; k++)
+        for (size_t p = first; p < first + arr->tri_count; p++)
+            if (owners[k].keep[w->region[p]] &&
+                !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
+                               f + owners[k].face_offset))
+                return mci_fail_nomem(w->err, "classifying faces");
+    return MCSG_OK;
+}
+
+/* The owner keeping pieces of the face [first, first + count), the number of such owners
+ * in *n. */
+static const owner *face_owner(const leaf_work *w, size_t first, size_t count,
+                               const owner *owners, size_t n_owners, size_t *n)
+{
+    const owner *found = NULL;
+    *n = 0;
+    for (size_t k = 0; k < n_owners; k++)
+        for (size_t p = first; p < first + count; p++)
+            if (owners[k].keep[w->region[p]]) {
+                found = &owners[k];
+                ++*n;
+                break;
+            }
+    return found;
+}
+
+static mcsg_status emit_kept(leaf_work *w, const owner *owners, size_t n_owners)
 {
     mcsg_status st = MCSG_OK;
     size_t p = 0;
@@ -1019,16 +1094,123 @@ static mcsg_status emit_kept(leaf_work *w, const uint8_t *keep, bool reversed, m
         uint32_t f = w->pface[p];
         const mci_face_arr *arr = arr_of_face(w->s, f);
         if (arr) {
-            size_t n = arr->tri_count;
-            st = emit_arranged_face(w, f, p, keep, reversed, kept);
+            size_t n = arr->tri_count, takers;
+            const owner *o = face_owner(w, p, n, owners, n_owners, &takers);
+            if (takers == 1)
+                st = emit_arranged_face(w, f, p, o);
+            else if (takers > 1)
+                st = emit_shared_face(w, f, p, owners, n_owners);
             p += n;
             continue;
         }
-        if (keep[w->region[p]] && !push_triangle(w->ctx, kept, w->pv + 3 * p, reversed, f))
-            st = mci_fail_nomem(w->err, "classifying faces");
+        for (size_t k = 0; k < n_owners && st == MCSG_OK; k++)
+            if (owners[k].keep[w->region[p]] &&
+                !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
+                               f + owners[k].face_offset))
+                st = mci_fail_nomem(w->err, "classifying faces");
         p++;
     }
     return st;
+}
+
+/* Adds +1 over the node range of each entry's subtree to the difference array cover. */
+static void cover_entries(const mci_ptree *t, const mci_csg_entry *list, size_t n,
+                          int32_t *cover)
+{
+    for (size_t i = 0; i < n; i++) {
+        uint32_t node = list[i].node;
+        cover[node + 1 - t->nodes[node].size]++;
+        cover[node + 1]--;
+    }
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Copies: leaves that are the same mesh as this one                                   */
+
+/* A copy B of this leaf P has P's pieces and regions; its labels are P's, with P's
+ * own label SAME (the faces coincide, with the same orientation). P's classification
+ * therefore also decides B's output, with B's CSGlist. And in P's labels, a candidate
+ * that is a copy of another leaf R borrows R's labels (it has no faces in the scene). */
+static uint32_t stand_in(const leaf_work *w, uint32_t m)
+{
+    return mci_scene_leaf_stand_in(w->s, m);
+}
+
+/* The copies of this leaf and their trimmed CSGlists (candidates: this leaf's, less the
+ * copy, plus this leaf), marked in cover as well. */
+static mcsg_status trim_copy_lists(leaf_work *w, int32_t *cover)
+{
+    const mci_ptree *t = w->cl->tree;
+    if (!w->cl->copy_start)
+        return MCSG_OK;
+    w->copies = w->cl->copy_of + w->cl->copy_start[w->leaf];
+    w->ncopies = w->cl->copy_start[w->leaf + 1] - w->cl->copy_start[w->leaf];
+    if (w->ncopies == 0)
+        return MCSG_OK;
+    w->copy_list = mci_calloc_array(w->ctx, w->ncopies, sizeof *w->copy_list);
+    w->copy_nlist = mci_calloc_array(w->ctx, w->ncopies, sizeof *w->copy_nlist);
+    if (!w->copy_list || !w->copy_nlist)
+        return MCSG_ERR_NOMEM;
+    for (size_t k = 0; k < w->ncopies; k++) {
+        uint32_t b = w->copies[k];
+        bool rejected;
+        if (!(w->copy_list[k] = mci_malloc_array(w->ctx, t->node_count + 1, sizeof **w->copy_list)))
+            return MCSG_ERR_NOMEM;
+        w->leaf_labels[b] = MCI_LABEL_OUT;
+        w->leaf_labels[w->leaf] = MCI_LABEL_UNKNOWN;
+        w->copy_nlist[k] = mci_csglist_trim(t, b, w->leaf_labels, w->scratch, w->copy_list[k],
+                                            &rejected);
+        w->leaf_labels[b] = MCI_LABEL_UNKNOWN;
+        w->leaf_labels[w->leaf] = MCI_LABEL_OUT;
+        if (rejected)
+            w->copy_nlist[k] = SIZE_MAX; /* none of its faces is kept */
+        else
+            cover_entries(t, w->copy_list[k], w->copy_nlist[k], cover);
+    }
+    return MCSG_OK;
+}
+
+/* Before labelling: copies of this leaf are SAME everywhere; a copy of another leaf is
+ * not labelled itself (it has no faces for rays or separators), that leaf is instead. */
+static mcsg_status prepare_copy_labels(leaf_work *w)
+{
+    if (!w->s->alias)
+        return MCSG_OK;
+    w->borrowed = mci_calloc_array(w->ctx, w->ncand + 1, 1);
+    if (!w->borrowed)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t c = 0; c < w->ncand; c++) {
+        uint32_t r = stand_in(w, w->cand[c]), rc;
+        if (r == w->cand[c])
+            continue;
+        if (r == w->leaf) {
+            for (size_t g = 0; g < w->nreg; g++)
+                w->labels[g * w->ncand + c] = MCI_LABEL_SAME;
+            continue;
+        }
+        rc = w->slot_of_leaf[r]; /* a candidate: its box is the copy's */
+        if (rc == MCI_NONE)
+            return mci_fail(w->err, MCSG_ERR_INTERNAL, "leaf %u: a copy's leaf is no "
+                            "candidate", w->leaf);
+        w->borrowed[c] = 1 + w->needed[c];
+        w->needed[rc] |= w->needed[c];
+        w->needed[c] = 0;
+    }
+    return MCSG_OK;
+}
+
+/* After labelling: a copy of another leaf takes that leaf's labels. */
+static void finish_copy_labels(leaf_work *w)
+{
+    for (size_t c = 0; w->borrowed && c < w->ncand; c++) {
+        size_t rc;
+        if (!w->borrowed[c])
+            continue;
+        rc = w->slot_of_leaf[stand_in(w, w->cand[c])];
+        for (size_t g = 0; g < w->nreg; g++)
+            w->labels[g * w->ncand + c] = w->labels[g * w->ncand + rc];
+        w->needed[c] = w->borrowed[c] - 1;
+    }
 }
 
 /* The first trimmed tree (paper §5.2, §5.3): every leaf whose box misses this leaf's is
@@ -1052,10 +1234,11 @@ static mcsg_status trim_csglist(leaf_work *w)
     for (size_t c = 0; c < w->ncand; c++)
         w->leaf_labels[w->cand[c]] = MCI_LABEL_UNKNOWN;
     w->nlist = mci_csglist_trim(t, w->leaf, w->leaf_labels, w->scratch, w->list, &w->rejected);
-    for (size_t i = 0; i < w->nlist && !w->rejected; i++) {
-        uint32_t node = w->list[i].node;
-        cover[node + 1 - t->nodes[node].size]++;
-        cover[node + 1]--;
+    if (!w->rejected)
+        cover_entries(t, w->list, w->nlist, cover);
+    if (trim_copy_lists(w, cover) != MCSG_OK) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
     }
     for (size_t n = 1; n <= t->node_count; n++)
         cover[n] += cover[n - 1];
@@ -1067,31 +1250,68 @@ static mcsg_status trim_csglist(leaf_work *w)
     return MCSG_OK;
 }
 
-/* Evaluate each region's CSGlist and output the pieces of the kept ones. */
-static mcsg_status select_pieces(leaf_work *w, mci_kept *kept)
+/* Labels of region r for the CSGlist of leaf `as` (this leaf or a copy of it): this
+ * leaf is SAME for a copy; reversed for a complemented leaf. */
+static void region_labels(leaf_work *w, size_t r, uint32_t as)
 {
     const mci_ptree *t = w->cl->tree;
-    bool reversed = t->nodes[t->leaf_node[w->leaf]].complement;
-    uint8_t *keep = mci_malloc_array(w->ctx, w->nreg + 1, 1);
-    mcsg_status st = MCSG_OK;
-    if (!keep)
-        return mci_fail_nomem(w->err, "classifying faces");
-    for (size_t r = 0; r < w->nreg && st == MCSG_OK; r++) {
-        const uint8_t *lab = w->labels + r * w->ncand;
-        int accepts;
-        for (size_t c = 0; c < w->ncand; c++)
-            w->leaf_labels[w->cand[c]] =
-                reversed ? mci_label_reverse((mci_label)lab[c]) : (mci_label)lab[c];
-        /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
-        accepts = mci_blist_accepts(&w->blist, w->leaf_labels);
-        if (accepts < 0)
-            accepts = mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch);
-        if (accepts < 0)
-            st = mci_fail(w->err, MCSG_ERR_INTERNAL,
-                          "leaf %u: a region's label could not be decided", w->leaf);
+    bool reversed = t->nodes[t->leaf_node[as]].complement;
+    const uint8_t *lab = w->labels + r * w->ncand;
+    for (size_t c = 0; c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = (mci_label)lab[c];
+    if (as != w->leaf)
+        w->leaf_labels[w->leaf] = MCI_LABEL_SAME;
+    for (size_t c = 0; reversed && c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = mci_label_reverse(w->leaf_labels[w->cand[c]]);
+    if (reversed && as != w->leaf)
+        w->leaf_labels[w->leaf] = mci_label_reverse(w->leaf_labels[w->leaf]);
+}
+
+/* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
+static mcsg_status decide_regions(leaf_work *w, size_t k, uint8_t *keep)
+{
+    const mci_ptree *t = w->cl->tree;
+    bool self = k == w->ncopies, rejected = self ? w->rejected : w->copy_nlist[k] == SIZE_MAX;
+    for (size_t r = 0; r < w->nreg; r++) {
+        int accepts = 0;
+        if (!rejected) {
+            region_labels(w, r, self ? w->leaf : w->copies[k]);
+            /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
+            accepts = self ? mci_blist_accepts(&w->blist, w->leaf_labels) : -1;
+            if (accepts < 0)
+                accepts = self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels,
+                                                     w->scratch)
+                               : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k],
+                                                     w->leaf_labels, w->scratch);
+            if (accepts < 0)
+                return mci_fail(w->err, MCSG_ERR_INTERNAL,
+                                "leaf %u: a region's label could not be decided", w->leaf);
+        }
         keep[r] = accepts == 1;
     }
-    st = st == MCSG_OK ? emit_kept(w, keep, reversed, kept) : st;
+    if (!self)
+        w->leaf_labels[w->leaf] = MCI_LABEL_OUT; /* as trimming left it */
+    return MCSG_OK;
+}
+
+/* Evaluate each region's CSGlist (this leaf's and its copies') and output the pieces of
+ * the kept ones. */
+static mcsg_status select_pieces(leaf_work *w)
+{
+    const mci_ptree *t = w->cl->tree;
+    size_t n = w->ncopies + 1;
+    owner *owners = mci_malloc_array(w->ctx, n, sizeof *owners);
+    uint8_t *keep = mci_malloc_array(w->ctx, n * (w->nreg + 1), 1);
+    mcsg_status st = owners && keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    for (size_t k = 0; k < n && st == MCSG_OK; k++) {
+        uint32_t as = k == 0 ? w->leaf : w->copies[k - 1];
+        owners[k] = (owner){keep + k * (w->nreg + 1), t->nodes[t->leaf_node[as]].complement,
+                            &w->kept_all[as],
+                            w->s->octree.face_base[as] - w->s->octree.face_base[w->leaf]};
+        st = decide_regions(w, k == 0 ? w->ncopies : k - 1, keep + k * (w->nreg + 1));
+    }
+    st = st == MCSG_OK ? emit_kept(w, owners, n) : st;
+    mci_free(w->ctx, owners);
     mci_free(w->ctx, keep);
     return st;
 }
@@ -1101,7 +1321,10 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
 {
     leaf_work w;
     mcsg_status st;
+    if (mci_scene_leaf_stand_in(cl->scene, leaf) != leaf)
+        return MCSG_OK; /* a copy: the leaf it copies outputs its pieces too */
     memset(&w, 0, sizeof w);
+    w.kept_all = kept;
     w.ctx = ctx;
     w.cl = cl;
     w.s = cl->scene;
@@ -1125,10 +1348,14 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
         st = find_candidates(&w);
     if (st == MCSG_OK)
         st = trim_csglist(&w);
-    if (st == MCSG_OK && !w.rejected)
-        st = label_regions(&w);
-    if (st == MCSG_OK && !w.rejected)
-        st = select_pieces(&w, kept);
+    if (st == MCSG_OK && (!w.rejected || w.ncopies > 0)) {
+        st = prepare_copy_labels(&w);
+        if (st == MCSG_OK)
+            st = label_regions(&w);
+        finish_copy_labels(&w);
+        if (st == MCSG_OK)
+            st = select_pieces(&w);
+    }
     stats->rejected_leaves += w.rejected;
     stats->pieces += w.np;
     stats->regions += w.nreg;

@@ -34,6 +34,9 @@ typedef struct mci_classifier {
     const double **new_vertex;
     size_t new_vertex_count;
     double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
+    /* Copies (scene->alias): copy_of[copy_start[l] .. copy_start[l + 1]) are the leaves
+     * that are copies of leaf l, in increasing order (NULL when there is none). */
+    uint32_t *copy_start, *copy_of;
 } mci_classifier;
 
 /* The bounding box of a mesh's vertices: lo[3], hi[3] (zeros for an empty mesh). */
@@ -49,8 +52,9 @@ typedef struct mci_classify_stats {
 } mci_classify_stats;
 
 /* Classify every piece of primitive `leaf` (the scene's leaf of the same index) and
- * append those that belong to the result to *kept (reversed for a complemented
- * primitive). Fails with MCSG_ERR_INTERNAL when the leaf's pieces do not close up (an
+ * append those that belong to the result to kept[leaf] (reversed for a complemented
+ * primitive); for a leaf with copies (scene->alias), to each copy's kept[] as well, and
+ * nothing for a copy itself. Fails with MCSG_ERR_INTERNAL when the leaf's pieces do not close up (an
  * input that is not closed and edge-manifold) or a label cannot be decided. */
 mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint32_t leaf,
                               mci_kept *kept, mci_classify_stats *stats, mcsg_error *err);

@@ -11,11 +11,14 @@
 #include "rounding_repair.h"
 #include "whole_faces.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct eval_state {
     mci_ctx ctx;
     mci_ptree tree;
+    uint32_t *alias; /* per primitive: the earlier one it is a copy of, or itself; NULL if
+                        no primitive is a copy */
     mci_scene scene;
     mci_classifier cl;
     mci_kept kept;
@@ -60,8 +63,8 @@ typedef struct leaf_jobs {
 static mcsg_status classify_one(void *user, size_t leaf, mcsg_error *err)
 {
     leaf_jobs *j = user;
-    return mci_classify_leaf(&j->e->ctx, &j->e->cl, (uint32_t)leaf, &j->kept[leaf],
-                             &j->stats[leaf], err);
+    return mci_classify_leaf(&j->e->ctx, &j->e->cl, (uint32_t)leaf, j->kept, &j->stats[leaf],
+                             err);
 }
 
 static bool join_kept(eval_state *e, const leaf_jobs *j)
@@ -358,12 +361,84 @@ static mcsg_status step(eval_state *e, const char *name, step_fn fn, mcsg_error 
     return st;
 }
 
+/* Whether two meshes are the same arrays (the same file imported twice in the same
+ * place, say): then the earlier one stands for the later in the whole evaluation. */
+static bool same_mesh(const mcsg_mesh *a, const mcsg_mesh *b)
+{
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
+           memcmp(a->vertices, b->vertices, 3 * a->vertex_count * sizeof *a->vertices) == 0 &&
+           memcmp(a->triangles, b->triangles, 3 * a->triangle_count * sizeof *a->triangles) == 0;
+}
+
+typedef struct leaf_ref {
+    const mcsg_mesh *mesh;
+    uint32_t leaf;
+} leaf_ref;
+
+/* By size and first vertex (copies compare equal), then by leaf. */
+static int compare_leaf_refs(const void *x, const void *y)
+{
+    const leaf_ref *p = x, *q = y;
+    const mcsg_mesh *a = p->mesh, *b = q->mesh;
+    int c;
+    if (a->vertex_count != b->vertex_count)
+        return a->vertex_count < b->vertex_count ? -1 : 1;
+    if (a->triangle_count != b->triangle_count)
+        return a->triangle_count < b->triangle_count ? -1 : 1;
+    c = a->vertex_count ? memcmp(a->vertices, b->vertices, 3 * sizeof *a->vertices) : 0;
+    return c ? c : (p->leaf > q->leaf) - (p->leaf < q->leaf);
+}
+
+static bool same_key(const leaf_ref *p, const leaf_ref *q)
+{
+    leaf_ref a = *p, b = *q;
+    a.leaf = b.leaf = 0;
+    return compare_leaf_refs(&a, &b) == 0;
+}
+
+/* e->alias: each copy points to the first leaf with the same mesh; only meshes of the
+ * same size and first vertex are compared in full. Stays NULL when there is no copy. */
+static mcsg_status find_copies(eval_state *e, mcsg_error *err)
+{
+    size_t n = e->tree.leaf_count, copies = 0;
+    leaf_ref *order = mci_malloc_array(&e->ctx, n + 1, sizeof *order);
+    uint32_t *alias = mci_malloc_array(&e->ctx, n + 1, sizeof *alias);
+    if (!order || !alias) {
+        mci_free(&e->ctx, order);
+        mci_free(&e->ctx, alias);
+        return mci_fail_nomem(err, "comparing the leaves");
+    }
+    for (uint32_t l = 0; l < n; l++) {
+        order[l] = (leaf_ref){e->tree.leaf_mesh[l], l};
+        alias[l] = l;
+    }
+    qsort(order, n, sizeof *order, compare_leaf_refs);
+    for (size_t i = 1, run = 0; i < n; i++) {
+        if (!same_key(&order[i], &order[i - 1]))
+            run = i;
+        for (size_t j = run; j < i; j++)
+            if (same_mesh(order[i].mesh, order[j].mesh)) {
+                alias[order[i].leaf] = alias[order[j].leaf];
+                copies++;
+                break;
+            }
+    }
+    mci_free(&e->ctx, order);
+    if (copies == 0)
+        mci_free(&e->ctx, alias);
+    else
+        e->alias = alias;
+    e->stats.copied_primitives = copies;
+    return MCSG_OK;
+}
+
 /* Faces that the result drops whole are found before splitting, which they then skip. */
 static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build_unsplit(&e->ctx,
-                                             (const mcsg_mesh *const *)e->tree.leaf_mesh,
-                                             e->tree.leaf_count, &e->scene, err);
+    mcsg_status st = find_copies(e, err);
+    if (st == MCSG_OK)
+        st = mci_scene_build_unsplit(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
+                                     e->tree.leaf_count, e->alias, &e->scene, err);
     double t0 = mci_seconds_now();
     if (st == MCSG_OK)
         st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,
@@ -427,6 +502,7 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     mci_kept_free(&e.ctx, &e.kept);
     mci_scene_free(&e.ctx, &e.scene);
     mci_ptree_free(&e.ctx, &e.tree);
+    mci_free(&e.ctx, e.alias);
     e.stats.seconds_total = mci_seconds_now() - t0;
     if (stats)
         *stats = e.stats;

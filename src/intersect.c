@@ -716,19 +716,36 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build_unsplit(ctx, leaves, leaf_count, scene, err);
+    mcsg_status st = mci_scene_build_unsplit(ctx, leaves, leaf_count, NULL, scene, err);
     if (st == MCSG_OK && (st = mci_scene_split(ctx, scene, NULL, err)) != MCSG_OK)
         mci_scene_free(ctx, scene);
     return st;
 }
 
+uint32_t mci_scene_leaf_stand_in(const mci_scene *s, uint32_t m)
+{
+    return s->alias ? s->alias[m] : m;
+}
+
 mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
-                                    size_t leaf_count, mci_scene *scene, mcsg_error *err)
+                                    size_t leaf_count, const uint32_t *alias,
+                                    mci_scene *scene, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
+    mci_octree_params params = {0, 0, NULL};
+    uint8_t *skip = NULL;
     mcsg_status st;
     memset(scene, 0, sizeof *scene);
-    st = mci_octree_build(ctx, leaves, leaf_count, NULL, &scene->octree, err);
+    scene->alias = alias;
+    if (alias) {
+        if (!(skip = mci_malloc_array(ctx, leaf_count + 1, 1)))
+            return mci_fail_nomem(err, "building the octree");
+        for (size_t l = 0; l < leaf_count; l++)
+            skip[l] = alias[l] != l;
+    }
+    params.skip_leaf = skip;
+    st = mci_octree_build(ctx, leaves, leaf_count, alias ? &params : NULL, &scene->octree, err);
+    mci_free(ctx, skip);
     if (st != MCSG_OK)
         return st;
     scene->stats.seconds_octree = mci_seconds_now() - t0;

@@ -130,7 +130,7 @@ static size_t total_faces(const mcsg_mesh *const *leaves, size_t leaf_count)
     return total;
 }
 
-static bool index_faces(const mci_ctx *ctx, mci_octree *t)
+static bool index_faces(const mci_ctx *ctx, mci_octree *t, const uint8_t *skip_leaf)
 {
     size_t total = total_faces(t->leaves, t->leaf_count);
     t->face_base = mci_malloc_array(ctx, t->leaf_count + 1, sizeof *t->face_base);
@@ -145,9 +145,10 @@ static bool index_faces(const mci_ctx *ctx, mci_octree *t)
         for (uint32_t f = t->face_base[i]; f < end; f++)
             t->face_leaf[f] = (uint32_t)i;
     }
+    t->face_id_count = 0;
     for (size_t f = 0; f < total; f++)
-        t->face_ids[f] = (uint32_t)f;
-    t->face_id_count = total;
+        if (!skip_leaf || !skip_leaf[t->face_leaf[f]])
+            t->face_ids[t->face_id_count++] = (uint32_t)f;
     return true;
 }
 
@@ -157,13 +158,13 @@ static void root_bounds(const mci_octree *t, mci_cell *root)
         root->lo[k] = 0;
         root->hi[k] = 0;
     }
-    for (uint32_t f = 0; f < t->face_id_count; f++) {
+    for (uint32_t i = 0; i < t->face_id_count; i++) {
         for (int v = 0; v < 3; v++) {
-            const double *p = mci_octree_face_vertex(t, f, v);
+            const double *p = mci_octree_face_vertex(t, t->face_ids[i], v);
             for (int k = 0; k < 3; k++) {
-                if ((f == 0 && v == 0) || p[k] < root->lo[k])
+                if ((i == 0 && v == 0) || p[k] < root->lo[k])
                     root->lo[k] = p[k];
-                if ((f == 0 && v == 0) || p[k] > root->hi[k])
+                if ((i == 0 && v == 0) || p[k] > root->hi[k])
                     root->hi[k] = p[k];
             }
         }
@@ -524,9 +525,11 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     out->leaf_count = leaf_count;
     b.ctx = ctx;
     b.tree = out;
-    b.params.max_cell_faces = params ? params->max_cell_faces : DEFAULT_MAX_CELL_FACES;
-    b.params.max_depth = params ? params->max_depth : DEFAULT_MAX_DEPTH;
-    st = index_faces(ctx, out) && (b.face_box = face_boxes(ctx, out)) != NULL
+    b.params.max_cell_faces = params && params->max_cell_faces ? params->max_cell_faces
+                                                               : DEFAULT_MAX_CELL_FACES;
+    b.params.max_depth = params && params->max_depth ? params->max_depth : DEFAULT_MAX_DEPTH;
+    st = index_faces(ctx, out, params ? params->skip_leaf : NULL) &&
+                 (b.face_box = face_boxes(ctx, out)) != NULL
              ? build_cells(&b, err)
              : mci_fail_nomem(err, "building the octree");
     mci_free(ctx, b.face_box);

@@ -36,10 +36,14 @@ typedef struct mci_octree {
     unsigned max_depth;
 } mci_octree;
 
-/* Tuning: a critical cell with more faces than this is subdivided, up to the depth. */
+/* Tuning: a critical cell with more faces than this is subdivided, up to the depth
+ * (zero: the defaults). */
 typedef struct mci_octree_params {
     uint32_t max_cell_faces;
     unsigned max_depth;
+    /* Optional (NULL: none): leaves whose faces are left out of the cells (they keep
+     * their global face ids, but meet no other face and no ray). */
+    const uint8_t *skip_leaf;
 } mci_octree_params;
 
 /* Build the octree over the given leaves (which must outlive it). params may be NULL

@@ -30,6 +30,9 @@ typedef struct mci_scene {
     /* Per arrangement: 1 when the face is dropped whole (mci_decide_whole_faces; NULL
      * before): it is not split nor tessellated, and has no pieces. */
     uint8_t *arr_dropped;
+    /* Per leaf (NULL: none): the leaf it is a copy of (itself if none). A copy's faces
+     * are left out of the octree: the leaf it copies stands for it (see eval.c). */
+    const uint32_t *alias;
     mcsg_intersect_stats stats;
 } mci_scene;
 
@@ -44,7 +47,11 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
  * so that their points and locations are final (their faces will not be tessellated
  * with their constraints: see mci_decide_whole_faces). */
 mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
-                                    size_t leaf_count, mci_scene *scene, mcsg_error *err);
+                                    size_t leaf_count, const uint32_t *alias,
+                                    mci_scene *scene, mcsg_error *err);
+
+/* The leaf that stands for leaf m (m itself unless it is a copy). */
+uint32_t mci_scene_leaf_stand_in(const mci_scene *scene, uint32_t m);
 mcsg_status mci_scene_split(const mci_ctx *ctx, mci_scene *scene, const uint8_t *skip,
                             mcsg_error *err);
 

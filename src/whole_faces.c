@@ -30,6 +30,7 @@ typedef struct decide_job {
     const mci_ptree *t;
     const double (*box)[6]; /* per leaf */
     size_t *dropped;        /* per leaf: faces flagged */
+    uint8_t *copied;        /* per leaf: another leaf is a copy of it (NULL: none is) */
 } decide_job;
 
 /* One leaf's decision. Vertex arrays are indexed by the leaf mesh's vertex index. */
@@ -166,7 +167,7 @@ static bool reaches_outside(const leaf_decision *d, uint32_t f, const double mbo
  * face the search reaches gets the same label, so later faces of the group are free. */
 static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
 {
-    uint32_t m = d->reads[r];
+    uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->reads[r]);
     const double *mbox = d->j->box[m];
     size_t head = 0, tail = 0;
     uint8_t result = MCI_LABEL_UNKNOWN;
@@ -211,15 +212,18 @@ static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
 }
 
 /* labels[i][r] for every touched face i and read leaf r it does not meet: OUT when its
- * box misses r's, else its group's. */
+ * box misses r's, else its group's. A copy of another leaf is that leaf (it has no faces
+ * in the scene); a copy of this leaf is SAME, which the pass below leaves UNKNOWN. */
 static bool label_faces(leaf_decision *d)
 {
     for (size_t r = 0; r < d->nreads; r++) {
-        uint32_t m = d->reads[r];
+        uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->reads[r]);
         for (size_t i = 0; i < d->nfaces; i++) {
             uint8_t *label = &d->labels[i * d->nreads + r];
             uint32_t local = d->faces[i] - d->face_base;
             *label = MCI_LABEL_UNKNOWN;
+            if (m == d->leaf)
+                continue;
             if (!boxes_meet(d->face_box[local], d->j->box[m]))
                 *label = MCI_LABEL_OUT; /* it is outside the box that holds m */
             else if (!mci_scene_face_touches(d->j->s, d->faces[i], m) &&
@@ -262,6 +266,10 @@ static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
     const decide_job *j = user;
     leaf_decision d;
     bool rejected = false, ok;
+    /* A leaf with copies: its faces' fate also depends on the copies' CSGlists, which
+     * this pass does not read; they are left to the classification. */
+    if (j->copied && j->copied[leaf])
+        return MCSG_OK;
     memset(&d, 0, sizeof d);
     d.j = j;
     d.leaf = (uint32_t)leaf;
@@ -298,11 +306,14 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
     size_t n = s->octree.leaf_count;
     double (*box)[6] = mci_malloc_array(ctx, n + 1, sizeof *box);
     size_t *dropped = mci_calloc_array(ctx, n + 1, sizeof *dropped);
-    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped};
+    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped, NULL};
     mcsg_status st = MCSG_OK;
     *count = 0;
     s->arr_dropped = mci_calloc_array(ctx, s->arr_count + 1, 1);
-    if (!box || !dropped || !s->arr_dropped)
+    if (s->alias && (job.copied = mci_calloc_array(ctx, n + 1, 1)) != NULL)
+        for (size_t l = 0; l < n; l++)
+            job.copied[s->alias[l]] |= s->alias[l] != l;
+    if (!box || !dropped || !s->arr_dropped || (s->alias && !job.copied))
         st = mci_fail_nomem(err, "deciding whole faces");
     for (size_t l = 0; st == MCSG_OK && l < n; l++)
         mci_leaf_box(s->octree.leaves[l], box[l]);
@@ -312,5 +323,6 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
         *count += dropped[l];
     mci_free(ctx, box);
     mci_free(ctx, dropped);
+    mci_free(ctx, job.copied);
     return st;
 }

@@ -169,6 +169,42 @@ TEST(buried_faces_are_dropped_whole)
                          1000 + 64 - 8, 1) > 0);
 }
 
+/* expect_solid, and the number of primitives that are copies of an earlier one. */
+static size_t solid_copies(const char *text, double volume, size_t components)
+{
+    result r;
+    size_t copies;
+    expect_solid(text, volume, components);
+    if (!eval_text(text, &r))
+        return 0;
+    copies = r.stats.copied_primitives;
+    mcsg_mesh_free(&r.mesh, NULL);
+    return copies;
+}
+
+/* A primitive that is the same mesh as an earlier one is evaluated through it (eval.c):
+ * its faces are the earlier one's, with its own CSGlist, orientation and provenance. The
+ * cases put both copies' faces in the result, in parts of one face, complemented. */
+TEST(copies_are_evaluated_once)
+{
+    const char *a = "cube(4);", *c = "translate([2,0,0]) cube(4);";
+    char text[256];
+    /* (A n C) u (A' - C'): the faces of A are kept partly by A, partly by A'. */
+    snprintf(text, sizeof text, "union() { intersection() { %s %s } difference() { %s %s } }",
+             a, c, a, c);
+    CHECK_EQ_SIZE(solid_copies(text, 64, 1), 2);
+    snprintf(text, sizeof text, "difference() { %s intersection() { %s %s } }", a, a, c);
+    CHECK_EQ_SIZE(solid_copies(text, 32, 1), 1);
+    snprintf(text, sizeof text, "difference() { union() { %s %s } %s }", a, c, a);
+    CHECK_EQ_SIZE(solid_copies(text, 32, 1), 1);
+    snprintf(text, sizeof text, "union() { difference() { %s %s } %s %s }", c, a, a, a);
+    CHECK_EQ_SIZE(solid_copies(text, 96, 1), 2);
+    /* A copy of a leaf that another leaf crosses, and a copy of that one. */
+    CHECK_EQ_SIZE(solid_copies("intersection() { union() { cube(4); sphere(1, $fn=8); }"
+                               " union() { cube(4); translate([5,0,0]) cube(1); } }", 64, 1),
+                  1);
+}
+
 TEST(touching_solids)
 {
     /* B touches A on a face: A - B = A, A u B fuses into one box. */
@@ -511,6 +547,7 @@ int main(void)
     RUN(box_scenes_have_exact_volumes);
     RUN(identical_operands);
     RUN(buried_faces_are_dropped_whole);
+    RUN(copies_are_evaluated_once);
     RUN(touching_solids);
     RUN(coplanar_overlaps);
     RUN(curved_volumes_add_up);
