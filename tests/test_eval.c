@@ -131,17 +131,23 @@ TEST(identical_operands)
     }
 }
 
-/* expect_solid, and the number of touched faces dropped whole before splitting. */
-static size_t solid_dropping(const char *text, double volume, size_t components)
+/* expect_solid, and the evaluation's statistics (zeros if it failed). */
+static mcsg_eval_stats solid_stats(const char *text, double volume, size_t components)
 {
     result r;
-    size_t dropped;
+    mcsg_eval_stats stats;
+    memset(&stats, 0, sizeof stats);
     expect_solid(text, volume, components);
     if (!eval_text(text, &r))
-        return 0;
-    dropped = r.stats.faces_dropped_whole;
+        return stats;
+    stats = r.stats;
     mcsg_mesh_free(&r.mesh, NULL);
-    return dropped;
+    return stats;
+}
+
+static size_t solid_dropping(const char *text, double volume, size_t components)
+{
+    return solid_stats(text, volume, components).faces_dropped_whole;
 }
 
 /* Faces crossed by other leaves but buried in (or outside) a leaf they do not meet are
@@ -169,17 +175,9 @@ TEST(buried_faces_are_dropped_whole)
                          1000 + 64 - 8, 1) > 0);
 }
 
-/* expect_solid, and the number of primitives that are copies of an earlier one. */
 static size_t solid_copies(const char *text, double volume, size_t components)
 {
-    result r;
-    size_t copies;
-    expect_solid(text, volume, components);
-    if (!eval_text(text, &r))
-        return 0;
-    copies = r.stats.copied_primitives;
-    mcsg_mesh_free(&r.mesh, NULL);
-    return copies;
+    return solid_stats(text, volume, components).copied_primitives;
 }
 
 /* A primitive that is the same mesh as an earlier one is evaluated through it (eval.c):
