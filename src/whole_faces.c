@@ -46,7 +46,7 @@ typedef struct leaf_decision {
     mci_blist blist;
     uint32_t *reads;         /* the distinct leaves the blist reads */
     size_t nreads;
-    double (*face_box)[6];   /* per face of the leaf */
+    double (*face_box)[6];   /* per touched face */
     uint32_t *vf_start, *vf_face; /* faces around each vertex (CSR) */
     uint32_t *seen;          /* per face: the last search that reached it */
     uint32_t *labelled;      /* per face: the leaf read (r + 1) its group_label is for */
@@ -165,12 +165,28 @@ static bool reaches_outside(const leaf_decision *d, uint32_t f, const double mbo
  * stops at the first one reaching outside m's box (OUT); a group wholly inside the box
  * takes the label of a ray from one of its vertices (none lies on m's surface). Every
  * face the search reaches gets the same label, so later faces of the group are free. */
+/* The search's arrays, made at the first search (most leaves need none: their touched
+ * faces meet the leaves their CSGlist reads, as in a difference of two models). */
+static bool prepare_search(leaf_decision *d)
+{
+    size_t nt = d->m->triangle_count + 1;
+    if (d->queue)
+        return true;
+    d->seen = mci_calloc_array(d->j->ctx, nt, sizeof *d->seen);
+    d->labelled = mci_calloc_array(d->j->ctx, nt, sizeof *d->labelled);
+    d->group_label = mci_malloc_array(d->j->ctx, nt, 1);
+    d->queue = mci_malloc_array(d->j->ctx, nt, sizeof *d->queue);
+    return d->seen && d->labelled && d->group_label && d->queue && index_vertex_faces(d);
+}
+
 static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
 {
     uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->reads[r]);
     const double *mbox = d->j->box[m];
     size_t head = 0, tail = 0;
     uint8_t result = MCI_LABEL_UNKNOWN;
+    if (!prepare_search(d))
+        return false;
     if (d->labelled[f] == r + 1) {
         *label = d->group_label[f];
         return true;
@@ -224,7 +240,7 @@ static bool label_faces(leaf_decision *d)
             *label = MCI_LABEL_UNKNOWN;
             if (m == d->leaf)
                 continue;
-            if (!boxes_meet(d->face_box[local], d->j->box[m]))
+            if (!boxes_meet(d->face_box[i], d->j->box[m]))
                 *label = MCI_LABEL_OUT; /* it is outside the box that holds m */
             else if (!mci_scene_face_touches(d->j->s, d->faces[i], m) &&
                      !group_label(d, local, r, label))
@@ -281,17 +297,12 @@ static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
             j->s->arr_dropped[j->s->arr_of[d.faces[i]]] = 1;
         j->dropped[leaf] = d.nfaces;
     } else if (ok && d.nfaces > 0 && d.nreads > 0) {
-        size_t nt = d.m->triangle_count + 1;
         d.labels = mci_malloc_array(j->ctx, d.nfaces, d.nreads);
-        d.face_box = mci_malloc_array(j->ctx, nt, sizeof *d.face_box);
-        d.seen = mci_calloc_array(j->ctx, nt, sizeof *d.seen);
-        d.labelled = mci_calloc_array(j->ctx, nt, sizeof *d.labelled);
-        d.group_label = mci_malloc_array(j->ctx, nt, 1);
-        d.queue = mci_malloc_array(j->ctx, nt, sizeof *d.queue);
-        ok = d.labels && d.face_box && d.seen && d.labelled && d.group_label && d.queue &&
-             index_vertex_faces(&d);
-        for (size_t f = 0; ok && f < d.m->triangle_count; f++)
-            triangle_box(d.m, d.m->triangles + 3 * f, d.face_box[f]);
+        d.face_box = mci_malloc_array(j->ctx, d.nfaces, sizeof *d.face_box);
+        ok = d.labels && d.face_box;
+        for (size_t i = 0; ok && i < d.nfaces; i++)
+            triangle_box(d.m, d.m->triangles + 3 * (size_t)(d.faces[i] - d.face_base),
+                         d.face_box[i]);
         ok = ok && label_faces(&d);
         if (ok)
             j->dropped[leaf] = flag_dropped(&d);
