@@ -86,6 +86,9 @@ typedef enum mci_point_kind {
 
 typedef struct mci_point {
     mci_point_kind kind;
+    /* These two sit in kind's padding (points are stored and copied by the million). */
+    uint8_t exact_axes; /* bit k: coordinate k is exactly c[k] (see the box below) */
+    int8_t w_sign; /* exact sign of the stored w (+1), or 0 if W is exactly 0 (no point) */
     /* Defining input vertices. explicit: v[0]. LPI: line v[0], v[1]; plane v[2..4].
      * TPI: planes v[0..2], v[3..5], v[6..8]. base = v[0] in every case. */
     const double *v[9];
@@ -98,8 +101,6 @@ typedef struct mci_point {
      * constant). First-stage filters use it; axis-aligned input (CAD parts, coplanar
      * grids) then decides ties without the exact stage. */
     double c[3], r;
-    uint8_t exact_axes;
-    int8_t w_sign; /* exact sign of the stored w (+1), or 0 if W is exactly 0 (no point) */
 } mci_point;
 
 /* Constructors. Each returns true when the point exists: always for explicit points;
