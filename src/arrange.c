@@ -97,16 +97,13 @@ static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lin
     return points;
 }
 
-/* Room for one more point: the block doubles (at least 8), keeping its contents. */
-static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
+/* A new block of `capacity` (at least point_count) points, keeping the contents. */
+static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity)
 {
-    size_t capacity = arr->point_capacity < 4 ? 8 : 2 * arr->point_capacity;
     mci_point_lines *lines;
     mci_point *points;
     uint8_t *where;
-    if (arr->point_count < arr->point_capacity)
-        return true;
-    if (capacity > SIZE_MAX / 2 || !(points = point_block(ctx, capacity, &lines, &where)))
+    if (!(points = point_block(ctx, capacity, &lines, &where)))
         return false;
     if (arr->point_count) { /* the first block has nothing to copy (and memcpy no NULL) */
         memcpy(points, arr->points, arr->point_count * sizeof *points);
@@ -119,6 +116,30 @@ static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
     arr->lines = lines;
     arr->where = where;
     arr->point_capacity = capacity;
+    return true;
+}
+
+/* Room for one more point: the block doubles (at least 8). */
+static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
+{
+    size_t capacity = arr->point_capacity < 4 ? 8 : 2 * arr->point_capacity;
+    if (arr->point_count < arr->point_capacity)
+        return true;
+    return capacity <= SIZE_MAX / 2 && resize_points(ctx, arr, capacity);
+}
+
+bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_t segments)
+{
+    if (points > arr->point_capacity && !resize_points(ctx, arr, points))
+        return false;
+    if (segments > arr->segment_capacity) {
+        mci_arr_segment *grown = mci_realloc_array(ctx, arr->segments, segments,
+                                                   sizeof *grown);
+        if (!grown)
+            return false;
+        arr->segments = grown;
+        arr->segment_capacity = segments;
+    }
     return true;
 }
 

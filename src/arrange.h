@@ -78,6 +78,11 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          size_t max_coplanar, mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
 
+/* Room for `points` points and `segments` segments in all (when more than now), so that
+ * adding a counted number of them does not grow the arrays step by step (doubling left
+ * a third of the arrangements' memory unused). False when out of memory. */
+bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_t segments);
+
 /* Inputs. Points must lie on the face (closed triangle). */
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
 /* The segment a-b where face `other` crosses. `plane_id` names other's plane: faces of

@@ -456,12 +456,18 @@ static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t
                                 const face_facts *ff, const plane_cache *planes,
                                 mci_face_arr *arr, mcsg_error *err)
 {
-    size_t coplanar = 0;
+    size_t coplanar = 0, crossing = 0;
     mcsg_status st;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         coplanar += hits->v[ids[i]].kind == MCI_TT_COPLANAR;
+        crossing += hits->v[ids[i]].kind == MCI_TT_SEGMENT;
+    }
     st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
                       mci_scene_corner(s, f, 2), coplanar, err);
+    /* A crossing adds a segment, a coplanar face up to three (their points are counted
+     * as they come: corner copies, the most common, are not appended). */
+    if (st == MCSG_OK && !mci_arr_reserve(ctx, arr, 0, crossing + 3 * coplanar))
+        st = mci_fail_nomem(err, "arranging faces");
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
         if (!add_hit(ctx, s, arr, hits, &hits->v[ids[i]], ff, planes))
             st = mci_fail_nomem(err, "arranging faces");
@@ -515,6 +521,32 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *n
     return st;
 }
 
+/* Room in each arrangement for the points the loop below will give it (the loop, and
+ * which arrangements it skips, replayed without the points). */
+static mcsg_status reserve_shared(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    uint32_t *extra = mci_calloc_array(ctx, s->arr_count + 1, sizeof *extra);
+    mcsg_status st = extra ? MCSG_OK : mci_fail_nomem(err, "arranging faces");
+    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
+        const mci_face_arr *arr = &s->arrs[k];
+        if (arr->dirty || extra[k]) /* it received points: the loop skips it */
+            continue;
+        for (size_t p = 3; p < arr->point_count; p++) {
+            uint32_t nb;
+            if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
+                continue;
+            nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
+            if (nb != MCI_NONE)
+                extra[s->arr_of[nb]]++;
+        }
+    }
+    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++)
+        if (extra[k] && !mci_arr_reserve(ctx, &s->arrs[k], s->arrs[k].point_count + extra[k], 0))
+            st = mci_fail_nomem(err, "arranging faces");
+    mci_free(ctx, extra);
+    return st;
+}
+
 static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
     bool *needs = mci_calloc_array(ctx, s->face_count + 1, sizeof *needs);
@@ -526,6 +558,8 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
     st = add_receivers(ctx, s, needs, err);
     mci_free(ctx, needs);
     count = s->arr_count;
+    if (st == MCSG_OK)
+        st = reserve_shared(ctx, s, err);
     for (size_t k = 0; st == MCSG_OK && k < count; k++) {
         const mci_face_arr *arr = &s->arrs[k];
         for (size_t p = 3; p < arr->point_count && !arr->dirty; p++) {
