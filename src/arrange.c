@@ -50,7 +50,7 @@ static const double *add_aux(mci_face_arr *arr, const double *x)
 
 mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const double *a, const double *b, const double *c,
-                         size_t max_coplanar, mcsg_error *err)
+                         size_t max_coplanar, size_t points, mcsg_error *err)
 {
     memset(arr, 0, sizeof *arr);
     arr->face = face;
@@ -60,8 +60,10 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
         return mci_fail(err, MCSG_ERR_INVALID_MESH, "face %u is degenerate", face);
     arr->aux_capacity = 3 + 3 * max_coplanar;
     arr->aux = mci_malloc_array(ctx, arr->aux_capacity, sizeof *arr->aux);
-    if (!arr->aux)
+    if (!arr->aux || !mci_arr_reserve(ctx, arr, points > 3 ? points : 3, 0)) {
+        mci_arr_free(ctx, arr);
         return mci_fail_nomem(err, "arranging a face");
+    }
     for (int i = 0; i < 3; i++) {
         mci_point p;
         mci_point_explicit(&p, corner(arr, i));

@@ -72,10 +72,11 @@ typedef struct mci_face_arr {
 
 /* Start the arrangement of face `face` with corners a, b, c (non-degenerate).
  * `max_coplanar` bounds the number of mci_arr_add_coplanar calls (it sizes the
- * auxiliary vertex store, whose addresses must not move). */
+ * auxiliary vertex store, whose addresses must not move); `points` is the number of
+ * points expected in all, corners included (room is made for them; more may come). */
 mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const double *a, const double *b, const double *c,
-                         size_t max_coplanar, mcsg_error *err);
+                         size_t max_coplanar, size_t points, mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Room for `points` points and `segments` segments in all (when more than now), so that

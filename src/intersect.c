@@ -462,10 +462,11 @@ static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t
         coplanar += hits->v[ids[i]].kind == MCI_TT_COPLANAR;
         crossing += hits->v[ids[i]].kind == MCI_TT_SEGMENT;
     }
+    /* A crossing adds two points and a segment, a contact one point, a coplanar face up
+     * to three segments (its points are counted as they come: corner copies, the most
+     * common, are not appended). */
     st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
-                      mci_scene_corner(s, f, 2), coplanar, err);
-    /* A crossing adds a segment, a coplanar face up to three (their points are counted
-     * as they come: corner copies, the most common, are not appended). */
+                      mci_scene_corner(s, f, 2), coplanar, 3 + n - coplanar + crossing, err);
     if (st == MCSG_OK && !mci_arr_reserve(ctx, arr, 0, crossing + 3 * coplanar))
         st = mci_fail_nomem(err, "arranging faces");
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
@@ -509,7 +510,7 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *n
             all[out] = s->arrs[k++];
         } else if (needs[f] && st == MCSG_OK) {
             st = mci_arr_init(ctx, &all[out], f, mci_scene_corner(s, f, 0),
-                              mci_scene_corner(s, f, 1), mci_scene_corner(s, f, 2), 0, err);
+                              mci_scene_corner(s, f, 1), mci_scene_corner(s, f, 2), 0, 3, err);
         } else {
             continue;
         }
