@@ -40,19 +40,15 @@ typedef struct leaf_decision {
     const mcsg_mesh *m;
     uint32_t *faces;         /* the leaf's touched faces (global ids) ... */
     size_t nfaces;
-    uint8_t *labels;         /* ... and their labels: nfaces x nreads */
     mci_csg_entry *list;
     mci_label *leaf_labels, *scratch;
-    mci_blist blist;
-    uint32_t *reads;         /* the distinct leaves the blist reads */
-    size_t nreads;
+    mci_blist blist;         /* each step reads one leaf, no two the same leaf */
+    uint32_t *reached, sweep; /* per step: the last sweep (face) that reached it */
     double (*face_box)[6];   /* per touched face */
     uint32_t *vf_start, *vf_face; /* faces around each vertex (CSR) */
     uint32_t *seen;          /* per face: the last search that reached it */
-    uint32_t *labelled;      /* per face: the leaf read (r + 1) its group_label is for */
-    uint8_t *group_label;
+    uint8_t *memo;           /* per step and face: 1 + the label found by a search, or 0 */
     uint32_t *queue, search;
-    uint8_t *step_scratch;
     mci_ray_scratch ray;
 } leaf_decision;
 
@@ -86,9 +82,8 @@ static bool outside_box(const double *x, const double box[6])
 static void free_decision(leaf_decision *d)
 {
     const mci_ctx *ctx = d->j->ctx;
-    void *all[] = {d->faces, d->labels, d->list, d->leaf_labels, d->scratch, d->reads,
-                   d->face_box, d->vf_start, d->vf_face, d->seen, d->labelled, d->group_label,
-                   d->queue, d->step_scratch};
+    void *all[] = {d->faces, d->list, d->leaf_labels, d->scratch, d->reached, d->face_box,
+                   d->vf_start, d->vf_face, d->seen, d->memo, d->queue};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(ctx, all[i]);
     mci_blist_free(ctx, &d->blist);
@@ -105,8 +100,7 @@ static bool trim_list(leaf_decision *d, bool *rejected)
     d->list = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->list);
     d->scratch = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->scratch);
     d->leaf_labels = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
-    d->reads = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->reads);
-    if (!d->list || !d->scratch || !d->leaf_labels || !d->reads)
+    if (!d->list || !d->scratch || !d->leaf_labels)
         return false;
     for (uint32_t l = 0; l < t->leaf_count; l++)
         d->leaf_labels[l] = l != d->leaf && boxes_meet(box[l], box[d->leaf]) ? MCI_LABEL_UNKNOWN
@@ -116,19 +110,8 @@ static bool trim_list(leaf_decision *d, bool *rejected)
         return true;
     if (!mci_blist_build(d->j->ctx, t, d->list, nlist, d->leaf_labels, &d->blist))
         return false;
-    /* The distinct leaves of the steps, found with a mark per leaf (in step_scratch,
-     * which is large enough and free until the faces are tested). */
-    d->step_scratch = mci_calloc_array(d->j->ctx, t->leaf_count + d->blist.count + 1, 1);
-    if (!d->step_scratch)
-        return false;
-    for (size_t k = 0; k < d->blist.count; k++) {
-        uint32_t l = d->blist.steps[k].leaf;
-        if (!d->step_scratch[l]) {
-            d->step_scratch[l] = 1;
-            d->reads[d->nreads++] = l;
-        }
-    }
-    return true;
+    d->reached = mci_calloc_array(d->j->ctx, d->blist.count + 1, sizeof *d->reached);
+    return d->reached != NULL;
 }
 
 /* Faces around each vertex of the leaf mesh (CSR), for the searches below. */
@@ -172,23 +155,26 @@ static bool prepare_search(leaf_decision *d)
     size_t nt = d->m->triangle_count + 1;
     if (d->queue)
         return true;
+    if (d->blist.count > SIZE_MAX / nt)
+        return false;
     d->seen = mci_calloc_array(d->j->ctx, nt, sizeof *d->seen);
-    d->labelled = mci_calloc_array(d->j->ctx, nt, sizeof *d->labelled);
-    d->group_label = mci_malloc_array(d->j->ctx, nt, 1);
+    d->memo = mci_calloc_array(d->j->ctx, d->blist.count * nt, 1);
     d->queue = mci_malloc_array(d->j->ctx, nt, sizeof *d->queue);
-    return d->seen && d->labelled && d->group_label && d->queue && index_vertex_faces(d);
+    return d->seen && d->memo && d->queue && index_vertex_faces(d);
 }
 
 static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
 {
-    uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->reads[r]);
+    uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->blist.steps[r].leaf);
     const double *mbox = d->j->box[m];
     size_t head = 0, tail = 0;
     uint8_t result = MCI_LABEL_UNKNOWN;
+    uint8_t *memo;
     if (!prepare_search(d))
         return false;
-    if (d->labelled[f] == r + 1) {
-        *label = d->group_label[f];
+    memo = d->memo + r * (d->m->triangle_count + 1);
+    if (memo[f]) {
+        *label = (uint8_t)(memo[f] - 1);
         return true;
     }
     d->search++; /* a fresh search: its marks are new */
@@ -219,50 +205,78 @@ static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
             return false;
         result = (uint8_t)l; /* UNKNOWN only on m's surface, which f does not meet */
     }
-    for (size_t i = 0; i < tail; i++) {
-        d->group_label[d->queue[i]] = result;
-        d->labelled[d->queue[i]] = (uint32_t)r + 1;
-    }
+    for (size_t i = 0; i < tail; i++)
+        memo[d->queue[i]] = (uint8_t)(result + 1);
     *label = result;
     return true;
 }
 
-/* labels[i][r] for every touched face i and read leaf r it does not meet: OUT when its
- * box misses r's, else its group's. A copy of another leaf is that leaf (it has no faces
- * in the scene); a copy of this leaf is SAME, which the pass below leaves UNKNOWN. */
-static bool label_faces(leaf_decision *d)
+/* The label of touched face i with respect to the leaf step k reads, if the face does
+ * not meet it: OUT when its box misses that leaf's, else its group's. A copy of another
+ * leaf is that leaf (it has no faces in the scene); a copy of this one is SAME, left
+ * UNKNOWN here. */
+static bool step_label(leaf_decision *d, size_t i, size_t k, mci_label *label)
 {
-    for (size_t r = 0; r < d->nreads; r++) {
-        uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->reads[r]);
-        for (size_t i = 0; i < d->nfaces; i++) {
-            uint8_t *label = &d->labels[i * d->nreads + r];
-            uint32_t local = d->faces[i] - d->face_base;
-            *label = MCI_LABEL_UNKNOWN;
-            if (m == d->leaf)
+    uint32_t m = mci_scene_leaf_stand_in(d->j->s, d->blist.steps[k].leaf);
+    uint8_t l = MCI_LABEL_UNKNOWN;
+    *label = MCI_LABEL_UNKNOWN;
+    if (m == d->leaf)
+        return true;
+    if (!boxes_meet(d->face_box[i], d->j->box[m]))
+        l = MCI_LABEL_OUT; /* it is outside the box that holds m */
+    else if (!mci_scene_face_touches(d->j->s, d->faces[i], m) &&
+             !group_label(d, d->faces[i] - d->face_base, k, &l))
+        return false;
+    *label = (mci_label)l;
+    return true;
+}
+
+/* Whether some value of touched face i's unknown labels would keep it: the steps jump
+ * only forward, so a sweep in step order from the start marks the steps some way
+ * reaches, reading each step's label only when reached, and stops at the first way to
+ * acceptance (a kept face is found as soon as its way is). */
+static bool may_accept(leaf_decision *d, size_t i, bool *accepts)
+{
+    const mci_blist *b = &d->blist;
+    *accepts = b->start == MCI_BLIST_ACCEPT;
+    if (b->start < 0)
+        return true;
+    d->sweep++;
+    d->reached[b->start] = d->sweep;
+    for (size_t k = (size_t)b->start; k < b->count && !*accepts; k++) {
+        const mci_blist_step *step = &b->steps[k];
+        int32_t to[2] = {step->on_in, step->on_out};
+        mci_label l;
+        if (d->reached[k] != d->sweep)
+            continue;
+        if (!step_label(d, i, k, &l))
+            return false;
+        for (int t = 0; t < 2; t++) {
+            if ((t == 0 && l == MCI_LABEL_OUT) || (t == 1 && l == MCI_LABEL_IN))
                 continue;
-            if (!boxes_meet(d->face_box[i], d->j->box[m]))
-                *label = MCI_LABEL_OUT; /* it is outside the box that holds m */
-            else if (!mci_scene_face_touches(d->j->s, d->faces[i], m) &&
-                     !group_label(d, local, r, label))
-                return false;
+            if (to[t] == MCI_BLIST_ACCEPT || (to[t] >= 0 && to[t] <= (int32_t)k))
+                *accepts = true; /* a backward jump would be a bug: keep the face */
+            else if (to[t] >= 0)
+                d->reached[to[t]] = d->sweep;
         }
     }
     return true;
 }
 
-/* Flag the touched faces whose known labels reject them. */
-static size_t flag_dropped(leaf_decision *d)
+/* Flag the touched faces that no value of their unknown labels would keep. */
+static bool flag_dropped(leaf_decision *d, size_t *n)
 {
-    size_t n = 0;
+    *n = 0;
     for (size_t i = 0; i < d->nfaces; i++) {
-        for (size_t r = 0; r < d->nreads; r++)
-            d->leaf_labels[d->reads[r]] = (mci_label)d->labels[i * d->nreads + r];
-        if (!mci_blist_may_accept(&d->blist, d->leaf_labels, d->step_scratch)) {
+        bool accepts;
+        if (!may_accept(d, i, &accepts))
+            return false;
+        if (!accepts) {
             d->j->s->arr_dropped[d->j->s->arr_of[d->faces[i]]] = 1;
-            n++;
+            ++*n;
         }
     }
-    return n;
+    return true;
 }
 
 static bool collect_faces(leaf_decision *d)
@@ -296,16 +310,13 @@ static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
         for (size_t i = 0; i < d.nfaces; i++)
             j->s->arr_dropped[j->s->arr_of[d.faces[i]]] = 1;
         j->dropped[leaf] = d.nfaces;
-    } else if (ok && d.nfaces > 0 && d.nreads > 0) {
-        d.labels = mci_malloc_array(j->ctx, d.nfaces, d.nreads);
+    } else if (ok && d.nfaces > 0) {
         d.face_box = mci_malloc_array(j->ctx, d.nfaces, sizeof *d.face_box);
-        ok = d.labels && d.face_box;
+        ok = d.face_box != NULL;
         for (size_t i = 0; ok && i < d.nfaces; i++)
             triangle_box(d.m, d.m->triangles + 3 * (size_t)(d.faces[i] - d.face_base),
                          d.face_box[i]);
-        ok = ok && label_faces(&d);
-        if (ok)
-            j->dropped[leaf] = flag_dropped(&d);
+        ok = ok && flag_dropped(&d, &j->dropped[leaf]);
     }
     free_decision(&d);
     return ok ? MCSG_OK : mci_fail_nomem(err, "deciding whole faces");
