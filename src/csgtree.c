@@ -351,7 +351,7 @@ bool mci_blist_build(const mci_ctx *ctx, const mci_ptree *t, const mci_csg_entry
     out->steps = mci_malloc_array(ctx, t->leaf_count + 1, sizeof *out->steps);
     ok = b.value && b.first && b.on_true && b.on_false && out->steps;
     /* Targets of nodes under a decided node are never linked (nothing reaches them):
-     * they stay REJECT rather than undefined, for mci_blist_may_accept's whole pass. */
+     * they stay REJECT rather than undefined, for passes that read every step. */
     for (size_t i = 0; ok && i < nodes; i++)
         b.on_true[i] = b.on_false[i] = MCI_BLIST_REJECT;
     if (ok) {
@@ -382,26 +382,6 @@ bool mci_blist_build(const mci_ctx *ctx, const mci_ptree *t, const mci_csg_entry
     if (!ok)
         mci_blist_free(ctx, out);
     return ok;
-}
-
-/* Steps only jump forward (post-order within an entry, entries in order), so one pass
- * from the last step decides, for each, whether some way through accepts. */
-bool mci_blist_may_accept(const mci_blist *b, const mci_label *leaf_labels, uint8_t *scratch)
-{
-    for (size_t k = b->count; k-- > 0;) {
-        const mci_blist_step *s = &b->steps[k];
-        int32_t on[2] = {s->on_in, s->on_out};
-        mci_label l = leaf_labels[s->leaf];
-        bool may = false;
-        for (int i = 0; i < 2; i++) {
-            if ((i == 0 && l == MCI_LABEL_OUT) || (i == 1 && l == MCI_LABEL_IN))
-                continue;
-            if (on[i] == MCI_BLIST_ACCEPT || (on[i] >= 0 && (on[i] <= (int32_t)k || scratch[on[i]])))
-                may = true; /* a backward jump would be a bug: answer "may" to stay safe */
-        }
-        scratch[k] = may;
-    }
-    return b->start == MCI_BLIST_ACCEPT || (b->start >= 0 && scratch[b->start]);
 }
 
 void mci_blist_free(const mci_ctx *ctx, mci_blist *b)

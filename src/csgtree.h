@@ -134,9 +134,4 @@ void mci_blist_free(const mci_ctx *ctx, mci_blist *b);
  * mci_csglist_accepts). */
 int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels);
 
-/* With some labels UNKNOWN (the others IN or OUT): false when the face is dropped
- * whatever the unknown labels are, true when some of their values would keep it.
- * scratch holds b->count bytes. */
-bool mci_blist_may_accept(const mci_blist *b, const mci_label *leaf_labels, uint8_t *scratch);
-
 #endif

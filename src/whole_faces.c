@@ -16,7 +16,7 @@
  * indices); a group is OUT when one of its vertices lies outside M's bounding box, and
  * otherwise takes the label of an exact ray from one of its vertices (none lies on M's
  * surface). A face is dropped when no value of its unknown labels (those of the leaves
- * it meets) would keep it (mci_blist_may_accept). Everything is exact; a face that is not
+ * it meets) would keep it (a forward sweep of the Blist). Everything is exact; a face that is not
  * decided here goes through the whole classification as before.
  */
 #include "whole_faces.h"
