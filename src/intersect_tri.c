@@ -68,19 +68,29 @@ static void swap_last_two(const double *v[3])
  * > 0 puts t2's first end strictly after t1's last; orient(p1, r1, p2, r2) < 0 likewise
  * puts t2's last end strictly before t1's first. Every corner must be strictly off the
  * other triangle's plane (so no three of these points are collinear). */
-static bool sections_apart(const mci_plane *t1, const int side1[3], const mci_plane *t2,
-                           const int side2[3])
-{
+/* The corners named as above: v1 = p1, q1, r1 and v2 = p2, q2, r2. */
+typedef struct strict_pair {
     const double *v1[3], *v2[3];
+    bool reversed; /* the section runs against n1 x n2 (exactly one triangle renamed) */
+} strict_pair;
+
+static void name_corners(const mci_plane *t1, const int side1[3], const mci_plane *t2,
+                         const int side2[3], strict_pair *c)
+{
     int lone1 = lone_corner(side1), lone2 = lone_corner(side2);
-    corners_from(t1, lone1, v1);
-    corners_from(t2, lone2, v2);
+    corners_from(t1, lone1, c->v1);
+    corners_from(t2, lone2, c->v2);
     if (side1[lone1] < 0)
-        swap_last_two(v2);
+        swap_last_two(c->v2);
     if (side2[lone2] < 0)
-        swap_last_two(v1);
-    return mci_orient3d_vertices(v1[0], v1[1], v2[0], v2[1]) > 0 ||
-           mci_orient3d_vertices(v1[0], v1[2], v2[0], v2[2]) < 0;
+        swap_last_two(c->v1);
+    c->reversed = side1[lone1] * side2[lone2] < 0;
+}
+
+static bool sections_apart(const strict_pair *c)
+{
+    return mci_orient3d_vertices(c->v1[0], c->v1[1], c->v2[0], c->v2[1]) > 0 ||
+           mci_orient3d_vertices(c->v1[0], c->v1[2], c->v2[0], c->v2[2]) < 0;
 }
 
 /* The corner of t1 that is t1's only contact with t2's plane (one side 0, the other two
@@ -113,6 +123,38 @@ static void edge_crossing(mci_point *out, const double *u, const double *v,
     bool swap = mci_vertex_before(v, u);
     /* The sides differ strictly, so the line is not parallel to the plane. */
     (void)mci_point_lpi(out, swap ? v : u, swap ? u : v, plane);
+}
+
+/* The overlap of sections that are not apart (every corner strictly off the other
+ * plane), with the names above: t1's section runs from I (on p1-r1) to J (on p1-q1), t2's
+ * from K (on p2-q2) to L (on p2-r2). The plane (p1, r1, p2) holds I and p2, so for a
+ * point X of the line, orient(p1, r1, p2, X) is > 0 after I, < 0 before it (as in
+ * sections_apart), and for K, on the segment from p2 to q2, it has q2's sign; likewise
+ * (p1, q1, p2) against J, with L taking r2's sign. So the overlap [max(I, K), min(J, L)]
+ * is known before any point is built, and only its two ends are (on a tie, t1's copy, as
+ * overlap_on_line keeps). It is a single point only when K = J or L = I. */
+static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const strict_pair *c,
+                           mci_tt_result *out)
+{
+    const double *p1 = c->v1[0], *q1 = c->v1[1], *r1 = c->v1[2];
+    const double *p2 = c->v2[0], *q2 = c->v2[1], *r2 = c->v2[2];
+    bool start_k = mci_orient3d_vertices(p1, r1, p2, q2) > 0;
+    bool end_l = mci_orient3d_vertices(p1, q1, p2, r2) < 0;
+    bool single = start_k && !end_l ? mci_orient3d_vertices(p1, q1, p2, q2) == 0
+                  : !start_k && end_l ? mci_orient3d_vertices(p1, r1, p2, r2) == 0
+                                      : false;
+    mci_point *first = &out->end[c->reversed && !single], *last = &out->end[!c->reversed];
+    if (start_k)
+        edge_crossing(first, p2, q2, t1);
+    else
+        edge_crossing(first, p1, r1, t2);
+    out->kind = single ? MCI_TT_POINT : MCI_TT_SEGMENT;
+    if (single)
+        return;
+    if (end_l)
+        edge_crossing(last, p2, r2, t1);
+    else
+        edge_crossing(last, p1, q1, t2);
 }
 
 /* t ∩ plane as 1 or 2 points (t not coplanar with the plane, not strictly on a side). */
@@ -219,9 +261,13 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
     vertex_sides(t2, t1, side2);
     if (all_strictly_one_side(side2))
         return;
-    if (all_sides_strict(side1) && all_sides_strict(side2) &&
-        sections_apart(t1, side1, t2, side2))
+    if (all_sides_strict(side1) && all_sides_strict(side2)) {
+        strict_pair c;
+        name_corners(t1, side1, t2, side2, &c);
+        if (!sections_apart(&c))
+            strict_overlap(t1, t2, &c, out);
         return;
+    }
     if (side1[0] == 0 && side1[1] == 0 && side1[2] == 0) {
         out->kind = MCI_TT_COPLANAR;
         out->overlap = coplanar_interiors_overlap(t1, t2);
