@@ -131,8 +131,9 @@ static void edge_crossing(mci_point *out, const double *u, const double *v,
  * point X of the line, orient(p1, r1, p2, X) is > 0 after I, < 0 before it (as in
  * sections_apart), and for K, on the segment from p2 to q2, it has q2's sign; likewise
  * (p1, q1, p2) against J, with L taking r2's sign. So the overlap [max(I, K), min(J, L)]
- * is known before any point is built, and only its two ends are (on a tie, t1's copy, as
- * overlap_on_line keeps). It is a single point only when K = J or L = I. */
+ * is known before any point is built, and only its two ends are (on a tie between the
+ * sections' ends, t1's copy, as overlap_on_line keeps). It is a single point only when
+ * K = J or L = I. */
 static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const strict_pair *c,
                            mci_tt_result *out)
 {
@@ -143,18 +144,24 @@ static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const stric
     bool single = start_k && !end_l ? mci_orient3d_vertices(p1, q1, p2, q2) == 0
                   : !start_k && end_l ? mci_orient3d_vertices(p1, r1, p2, r2) == 0
                                       : false;
-    mci_point *first = &out->end[c->reversed && !single], *last = &out->end[!c->reversed];
-    if (start_k)
-        edge_crossing(first, p2, q2, t1);
-    else
-        edge_crossing(first, p1, r1, t2);
+    mci_point *start = &out->end[c->reversed], *end = &out->end[!c->reversed];
     out->kind = single ? MCI_TT_POINT : MCI_TT_SEGMENT;
+    /* A single point is the copy overlap_on_line keeps: the later start along n1 x n2,
+     * which is the section's end when the section runs against it. */
     if (single)
-        return;
-    if (end_l)
-        edge_crossing(last, p2, r2, t1);
-    else
-        edge_crossing(last, p1, q1, t2);
+        start = end = &out->end[0];
+    if (!single || !c->reversed) {
+        if (start_k)
+            edge_crossing(start, p2, q2, t1);
+        else
+            edge_crossing(start, p1, r1, t2);
+    }
+    if (!single || c->reversed) {
+        if (end_l)
+            edge_crossing(end, p2, r2, t1);
+        else
+            edge_crossing(end, p1, q1, t2);
+    }
 }
 
 /* t ∩ plane as 1 or 2 points (t not coplanar with the plane, not strictly on a side). */
