@@ -47,7 +47,9 @@ typedef struct leaf_decision {
     double (*face_box)[6];   /* per touched face */
     uint32_t *vf_start, *vf_face; /* faces around each vertex (CSR) */
     uint32_t *seen;          /* per face: the last search that reached it */
-    uint8_t *memo;           /* per step and face: 1 + the label found by a search, or 0 */
+    uint8_t *memo;           /* per step and touched face: 1 + the label found by a search,
+                                or 0 */
+    bool no_search;          /* the memo would be too large: searched labels stay unknown */
     uint32_t *queue, search;
     mci_ray_scratch ray;
 } leaf_decision;
@@ -148,19 +150,35 @@ static bool reaches_outside(const leaf_decision *d, uint32_t f, const double mbo
  * stops at the first one reaching outside m's box (OUT); a group wholly inside the box
  * takes the label of a ray from one of its vertices (none lies on m's surface). Every
  * face the search reaches gets the same label, so later faces of the group are free. */
+/* Bytes the memo of one leaf may take (beyond, its faces are left to the classification
+ * rather than failing or taking memory out of proportion: a big model read against
+ * hundreds of leaves). */
+#define MEMO_LIMIT ((size_t)1 << 26)
+
 /* The search's arrays, made at the first search (most leaves need none: their touched
  * faces meet the leaves their CSGlist reads, as in a difference of two models). */
 static bool prepare_search(leaf_decision *d)
 {
     size_t nt = d->m->triangle_count + 1;
-    if (d->queue)
+    if (d->queue || d->no_search)
         return true;
-    if (d->blist.count > SIZE_MAX / nt)
-        return false;
+    if (d->blist.count > MEMO_LIMIT / d->nfaces) {
+        d->no_search = true;
+        return true;
+    }
     d->seen = mci_calloc_array(d->j->ctx, nt, sizeof *d->seen);
-    d->memo = mci_calloc_array(d->j->ctx, d->blist.count * nt, 1);
+    d->memo = mci_calloc_array(d->j->ctx, d->blist.count * d->nfaces, 1);
     d->queue = mci_malloc_array(d->j->ctx, nt, sizeof *d->queue);
     return d->seen && d->memo && d->queue && index_vertex_faces(d);
+}
+
+/* The memo slot of local face f, or NULL when f is not touched. The touched faces of a
+ * leaf have consecutive arrangement numbers, in face order, as d->faces lists them. */
+static uint8_t *memo_slot(const leaf_decision *d, uint8_t *row, uint32_t f)
+{
+    const mci_scene *s = d->j->s;
+    uint32_t a = s->arr_of[d->face_base + f];
+    return a == MCI_NONE ? NULL : row + (a - s->arr_of[d->faces[0]]);
 }
 
 static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
@@ -169,12 +187,17 @@ static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
     const double *mbox = d->j->box[m];
     size_t head = 0, tail = 0;
     uint8_t result = MCI_LABEL_UNKNOWN;
-    uint8_t *memo;
+    uint8_t *memo, *slot;
     if (!prepare_search(d))
         return false;
-    memo = d->memo + r * (d->m->triangle_count + 1);
-    if (memo[f]) {
-        *label = (uint8_t)(memo[f] - 1);
+    if (d->no_search) {
+        *label = MCI_LABEL_UNKNOWN;
+        return true;
+    }
+    memo = d->memo + r * d->nfaces;
+    slot = memo_slot(d, memo, f);
+    if (*slot) {
+        *label = (uint8_t)(*slot - 1);
         return true;
     }
     d->search++; /* a fresh search: its marks are new */
@@ -206,7 +229,8 @@ static bool group_label(leaf_decision *d, uint32_t f, size_t r, uint8_t *label)
         result = (uint8_t)l; /* UNKNOWN only on m's surface, which f does not meet */
     }
     for (size_t i = 0; i < tail; i++)
-        memo[d->queue[i]] = (uint8_t)(result + 1);
+        if ((slot = memo_slot(d, memo, d->queue[i])) != NULL)
+            *slot = (uint8_t)(result + 1);
     *label = result;
     return true;
 }
@@ -263,12 +287,40 @@ static bool may_accept(leaf_decision *d, size_t i, bool *accepts)
     return true;
 }
 
+/* Whether a point at `where` lies on the closed edge e (corner e to corner e + 1). */
+static bool on_closed_edge(uint8_t where, int e)
+{
+    return where == MCI_AT_EDGE + e || where == MCI_AT_CORNER + e ||
+           where == MCI_AT_CORNER + (e + 1) % 3;
+}
+
+/* Whether another surface meets the face along part of its border: a constraint segment
+ * with both ends on one edge. Once split, such a face has elementary edges along the
+ * border, and the classification of the neighbour across it reads them as separators
+ * (its own arrangement may have none there, e.g. when it is coplanar with that surface):
+ * dropping the face would take them away, so it is left to the classification. */
+static bool meets_surface_along_border(const mci_face_arr *arr)
+{
+    for (size_t k = 0; k < arr->segment_count; k++) {
+        const mci_arr_segment *g = &arr->segments[k];
+        if (g->phantom)
+            continue;
+        for (int e = 0; e < 3; e++)
+            if (on_closed_edge(arr->where[g->a], e) && on_closed_edge(arr->where[g->b], e))
+                return true;
+    }
+    return false;
+}
+
 /* Flag the touched faces that no value of their unknown labels would keep. */
 static bool flag_dropped(leaf_decision *d, size_t *n)
 {
+    const mci_scene *s = d->j->s;
     *n = 0;
     for (size_t i = 0; i < d->nfaces; i++) {
         bool accepts;
+        if (meets_surface_along_border(&s->arrs[s->arr_of[d->faces[i]]]))
+            continue;
         if (!may_accept(d, i, &accepts))
             return false;
         if (!accepts) {

@@ -156,7 +156,7 @@ static size_t solid_dropping(const char *text, double volume, size_t components)
 TEST(buried_faces_are_dropped_whole)
 {
     const char *two = "translate([2,2,2]) cube(3); translate([3,3,3]) cube(3);";
-    char text[256];
+    char text[512];
     snprintf(text, sizeof text, "union() { cube(10); %s }", two);
     CHECK(solid_dropping(text, 1000, 1) > 0);
     snprintf(text, sizeof text, "union() { %s cube(10); }", two);
@@ -173,6 +173,26 @@ TEST(buried_faces_are_dropped_whole)
     CHECK(solid_dropping("union() { cube(10); translate([8,8,8]) cube(4);"
                          " translate([7,7,7]) cube(2); }",
                          1000 + 64 - 8, 1) > 0);
+    /* The pyramid's top lies in the big cube's bottom plane and the small box crosses
+     * it; its sides, outside the box, are dropped whole only if the big cube does not
+     * meet them along the top's edges: those edges are the top's only separators with
+     * the cube (a face meeting a surface along its border is never dropped whole). */
+    {
+        const char *down = "polyhedron(points=[[1,1,0],[9,1,0],[5,9,0],[5,4,-3]], "
+                           "faces=[[0,2,1],[0,1,3],[1,2,3],[2,0,3]]);";
+        const char *up = "polyhedron(points=[[1,1,0],[9,1,0],[5,9,0],[5,4,3]], "
+                         "faces=[[0,1,2],[0,3,1],[1,3,2],[2,3,0]]);";
+        const char *box = "translate([4,3,-0.5]) cube([2,2,1]);";
+        snprintf(text, sizeof text, "intersection() { %s union() { cube(10); %s } }", box,
+                 down);
+        expect_solid(text, 4, 1);
+        snprintf(text, sizeof text, "intersection() { %s union() { cube(10); %s } }", box, up);
+        expect_solid(text, 2, 1);
+        snprintf(text, sizeof text,
+                 "intersection() { %s difference() { %s translate([0,0,-10]) cube(10); } }",
+                 box, down);
+        expect_empty(text);
+    }
 }
 
 static size_t solid_copies(const char *text, double volume, size_t components)
