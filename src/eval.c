@@ -365,9 +365,12 @@ static mcsg_status step(eval_state *e, const char *name, step_fn fn, mcsg_error 
  * place, say): then the earlier one stands for the later in the whole evaluation. */
 static bool same_mesh(const mcsg_mesh *a, const mcsg_mesh *b)
 {
+    /* Empty arrays may be NULL, which memcmp must not see even for 0 bytes. */
     return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
-           memcmp(a->vertices, b->vertices, 3 * a->vertex_count * sizeof *a->vertices) == 0 &&
-           memcmp(a->triangles, b->triangles, 3 * a->triangle_count * sizeof *a->triangles) == 0;
+           (a->vertex_count == 0 ||
+            memcmp(a->vertices, b->vertices, 3 * a->vertex_count * sizeof *a->vertices) == 0) &&
+           (a->triangle_count == 0 ||
+            memcmp(a->triangles, b->triangles, 3 * a->triangle_count * sizeof *a->triangles) == 0);
 }
 
 typedef struct leaf_ref {
