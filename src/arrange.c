@@ -340,6 +340,7 @@ bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
                           const mci_plane *other_plane, const bool crease[3], uint32_t group)
 {
     const double *v[3] = {other_plane->a, other_plane->b, other_plane->c};
+    arr->coplanar = true;
     /* An identical face (identical operands): every edge lies along an edge of this face,
      * so clipping would only add its two ends; the same points, without the tests. */
     if (is_twin(arr, v)) {

@@ -68,6 +68,7 @@ typedef struct mci_face_arr {
     uint32_t *adj;       /* ... and the side across each side (mci_cdt_output.adj) */
     size_t tri_count;
     bool dirty;          /* points were added since the last merge */
+    bool coplanar;       /* a coplanar face of another leaf was added */
 } mci_face_arr;
 
 /* Start the arrangement of face `face` with corners a, b, c (non-degenerate).

@@ -294,13 +294,20 @@ static bool on_closed_edge(uint8_t where, int e)
            where == MCI_AT_CORNER + (e + 1) % 3;
 }
 
-/* Whether another surface meets the face along part of its border: a constraint segment
- * with both ends on one edge. Once split, such a face has elementary edges along the
- * border, and the classification of the neighbour across it reads them as separators
- * (its own arrangement may have none there, e.g. when it is coplanar with that surface):
- * dropping the face would take them away, so it is left to the classification. */
-static bool meets_surface_along_border(const mci_face_arr *arr)
+/* Whether the face's pieces may carry what a neighbour's classification needs, so that
+ * it must not be dropped whole (its neighbours' sides along it become walls, which no
+ * region crosses):
+ * - another surface meets it along part of its border (a constraint segment with both
+ *   ends on one edge): once split, it has elementary edges there, and the neighbour
+ *   across reads them as separators (its own arrangement may have none there, when it
+ *   is coplanar with that surface);
+ * - it lies in another leaf's surface (a coplanar face): a neighbour in the same plane
+ *   has no side of that leaf to test along their common edge, and its regions take
+ *   their label from across it, from where the flat part of the surface ends. */
+static bool must_keep_pieces(const mci_face_arr *arr)
 {
+    if (arr->coplanar)
+        return true;
     for (size_t k = 0; k < arr->segment_count; k++) {
         const mci_arr_segment *g = &arr->segments[k];
         if (g->phantom)
@@ -319,7 +326,7 @@ static bool flag_dropped(leaf_decision *d, size_t *n)
     *n = 0;
     for (size_t i = 0; i < d->nfaces; i++) {
         bool accepts;
-        if (meets_surface_along_border(&s->arrs[s->arr_of[d->faces[i]]]))
+        if (must_keep_pieces(&s->arrs[s->arr_of[d->faces[i]]]))
             continue;
         if (!may_accept(d, i, &accepts))
             return false;

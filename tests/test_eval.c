@@ -192,6 +192,15 @@ TEST(buried_faces_are_dropped_whole)
                  "intersection() { %s difference() { %s translate([0,0,-10]) cube(10); } }",
                  box, down);
         expect_empty(text);
+        /* The same with the pyramid's top cut into a middle triangle, which the box
+         * crosses, and a ring of triangles around it: the ring lies in the cube's bottom
+         * face (and is not dropped whole) so the middle triangle's regions reach the
+         * cube's separators along the top's outer edges through it. */
+        expect_solid("intersection() { translate([4.8,3.4,-0.5]) cube([0.4,0.4,1]);"
+                     " union() { cube(10); polyhedron(points=[[1,1,0],[9,1,0],[5,9,0],"
+                     "[5,4,-3],[4,3,0],[6,3,0],[5,5,0]], faces=[[4,6,5],[0,5,1],[0,4,5],"
+                     "[1,6,2],[1,5,6],[2,4,0],[2,6,4],[0,1,3],[1,2,3],[2,0,3]]); } }",
+                     0.16, 1);
     }
 }
 
