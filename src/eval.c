@@ -23,6 +23,7 @@ typedef struct eval_state {
     mci_classifier cl;
     mci_kept kept;
     mcsg_eval_stats stats;
+    bool no_whole_faces; /* split and classify every touched face (the fallback in run) */
 } eval_state;
 
 static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
@@ -443,7 +444,7 @@ static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
         st = mci_scene_build_unsplit(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
                                      e->tree.leaf_count, e->alias, &e->scene, err);
     double t0 = mci_seconds_now();
-    if (st == MCSG_OK)
+    if (st == MCSG_OK && !e->no_whole_faces)
         st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,
                                     err);
     e->stats.seconds_whole_faces = mci_seconds_now() - t0;
@@ -453,6 +454,40 @@ static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
         st = mci_scene_number_points(&e->ctx, &e->scene, err);
     e->stats.intersect = e->scene.stats;
     return st;
+}
+
+/* Intersection, triangulation and classification. */
+static mcsg_status evaluate_faces(eval_state *e, mcsg_error *err)
+{
+    mcsg_status st = step(e, "intersect", intersect_step, err);
+    if (st == MCSG_OK)
+        st = step(e, "triangulate", triangulate_all, err);
+    if (st == MCSG_OK)
+        st = step(e, "classify", classify_all, err);
+    return st;
+}
+
+/* Faces dropped whole leave walls in their neighbours' regions, and a region's labels
+ * come only from its own side of them. Where a degenerate arrangement has a region that
+ * then cannot be labelled (no case is known: whole_faces.c keeps the pieces of faces
+ * that other surfaces meet along their border or lie in), the faces are evaluated again
+ * without that step, as every face was before it existed: slower, never wrong. */
+static mcsg_status evaluate_faces_safely(eval_state *e, mcsg_error *err)
+{
+    mcsg_eval_stats before = e->stats;
+    mcsg_status st = evaluate_faces(e, err);
+    if (st != MCSG_ERR_INTERNAL || e->stats.faces_dropped_whole == 0)
+        return st;
+    mci_log(&e->ctx, MCSG_LOG_INFO, "faces dropped whole left a region undecided (%s): "
+            "evaluating again with every touched face split", err ? err->message : "");
+    mci_classifier_free(&e->ctx, &e->cl);
+    mci_kept_free(&e->ctx, &e->kept);
+    mci_scene_free(&e->ctx, &e->scene);
+    mci_free(&e->ctx, e->alias);
+    e->alias = NULL;
+    e->stats = before;
+    e->no_whole_faces = true;
+    return evaluate_faces(e, err);
 }
 
 static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
@@ -471,11 +506,7 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     e->stats.seconds_check = mci_seconds_now() - t0;
     if (st != MCSG_OK)
         return st;
-    st = step(e, "intersect", intersect_step, err);
-    if (st == MCSG_OK)
-        st = step(e, "triangulate", triangulate_all, err);
-    if (st == MCSG_OK)
-        st = step(e, "classify", classify_all, err);
+    st = evaluate_faces_safely(e, err);
     if (st == MCSG_OK) {
         mci_progress(&e->ctx, "assemble", 0);
         st = assemble(e, out, provenance, err);
