@@ -436,13 +436,51 @@ static mcsg_status find_copies(eval_state *e, mcsg_error *err)
     return MCSG_OK;
 }
 
+/* Whether a primitive with copies has a face in another primitive's surface (a coplanar
+ * face). The classification of copies does not combine their labels correctly with such a
+ * third coincident surface (differential fuzzing found an extra piece of the shared plane,
+ * an edge with four triangles, where evaluating every primitive on its own is right), so
+ * those trees are evaluated without copies. */
+static mcsg_status copies_meet_coplanar_faces(eval_state *e, bool *meet, mcsg_error *err)
+{
+    const mci_scene *s = &e->scene;
+    size_t n = e->tree.leaf_count;
+    uint8_t *has_copies = mci_calloc_array(&e->ctx, n + 1, 1);
+    *meet = false;
+    if (!has_copies)
+        return mci_fail_nomem(err, "comparing the leaves");
+    for (size_t l = 0; l < n; l++)
+        has_copies[e->alias[l]] |= e->alias[l] != l;
+    for (size_t k = 0; k < s->arr_count && !*meet; k++)
+        *meet = s->arrs[k].coplanar && has_copies[s->octree.face_leaf[s->arrs[k].face]];
+    mci_free(&e->ctx, has_copies);
+    return MCSG_OK;
+}
+
+/* The scene of the pair tests and arrangements, through copies where they are safe. */
+static mcsg_status build_scene(eval_state *e, mcsg_error *err)
+{
+    const mcsg_mesh *const *leaves = (const mcsg_mesh *const *)e->tree.leaf_mesh;
+    bool coplanar = false;
+    mcsg_status st = find_copies(e, err);
+    if (st == MCSG_OK)
+        st = mci_scene_build_unsplit(&e->ctx, leaves, e->tree.leaf_count, e->alias, &e->scene,
+                                     err);
+    if (st == MCSG_OK && e->alias)
+        st = copies_meet_coplanar_faces(e, &coplanar, err);
+    if (st != MCSG_OK || !coplanar)
+        return st;
+    mci_scene_free(&e->ctx, &e->scene);
+    mci_free(&e->ctx, e->alias);
+    e->alias = NULL;
+    e->stats.copied_primitives = 0;
+    return mci_scene_build_unsplit(&e->ctx, leaves, e->tree.leaf_count, NULL, &e->scene, err);
+}
+
 /* Faces that the result drops whole are found before splitting, which they then skip. */
 static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
 {
-    mcsg_status st = find_copies(e, err);
-    if (st == MCSG_OK)
-        st = mci_scene_build_unsplit(&e->ctx, (const mcsg_mesh *const *)e->tree.leaf_mesh,
-                                     e->tree.leaf_count, e->alias, &e->scene, err);
+    mcsg_status st = build_scene(e, err);
     double t0 = mci_seconds_now();
     if (st == MCSG_OK && !e->no_whole_faces)
         st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,

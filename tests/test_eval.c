@@ -214,22 +214,28 @@ static size_t solid_copies(const char *text, double volume, size_t components)
  * cases put both copies' faces in the result, in parts of one face, complemented. */
 TEST(copies_are_evaluated_once)
 {
-    const char *a = "cube(4);", *c = "translate([2,0,0]) cube(4);";
+    const char *a = "cube(4);", *c = "translate([2,0.5,0.5]) cube([4,3,3]);";
     char text[256];
     /* (A n C) u (A' - C'): the faces of A are kept partly by A, partly by A'. */
     snprintf(text, sizeof text, "union() { intersection() { %s %s } difference() { %s %s } }",
              a, c, a, c);
     CHECK_EQ_SIZE(solid_copies(text, 64, 1), 2);
     snprintf(text, sizeof text, "difference() { %s intersection() { %s %s } }", a, a, c);
-    CHECK_EQ_SIZE(solid_copies(text, 32, 1), 1);
+    CHECK_EQ_SIZE(solid_copies(text, 46, 1), 1);
     snprintf(text, sizeof text, "difference() { union() { %s %s } %s }", a, c, a);
-    CHECK_EQ_SIZE(solid_copies(text, 32, 1), 1);
+    CHECK_EQ_SIZE(solid_copies(text, 18, 1), 1);
     snprintf(text, sizeof text, "union() { difference() { %s %s } %s %s }", c, a, a, a);
-    CHECK_EQ_SIZE(solid_copies(text, 96, 1), 2);
+    CHECK_EQ_SIZE(solid_copies(text, 82, 1), 2);
     /* A copy of a leaf that another leaf crosses, and a copy of that one. */
     CHECK_EQ_SIZE(solid_copies("intersection() { union() { cube(4); sphere(1, $fn=8); }"
                                " union() { cube(4); translate([5,0,0]) cube(1); } }", 64, 1),
                   1);
+    /* A copied leaf with faces in another leaf's faces (C's sides in A's planes): the
+     * copies' classification does not handle the third coincident surface, so the tree
+     * is evaluated without copies (tests/data/csg-regressions/copies-coplanar-*). */
+    snprintf(text, sizeof text, "union() { intersection() { %s %s } difference() { %s %s } }",
+             a, "translate([2,0,0]) cube(4);", a, "translate([2,0,0]) cube(4);");
+    CHECK_EQ_SIZE(solid_copies(text, 64, 1), 0);
 }
 
 TEST(touching_solids)
