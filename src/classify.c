@@ -24,6 +24,7 @@
 #include "classify.h"
 #include "triangulate.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -1267,22 +1268,110 @@ static void region_labels(leaf_work *w, size_t r, uint32_t as)
         w->leaf_labels[w->leaf] = mci_label_reverse(w->leaf_labels[w->leaf]);
 }
 
+/* A point strictly inside the triangle a, b, c (input vertices): where a line through its
+ * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
+ * vertices; `ends` holds the line's two ends, which the point refers to). False when the
+ * doubles do not give a line crossing the plane or a point strictly inside (slivers). */
+static bool point_inside_triangle(const double *a, const double *b, const double *c,
+                                  double ends[2][3], mci_point *out)
+{
+    double e1[3], e2[3], n[3], size = 0, norm = 0;
+    mci_plane plane;
+    mci_point corner[3];
+    int axis, sign, turns[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        size = fmax(size, fmax(fabs(e1[k]), fabs(e2[k])));
+    }
+    for (int k = 0; k < 3; k++) {
+        n[k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
+        norm = fmax(norm, fabs(n[k]));
+    }
+    if (!(norm > 0) || !(size > 0) || !isfinite(norm))
+        return false;
+    for (int k = 0; k < 3; k++) {
+        double centre = (a[k] + b[k] + c[k]) / 3, step = n[k] / norm * size;
+        ends[0][k] = centre + step;
+        ends[1][k] = centre - step;
+    }
+    mci_plane_init(&plane, a, b, c);
+    if (mci_orient3d_vertices(a, b, c, ends[0]) * mci_orient3d_vertices(a, b, c, ends[1]) >= 0 ||
+        !mci_point_lpi(out, ends[0], ends[1], &plane) ||
+        (axis = mci_plane_projection_axis(&plane, &sign)) < 0)
+        return false;
+    mci_point_explicit(&corner[0], a);
+    mci_point_explicit(&corner[1], b);
+    mci_point_explicit(&corner[2], c);
+    for (int i = 0; i < 3; i++)
+        turns[i] = mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], out, axis);
+    return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
+}
+
+/* The region's labels still unknown when its labels do not decide it: rays from a point
+ * strictly inside one of its pieces with input corners. The seeds cast rays from region
+ * vertices only; when every vertex lies on a leaf's surface and no side of the region is
+ * on it (faces touching that leaf only at their corners), the inside of a piece still
+ * tells. False when nothing was learnt. */
+static bool labels_from_inside(leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    bool learnt = false;
+    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && !learnt; k++) {
+        mci_point v[3], probe;
+        double ends[2][3];
+        uint32_t p = w->reg_pieces[k];
+        for (int i = 0; i < 3; i++)
+            piece_point(w, p, i, &v[i]);
+        if (v[0].kind != MCI_POINT_EXPLICIT || v[1].kind != MCI_POINT_EXPLICIT ||
+            v[2].kind != MCI_POINT_EXPLICIT ||
+            !point_inside_triangle(v[0].v[0], v[1].v[0], v[2].v[0], ends, &probe))
+            continue;
+        for (size_t c = 0; c < w->ncand; c++) {
+            mci_label label;
+            if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
+                continue;
+            w->stats->rays++;
+            if (!mci_ray_label_octree(w->ctx, &probe, &w->s->octree, w->cand[c], &w->ray,
+                                      &label)) {
+                w->out_of_memory = true;
+                return false;
+            }
+            lab[c] = (uint8_t)label;
+            learnt = learnt || label != MCI_LABEL_UNKNOWN;
+        }
+    }
+    return learnt;
+}
+
+/* Whether region r is kept, for this leaf or its copy k (-1: its labels do not tell). */
+static int region_accepts(leaf_work *w, uint32_t r, size_t k)
+{
+    const mci_ptree *t = w->cl->tree;
+    bool self = k == w->ncopies;
+    int accepts;
+    region_labels(w, r, self ? w->leaf : w->copies[k]);
+    /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
+    accepts = self ? mci_blist_accepts(&w->blist, w->leaf_labels) : -1;
+    if (accepts < 0)
+        accepts = self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch)
+                       : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k],
+                                             w->leaf_labels, w->scratch);
+    return accepts;
+}
+
 /* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
 static mcsg_status decide_regions(leaf_work *w, size_t k, uint8_t *keep)
 {
-    const mci_ptree *t = w->cl->tree;
     bool self = k == w->ncopies, rejected = self ? w->rejected : w->copy_nlist[k] == SIZE_MAX;
-    for (size_t r = 0; r < w->nreg; r++) {
+    for (uint32_t r = 0; r < w->nreg; r++) {
         int accepts = 0;
         if (!rejected) {
-            region_labels(w, r, self ? w->leaf : w->copies[k]);
-            /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
-            accepts = self ? mci_blist_accepts(&w->blist, w->leaf_labels) : -1;
-            if (accepts < 0)
-                accepts = self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels,
-                                                     w->scratch)
-                               : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k],
-                                                     w->leaf_labels, w->scratch);
+            accepts = region_accepts(w, r, k);
+            if (accepts < 0 && labels_from_inside(w, r))
+                accepts = region_accepts(w, r, k);
+            if (w->out_of_memory)
+                return mci_fail_nomem(w->err, "classifying faces");
             if (accepts < 0)
                 return mci_fail(w->err, MCSG_ERR_INTERNAL,
                                 "leaf %u: a region's label could not be decided", w->leaf);

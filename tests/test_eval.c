@@ -240,6 +240,24 @@ TEST(copies_are_evaluated_once)
 
 TEST(touching_solids)
 {
+    /* An octahedron in a cube, its corners at the centres of the cube's faces: its faces
+     * meet the cube only at their corners, so every vertex lies on the cube's surface and
+     * no side of a piece does; the label comes from a point inside a face. */
+    {
+        const char *oct = "translate([2,2,2]) polyhedron(points=[[1,0,0],[-1,0,0],[0,1,0],"
+                          "[0,-1,0],[0,0,1],[0,0,-1]], faces=[[0,4,2],[0,2,5],[0,3,4],"
+                          "[0,5,3],[1,2,4],[1,5,2],[1,4,3],[1,3,5]]);";
+        const char *box = "translate([1,1,1]) cube(2);";
+        char text[512];
+        snprintf(text, sizeof text, "union() { %s %s }", oct, box);
+        expect_solid(text, 8, 1);
+        snprintf(text, sizeof text, "intersection() { %s %s }", oct, box);
+        expect_solid(text, 4.0 / 3, 1);
+        snprintf(text, sizeof text, "difference() { %s %s }", oct, box);
+        expect_empty(text);
+        snprintf(text, sizeof text, "difference() { %s %s }", box, oct);
+        expect_solid(text, 8 - 4.0 / 3, 2);
+    }
     /* B touches A on a face: A - B = A, A u B fuses into one box. */
     expect_solid("difference() { cube(2); translate([2,0,0]) cube(2); }", 8, 1);
     expect_solid("difference() { cube(2); translate([2,0.5,0.5]) cube(1); }", 8, 1);
