@@ -92,9 +92,10 @@ typedef struct mcsg_options {
     mcsg_allocator allocator; /* zero: malloc/realloc/free */
     mcsg_log_fn log;          /* NULL: messages are dropped */
     void *log_user;           /* passed to log */
-    int threads;              /* worker threads for evaluation; 0: all cores. With more
-                                 than one, the allocator is called from several threads
-                                 at once and must be thread-safe (malloc is) */
+    int threads;              /* worker threads for evaluation and for writing text
+                                 meshes; 0: all cores. With more than one, the allocator
+                                 is called from several threads at once and must be
+                                 thread-safe (malloc is). Results do not depend on it */
     mcsg_progress_fn progress; /* NULL: no progress reports */
     void *progress_user;       /* passed to progress */
     int check_self_intersections; /* mcsg_eval: nonzero tests every leaf for

@@ -343,34 +343,88 @@ void mci_io_commit_text(mci_buf *out, const char *stop)
     out->len = (size_t)(stop - (const char *)out->data);
 }
 
+/* Text records are formatted in blocks, several blocks at once on the context's threads,
+ * each into its own buffer, and appended in block order: the text does not depend on the
+ * thread count. Blocks go in waves so that only a wave's text is held twice. */
+enum { RECORD_BLOCK = 4096, RECORD_WAVE = 32 };
+
+typedef struct record_job {
+    const mci_ctx *ctx;
+    const mcsg_mesh *mesh;
+    const char *vertex_prefix, *triangle_prefix;
+    uint32_t index_base;
+    size_t vertex_blocks; /* blocks 0 .. vertex_blocks-1 hold vertices, the rest triangles */
+    size_t first_block;   /* of the current wave */
+    mci_buf *text;        /* per block of the wave */
+} record_job;
+
+static char *put_vertex(char *p, const char *prefix, const double *xyz)
+{
+    p = mci_io_put_text(p, prefix);
+    for (int k = 0; k < 3; k++) {
+        p = mci_io_put_double(p, xyz[k]);
+        *p++ = k < 2 ? ' ' : '\n';
+    }
+    return p;
+}
+
+static char *put_triangle(char *p, const char *prefix, const uint32_t *abc, uint32_t base)
+{
+    p = mci_io_put_text(p, prefix);
+    for (int k = 0; k < 3; k++) {
+        p = mci_io_put_uint(p, (uint64_t)abc[k] + base);
+        *p++ = k < 2 ? ' ' : '\n';
+    }
+    return p;
+}
+
+static mcsg_status format_record_block(void *user, size_t i, mcsg_error *err)
+{
+    const record_job *j = user;
+    const mcsg_mesh *m = j->mesh;
+    size_t block = j->first_block + i;
+    bool vertices = block < j->vertex_blocks;
+    size_t first = (vertices ? block : block - j->vertex_blocks) * RECORD_BLOCK;
+    size_t total = vertices ? m->vertex_count : m->triangle_count;
+    size_t end = total - first < RECORD_BLOCK ? total : first + RECORD_BLOCK;
+    size_t room = vertices ? strlen(j->vertex_prefix) + 3 * MCI_DOUBLE_TEXT_MAX + 3
+                           : strlen(j->triangle_prefix) + 3 * 21 + 3;
+    char *p;
+    (void)err;
+    if (end - first > SIZE_MAX / room || !(p = mci_io_reserve_text(j->ctx, &j->text[i],
+                                                                   (end - first) * room)))
+        return MCSG_ERR_NOMEM;
+    for (size_t r = first; r < end; r++)
+        p = vertices ? put_vertex(p, j->vertex_prefix, m->vertices + 3 * r)
+                     : put_triangle(p, j->triangle_prefix, m->triangles + 3 * r, j->index_base);
+    mci_io_commit_text(&j->text[i], p);
+    return MCSG_OK;
+}
+
 mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
                                       const char *vertex_prefix, const char *triangle_prefix,
                                       uint32_t index_base, mci_buf *out)
 {
-    size_t prefix_room = strlen(vertex_prefix) + strlen(triangle_prefix);
-    char *p;
-    for (size_t i = 0; i < mesh->vertex_count; i++) {
-        if (!(p = mci_io_reserve_text(ctx, out, 3 * MCI_DOUBLE_TEXT_MAX + prefix_room + 4)))
-            return MCSG_ERR_NOMEM;
-        p = mci_io_put_text(p, vertex_prefix);
-        for (int k = 0; k < 3; k++) {
-            p = mci_io_put_double(p, mesh->vertices[3 * i + (size_t)k]);
-            *p++ = k < 2 ? ' ' : '\n';
+    mci_buf text[RECORD_WAVE];
+    record_job j = {ctx, mesh, vertex_prefix, triangle_prefix, index_base,
+                    (mesh->vertex_count + RECORD_BLOCK - 1) / RECORD_BLOCK, 0, text};
+    size_t blocks = j.vertex_blocks + (mesh->triangle_count + RECORD_BLOCK - 1) / RECORD_BLOCK;
+    mcsg_status st = MCSG_OK;
+    mcsg_error err;
+    memset(text, 0, sizeof text);
+    for (; st == MCSG_OK && j.first_block < blocks; j.first_block += RECORD_WAVE) {
+        size_t wave = blocks - j.first_block < RECORD_WAVE ? blocks - j.first_block : RECORD_WAVE;
+        st = mci_parallel_for(ctx, wave, format_record_block, &j, &err);
+        for (size_t i = 0; i < wave; i++) {
+            if (st == MCSG_OK && !mci_buf_append(ctx, out, text[i].data, text[i].len))
+                st = MCSG_ERR_NOMEM;
+            mci_buf_free(ctx, &text[i]);
         }
-        mci_io_commit_text(out, p);
-    }
-    for (size_t i = 0; i < mesh->triangle_count; i++) {
-        if (!(p = mci_io_reserve_text(ctx, out, 3 * 12 + prefix_room + 4)))
-            return MCSG_ERR_NOMEM;
-        p = mci_io_put_text(p, triangle_prefix);
-        for (int k = 0; k < 3; k++) {
-            p = mci_io_put_uint(p, (uint64_t)mesh->triangles[3 * i + (size_t)k] + index_base);
-            *p++ = k < 2 ? ' ' : '\n';
-        }
-        mci_io_commit_text(out, p);
     }
     /* An empty mesh still yields a buffer. */
-    return mci_io_reserve_text(ctx, out, 1) ? MCSG_OK : MCSG_ERR_NOMEM;
+    if (st == MCSG_OK && !mci_io_reserve_text(ctx, out, 1))
+        st = MCSG_ERR_NOMEM;
+    return st;
 }
 
 /* ---------------------------------------------------------------------------------- */

@@ -218,6 +218,59 @@ TEST(round_trip_exact_formats)
     }
 }
 
+/* Text records are formatted in blocks on several threads: a mesh spanning several waves
+ * of blocks (with a short last block) must read back exactly and give the same bytes for
+ * any thread count. */
+TEST(text_output_same_for_any_thread_count)
+{
+    static const mcsg_format text_formats[] = {MCSG_FORMAT_OFF, MCSG_FORMAT_OBJ,
+                                               MCSG_FORMAT_PLY_ASCII};
+    enum { NV = 150001, NT = 270007 };
+    static const int thread_counts[] = {1, 2, 3};
+    mcsg_mesh mesh = {malloc(3 * NV * sizeof(double)), malloc(3 * NT * sizeof(uint32_t)), NV,
+                      NT};
+    uint64_t state = 0x9e3779b97f4a7c15u;
+    mcsg_error err;
+    CHECK(mesh.vertices && mesh.triangles);
+    for (size_t i = 0; mesh.vertices && i < 3 * (size_t)NV; i++) {
+        state = state * 6364136223846793005u + 1442695040888963407u;
+        mesh.vertices[i] = ldexp((double)(state >> 11) - 0x1p52, (int)(state % 41) - 60);
+    }
+    for (size_t i = 0; mesh.triangles && i < 3 * (size_t)NT; i++)
+        mesh.triangles[i] = (uint32_t)((i * 2654435761u) % NV);
+    for (size_t f = 0; mesh.vertices && mesh.triangles && f < 3; f++) {
+        void *first = NULL;
+        size_t first_size = 0;
+        for (size_t t = 0; t < sizeof thread_counts / sizeof thread_counts[0]; t++) {
+            mcsg_options opts = {0};
+            mcsg_mesh back;
+            void *data = NULL;
+            size_t size = 0;
+            opts.threads = thread_counts[t];
+            CHECK_OK(mcsg_mesh_write_memory(text_formats[f], &mesh, &opts, &data, &size, &err),
+                     &err);
+            if (t == 0) {
+                CHECK_OK(mcsg_mesh_read_memory(data, size, text_formats[f], "big", NULL, &back,
+                                               &err),
+                         &err);
+                CHECK_MSG(test_same_mesh(&mesh, &back), "%s: the big mesh does not read back",
+                          mcsg_format_name(text_formats[f]));
+                mcsg_mesh_free(&back, NULL);
+                first = data;
+                first_size = size;
+                continue;
+            }
+            CHECK_MSG(size == first_size && memcmp(data, first, size) == 0,
+                      "%s: %d threads write other bytes than one", mcsg_format_name(text_formats[f]),
+                      thread_counts[t]);
+            mcsg_free(data, NULL);
+        }
+        mcsg_free(first, NULL);
+    }
+    free(mesh.vertices);
+    free(mesh.triangles);
+}
+
 TEST(round_trip_through_files)
 {
     static const char *const names[] = {"rt.off", "rt.obj", "rt.ply", "RT.PLY"};
@@ -1074,6 +1127,7 @@ TEST(write_errors)
 int main(void)
 {
     RUN(round_trip_exact_formats);
+    RUN(text_output_same_for_any_thread_count);
     RUN(round_trip_through_files);
     RUN(round_trip_empty_mesh);
     RUN(round_trip_stl);
