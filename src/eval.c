@@ -166,6 +166,28 @@ typedef struct rounded {
     size_t count;
 } rounded;
 
+/* Rounding an exact point costs about a thousand instructions: the used vertices are
+ * rounded in chunks of ids on the context's threads (each id writes its own slot). */
+enum { ROUND_CHUNK = 8192 };
+
+typedef struct round_job {
+    const eval_state *e;
+    const uint64_t *rep;
+    rounded *r;
+} round_job;
+
+static mcsg_status round_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const round_job *j = user;
+    size_t ids = j->e->scene.point_count + j->e->cl.new_vertex_count;
+    size_t end = ids - chunk * ROUND_CHUNK < ROUND_CHUNK ? ids : (chunk + 1) * ROUND_CHUNK;
+    (void)err;
+    for (size_t id = chunk * ROUND_CHUNK; id < end; id++)
+        if (j->r->dense[id] != MCI_NONE)
+            vertex_coordinates(j->e, j->rep, (uint32_t)id, j->r->xyz + 3 * (size_t)j->r->dense[id]);
+    return MCSG_OK;
+}
+
 static mcsg_status round_vertices(const eval_state *e, rounded *r, mcsg_error *err)
 {
     size_t ids = e->scene.point_count + e->cl.new_vertex_count;
@@ -181,9 +203,15 @@ static mcsg_status round_vertices(const eval_state *e, rounded *r, mcsg_error *e
     r->xyz = ok ? mci_malloc_array(&e->ctx, r->count + 1, 3 * sizeof *r->xyz) : NULL;
     r->canon = ok ? mci_malloc_array(&e->ctx, r->count + 1, sizeof *r->canon) : NULL;
     ok = ok && r->xyz && r->canon;
-    for (size_t id = 0; ok && id < ids; id++)
-        if (r->dense[id] != MCI_NONE)
-            vertex_coordinates(e, rep, (uint32_t)id, r->xyz + 3 * (size_t)r->dense[id]);
+    if (ok) {
+        round_job job = {e, rep, r};
+        mcsg_status st = mci_parallel_for(&e->ctx, (ids + ROUND_CHUNK - 1) / ROUND_CHUNK,
+                                          round_chunk, &job, err);
+        if (st != MCSG_OK) {
+            mci_free(&e->ctx, rep);
+            return st;
+        }
+    }
     ok = ok && mci_first_equal_coordinates(&e->ctx, r->xyz, r->count, r->canon);
     mci_free(&e->ctx, rep);
     return ok ? MCSG_OK : mci_fail_nomem(err, "assembling the result");

@@ -522,23 +522,67 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *n
     return st;
 }
 
+/* Whether arrangement t already has point p with the same definition among its located
+ * points on an edge. Nearly always so: the neighbour across an edge meets the same
+ * surfaces there and builds the same edge-plane points itself (on the bench scenes every
+ * shared point is such a copy). Sharing adds only what a face lacks, so most receivers
+ * stay merged: no copy, no second merge. */
+static bool has_edge_point(const mci_face_arr *t, const mci_point *p)
+{
+    for (size_t q = 3; q < t->where_count; q++)
+        if (t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE &&
+            mci_points_same_definition(&t->points[q], p))
+            return true;
+    return false;
+}
+
+/* The arrangement that point p of arr should also be in (its edge neighbour's), or NULL
+ * when there is none or it has the point already. */
+static mci_face_arr *share_target(const mci_scene *s, const mci_face_arr *arr, size_t p)
+{
+    uint32_t nb;
+    mci_face_arr *t;
+    if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
+        return NULL;
+    nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
+    if (nb == MCI_NONE)
+        return NULL;
+    t = &s->arrs[s->arr_of[nb]];
+    return has_edge_point(t, &arr->points[p]) ? NULL : t;
+}
+
+/* Which arrangements have an edge point their neighbour lacks: a read-only pass over
+ * every edge point, in parallel; the sharing loop then visits only those. */
+typedef struct lack_job {
+    const mci_scene *s;
+    uint8_t *lacking;
+} lack_job;
+
+static mcsg_status find_lacking(void *user, size_t k, mcsg_error *err)
+{
+    const lack_job *j = user;
+    const mci_face_arr *arr = &j->s->arrs[k];
+    (void)err;
+    for (size_t p = 3; p < arr->point_count && !j->lacking[k]; p++)
+        j->lacking[k] = share_target(j->s, arr, p) != NULL;
+    return MCSG_OK;
+}
+
 /* Room in each arrangement for the points the loop below will give it (the loop, and
  * which arrangements it skips, replayed without the points). */
-static mcsg_status reserve_shared(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+static mcsg_status reserve_shared(const mci_ctx *ctx, mci_scene *s, const uint8_t *lacking,
+                                  mcsg_error *err)
 {
     uint32_t *extra = mci_calloc_array(ctx, s->arr_count + 1, sizeof *extra);
     mcsg_status st = extra ? MCSG_OK : mci_fail_nomem(err, "arranging faces");
     for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
         const mci_face_arr *arr = &s->arrs[k];
-        if (arr->dirty || extra[k]) /* it received points: the loop skips it */
+        if (!lacking[k] || arr->dirty || extra[k]) /* received points: the loop skips it */
             continue;
         for (size_t p = 3; p < arr->point_count; p++) {
-            uint32_t nb;
-            if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
-                continue;
-            nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
-            if (nb != MCI_NONE)
-                extra[s->arr_of[nb]]++;
+            const mci_face_arr *t = share_target(s, arr, p);
+            if (t)
+                extra[t - s->arrs]++;
         }
     }
     for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++)
@@ -548,31 +592,34 @@ static mcsg_status reserve_shared(const mci_ctx *ctx, mci_scene *s, mcsg_error *
     return st;
 }
 
+/* Points on a face's edge go to the arrangement across that edge where it lacks them
+ * (in arrangement order; an arrangement that received points shares none itself, its
+ * new points are not located yet). */
 static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
     bool *needs = mci_calloc_array(ctx, s->face_count + 1, sizeof *needs);
-    size_t count;
+    lack_job job = {s, NULL};
     mcsg_status st;
     if (!needs)
         return mci_fail_nomem(err, "arranging faces");
     mark_receivers(s, needs);
     st = add_receivers(ctx, s, needs, err);
     mci_free(ctx, needs);
-    count = s->arr_count;
+    if (st == MCSG_OK && !(job.lacking = mci_calloc_array(ctx, s->arr_count + 1, 1)))
+        st = mci_fail_nomem(err, "arranging faces");
     if (st == MCSG_OK)
-        st = reserve_shared(ctx, s, err);
-    for (size_t k = 0; st == MCSG_OK && k < count; k++) {
+        st = mci_parallel_for(ctx, s->arr_count, find_lacking, &job, err);
+    if (st == MCSG_OK)
+        st = reserve_shared(ctx, s, job.lacking, err);
+    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
         const mci_face_arr *arr = &s->arrs[k];
-        for (size_t p = 3; p < arr->point_count && !arr->dirty; p++) {
-            uint32_t nb;
-            if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
-                continue;
-            nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
-            if (nb != MCI_NONE &&
-                !mci_arr_add_point(ctx, &s->arrs[s->arr_of[nb]], &arr->points[p]))
+        for (size_t p = 3; job.lacking[k] && p < arr->point_count && !arr->dirty; p++) {
+            mci_face_arr *t = share_target(s, arr, p);
+            if (t && !mci_arr_add_point(ctx, t, &arr->points[p]))
                 st = mci_fail_nomem(err, "arranging faces");
         }
     }
+    mci_free(ctx, job.lacking);
     return st;
 }
 
