@@ -866,6 +866,7 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
  *      joined after an exact equality test;
  *   3. numbers follow the first occurrence in (face, local index) order. */
 typedef struct numbering {
+    const mci_ctx *ctx;
     const mci_point **table; /* by slot */
     uint32_t *parent;        /* union-find over slots */
     size_t total;
@@ -893,29 +894,80 @@ static void join(uint32_t *parent, uint32_t a, uint32_t b)
         parent[a] = b;
 }
 
-static bool join_same_definitions(const mci_ctx *ctx, numbering *nb)
+/* Copies with one definition are found with one hash table per part of the hash space
+ * (parts by the top bits, filled in parallel): a class of copies lies in one part, each
+ * part takes its slots in increasing order, so every copy is joined to the first slot of
+ * its class as a single table would do. */
+enum { HASH_PARTS = 64, HASH_CHUNK = 16384 };
+
+typedef struct same_job {
+    numbering *nb;
+    uint64_t *hash;                   /* by slot */
+    uint32_t *by_part;                /* slots grouped by part, increasing within a part */
+    size_t part_start[HASH_PARTS + 1];
+} same_job;
+
+static mcsg_status hash_chunk(void *user, size_t chunk, mcsg_error *err)
 {
-    size_t size = 16;
+    const same_job *j = user;
+    size_t end = j->nb->total - chunk * HASH_CHUNK < HASH_CHUNK ? j->nb->total
+                                                                 : (chunk + 1) * HASH_CHUNK;
+    (void)err;
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+        j->hash[slot] = definition_hash(j->nb->table[slot]);
+    return MCSG_OK;
+}
+
+static mcsg_status join_part(void *user, size_t part, mcsg_error *err)
+{
+    const same_job *j = user;
+    const numbering *nb = j->nb;
+    size_t first = j->part_start[part], n = j->part_start[part + 1] - first, size = 16;
     uint32_t *bucket;
-    while (size < 2 * nb->total)
+    while (size < 2 * n)
         size *= 2;
-    bucket = mci_malloc_array(ctx, size, sizeof *bucket);
-    if (!bucket)
-        return false;
+    if (!(bucket = mci_malloc_array(nb->ctx, size, sizeof *bucket)))
+        return mci_fail_nomem(err, "numbering points");
     for (size_t i = 0; i < size; i++)
         bucket[i] = MCI_NONE;
-    for (uint32_t slot = 0; slot < nb->total; slot++) {
-        size_t at = definition_hash(nb->table[slot]) & (size - 1);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t slot = j->by_part[first + i];
+        size_t at = j->hash[slot] & (size - 1);
         while (bucket[at] != MCI_NONE &&
-               !mci_points_same_definition(nb->table[bucket[at]], nb->table[slot]))
+               (j->hash[bucket[at]] != j->hash[slot] ||
+                !mci_points_same_definition(nb->table[bucket[at]], nb->table[slot])))
             at = (at + 1) & (size - 1);
         if (bucket[at] == MCI_NONE)
             bucket[at] = slot;
         else
-            join(nb->parent, bucket[at], slot);
+            nb->parent[slot] = bucket[at]; /* both are roots: the first of the class wins */
     }
-    mci_free(ctx, bucket);
-    return true;
+    mci_free(nb->ctx, bucket);
+    return MCSG_OK;
+}
+
+static mcsg_status join_same_definitions(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
+{
+    same_job j = {nb, mci_malloc_array(ctx, nb->total + 1, sizeof *j.hash),
+                  mci_malloc_array(ctx, nb->total + 1, sizeof *j.by_part), {0}};
+    mcsg_status st = j.hash && j.by_part ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, (nb->total + HASH_CHUNK - 1) / HASH_CHUNK, hash_chunk, &j, err);
+    if (st == MCSG_OK) { /* a stable counting sort of the slots by part */
+        size_t at[HASH_PARTS] = {0};
+        for (size_t slot = 0; slot < nb->total; slot++)
+            j.part_start[(j.hash[slot] >> 58) + 1]++;
+        for (size_t q = 0; q < HASH_PARTS; q++)
+            j.part_start[q + 1] += j.part_start[q];
+        for (size_t q = 0; q < HASH_PARTS; q++)
+            at[q] = j.part_start[q];
+        for (size_t slot = 0; slot < nb->total; slot++)
+            j.by_part[at[j.hash[slot] >> 58]++] = (uint32_t)slot;
+        st = mci_parallel_for(ctx, HASH_PARTS, join_part, &j, err);
+    }
+    mci_free(ctx, j.hash);
+    mci_free(ctx, j.by_part);
+    return st;
 }
 
 typedef struct boxed_slot {
@@ -932,33 +984,49 @@ static uint64_t orderable(double x)
     return bits >> 63 ? ~bits : bits | (UINT64_C(1) << 63);
 }
 
+typedef struct bounds_job {
+    const numbering *nb;
+    boxed_slot *items;
+    mci_keyed *order;
+    size_t n;
+} bounds_job;
+
+/* The certified boxes (the cost of this step: LPI and TPI bounds), in parallel. */
+static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const bounds_job *j = user;
+    size_t end = j->n - chunk * HASH_CHUNK < HASH_CHUNK ? j->n : (chunk + 1) * HASH_CHUNK;
+    (void)err;
+    for (size_t i = chunk * HASH_CHUNK; i < end; i++) {
+        boxed_slot *item = &j->items[i];
+        mci_point_bounds(j->nb->table[item->slot], item->lo, item->hi);
+        j->order[i].key = orderable(item->lo[0]);
+        j->order[i].ref = (uint32_t)i;
+    }
+    return MCSG_OK;
+}
+
 /* Distinct definitions of one point: a sweep along x over the certified boxes (sorted by
  * their low x with the keyed radix sort; equal lows in slot order), each pair whose
  * boxes overlap tested exactly. The joins do not depend on the order, only on the pairs. */
-static bool join_equal_points(const mci_ctx *ctx, numbering *nb)
+static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
 {
-    size_t n = 0;
-    boxed_slot *items = mci_malloc_array(ctx, nb->total + 1, sizeof *items);
-    mci_keyed *order = mci_malloc_array(ctx, nb->total + 1, sizeof *order);
-    if (!items || !order) {
-        mci_free(ctx, items);
-        mci_free(ctx, order);
-        return false;
-    }
-    for (uint32_t slot = 0; slot < nb->total; slot++) {
-        if (nb->parent[slot] != slot)
-            continue; /* a copy of an earlier definition */
-        mci_point_bounds(nb->table[slot], items[n].lo, items[n].hi);
-        items[n].slot = slot;
-        order[n].key = orderable(items[n].lo[0]);
-        order[n].ref = (uint32_t)n;
-        n++;
-    }
-    mci_sort_keyed(order, n);
-    for (size_t i = 0; i < n; i++) {
+    bounds_job j = {nb, mci_malloc_array(ctx, nb->total + 1, sizeof *j.items),
+                    mci_malloc_array(ctx, nb->total + 1, sizeof *j.order), 0};
+    const boxed_slot *items = j.items;
+    const mci_keyed *order = j.order;
+    mcsg_status st = j.items && j.order ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    for (uint32_t slot = 0; st == MCSG_OK && slot < nb->total; slot++)
+        if (nb->parent[slot] == slot) /* not a copy of an earlier definition */
+            j.items[j.n++].slot = slot;
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
+    if (st == MCSG_OK)
+        mci_sort_keyed(j.order, j.n);
+    for (size_t i = 0; st == MCSG_OK && i < j.n; i++) {
         const boxed_slot *a = &items[order[i].ref];
-        for (size_t j = i + 1; j < n && items[order[j].ref].lo[0] <= a->hi[0]; j++) {
-            const boxed_slot *b = &items[order[j].ref];
+        for (size_t k = i + 1; k < j.n && items[order[k].ref].lo[0] <= a->hi[0]; k++) {
+            const boxed_slot *b = &items[order[k].ref];
             if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
                 b->lo[2] > a->hi[2])
                 continue;
@@ -966,16 +1034,17 @@ static bool join_equal_points(const mci_ctx *ctx, numbering *nb)
                 join(nb->parent, a->slot, b->slot);
         }
     }
-    mci_free(ctx, items);
-    mci_free(ctx, order);
-    return true;
+    mci_free(ctx, j.items);
+    mci_free(ctx, j.order);
+    return st;
 }
 
 mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
-    numbering nb = {NULL, NULL, 0};
+    numbering nb = {ctx, NULL, NULL, 0};
     size_t id = 0;
     bool ok;
+    mcsg_status st;
     double t0 = mci_seconds_now();
     for (size_t k = 0; k < s->arr_count; k++)
         nb.total += s->arrs[k].point_count;
@@ -995,16 +1064,18 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     }
     if (ok)
         s->gid_start[s->arr_count] = (uint32_t)nb.total;
-    ok = ok && join_same_definitions(ctx, &nb) && join_equal_points(ctx, &nb);
-    for (uint32_t slot = 0; ok && slot < nb.total; slot++) {
+    st = ok ? join_same_definitions(ctx, &nb, err) : mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK)
+        st = join_equal_points(ctx, &nb, err);
+    for (uint32_t slot = 0; st == MCSG_OK && slot < nb.total; slot++) {
         uint32_t root = find_root(nb.parent, slot);
         s->gid[slot] = root == slot ? (uint32_t)id++ : s->gid[root];
     }
-    s->point_count = ok ? id : 0;
+    s->point_count = st == MCSG_OK ? id : 0;
     mci_free(ctx, nb.table);
     mci_free(ctx, nb.parent);
     s->stats.seconds_merge = mci_seconds_now() - t0;
-    return ok ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    return st;
 }
 
 /* ---------------------------------------------------------------------------------- */
