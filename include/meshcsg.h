@@ -92,7 +92,8 @@ typedef struct mcsg_options {
     mcsg_allocator allocator; /* zero: malloc/realloc/free */
     mcsg_log_fn log;          /* NULL: messages are dropped */
     void *log_user;           /* passed to log */
-    int threads;              /* worker threads for evaluation and for writing text
+    int threads;              /* worker threads for evaluation, for reading the files
+                                 of a CSG text's import() calls and for writing text
                                  meshes; 0: all cores. With more than one, the allocator
                                  is called from several threads at once and must be
                                  thread-safe (malloc is). Results do not depend on it */

@@ -309,7 +309,10 @@ mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *nam
     if (st == MCSG_OK)
         st = mcsg_tree_create(opts, &sc.tree, err);
     if (st == MCSG_OK)
+        st = scad_prefetch_imports(&sc, err);
+    if (st == MCSG_OK)
         st = walk(&sc, err);
+    scad_prefetch_free(&sc);
     scad_eval_free(&sc.ev);
     scad_program_free(&prog);
     if (st != MCSG_OK) {

@@ -204,6 +204,12 @@ typedef struct scad_transform {
     bool degenerate;
 } scad_transform;
 
+/* Meshes of import() calls read ahead of the walk (scad_prefetch.c). */
+typedef struct scad_prefetch {
+    struct prefetched *entries; /* sorted by path */
+    size_t count;
+} scad_prefetch;
+
 typedef struct scad_context {
     scad_eval ev;
     const scad_program *prog;
@@ -211,7 +217,17 @@ typedef struct scad_context {
     mcsg_tree *tree;
     const char *base_dir; /* NULL: current directory */
     const char *name;     /* for messages and labels */
+    scad_prefetch prefetch;
 } scad_context;
+
+/* Read the files of every import() call with a literal file name, on the options'
+ * threads, into sc->prefetch (failed reads are kept as failures, not reported). */
+mcsg_status scad_prefetch_imports(scad_context *sc, mcsg_error *err);
+/* The mesh read ahead for `path`, if there is one (*found): moved out for its last
+ * call, copied for the others; the messages its read logged are logged again. */
+mcsg_status scad_prefetch_take(scad_context *sc, const char *path, mcsg_mesh *mesh,
+                               bool *found, mcsg_error *err);
+void scad_prefetch_free(scad_context *sc);
 
 /* What a call with children contributes once its children are done. */
 typedef enum scad_role { ROLE_OP, ROLE_GROUP } scad_role;

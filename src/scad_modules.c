@@ -639,8 +639,11 @@ static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad
     uint32_t file_len = 0;
     mcsg_error read_err = {MCSG_OK, ""};
     mcsg_mesh mesh;
+    bool prefetched = false;
     mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
-    if (st == MCSG_OK) {
+    if (st == MCSG_OK)
+        st = scad_prefetch_take(sc, (const char *)path.data, &mesh, &prefetched, err);
+    if (st == MCSG_OK && !prefetched) {
         st = mcsg_mesh_read((const char *)path.data, MCSG_FORMAT_AUTO, sc->opts, &mesh,
                             &read_err);
         if (st != MCSG_OK)

@@ -530,6 +530,45 @@ TEST(imports)
     mcsg_tree_free(tree);
 }
 
+/* import() files are read ahead, several at once: a file named twice gives two leaves
+ * (one a copy), each transformed on its own, and the messages its read logs come once
+ * per call, in program order between the walk's own messages. */
+TEST(imports_read_ahead)
+{
+    static const char text[] = "union() {\n"
+                               "  import(\"warns.obj\");\n"
+                               "  translate() cube(1);\n"
+                               "  translate([5, 0, 0]) import(\"warns.obj\");\n"
+                               "  import(\"cube.off\");\n"
+                               "}\n";
+    log_capture log;
+    mcsg_options opts = logging(&log);
+    mcsg_tree *tree = NULL;
+    mcsg_error err;
+    const char *first, *walk, *second;
+    opts.threads = 2;
+    CHECK_OK(mcsg_scad_read_memory(text, strlen(text), "t.scad", data_dir(), &opts, &tree,
+                                   &err),
+             &err);
+    CHECK(tree && mcsg_tree_leaf_count(tree) == 4);
+    if (tree && mcsg_tree_leaf_count(tree) == 4) {
+        const mcsg_mesh *a = mcsg_tree_leaf_mesh(tree, mcsg_tree_child(tree, root(tree), 0));
+        const mcsg_mesh *b = mcsg_tree_leaf_mesh(tree, mcsg_tree_child(tree, root(tree), 2));
+        const mcsg_mesh *c = mcsg_tree_leaf_mesh(tree, mcsg_tree_child(tree, root(tree), 3));
+        CHECK(a && b && a->vertex_count == 4 && b->vertex_count == 4);
+        for (size_t i = 0; a && b && i < 12; i++)
+            CHECK(b->vertices[i] == a->vertices[i] + (i % 3 == 0 ? 5 : 0));
+        CHECK(c && c->vertex_count == 8 && c->triangle_count == 12);
+    }
+    CHECK_EQ_SIZE(log.warnings, 3);
+    first = strstr(log.text, "ignoring unknown OBJ keyword 'foo'");
+    walk = strstr(log.text, "translate(): no vector given");
+    second = first ? strstr(first + 1, "ignoring unknown OBJ keyword 'foo'") : NULL;
+    CHECK_MSG(first && walk && second && first < walk && walk < second,
+              "messages out of order:\n%s", log.text);
+    mcsg_tree_free(tree);
+}
+
 TEST(import_relative_to_the_file)
 {
     mcsg_tree *tree = NULL;
@@ -919,6 +958,7 @@ int main(void)
     RUN(polyhedron_polygons_and_2d_points);
     RUN(polyhedron_errors);
     RUN(imports);
+    RUN(imports_read_ahead);
     RUN(import_relative_to_the_file);
     RUN(import_errors);
     RUN(openscad_exported_csg);
