@@ -22,14 +22,28 @@
 
 #include <string.h>
 
+/* Pairing and grouping run on the threads in fixed chunks of vertices (each chunk writes
+ * only its own vertices' edge slots and corners); copies are numbered in vertex order
+ * through per-chunk counts, so the result does not depend on the thread count. */
+enum { VERTEX_CHUNK = 4096 };
+
 typedef struct splitter {
     const mci_ctx *ctx;
     mcsg_mesh *m;
     uint32_t *mate; /* per edge slot 3t + i (corner i -> i + 1): the paired slot */
     uint32_t *start, *corner; /* corners (= outgoing edge slots) of vertex v:
                                  corner[start[v] .. start[v + 1]) */
-    size_t bad_edges;
+    size_t chunks;
+    size_t *bad_edges;        /* per chunk */
+    uint32_t *parent, *copy;  /* per corner: union-find, the copy of a root */
+    size_t *extra;            /* per chunk: new vertices; then the first new id */
 } splitter;
+
+static size_t chunk_end(const splitter *sp, size_t chunk)
+{
+    size_t nv = sp->m->vertex_count;
+    return nv - chunk * VERTEX_CHUNK < VERTEX_CHUNK ? nv : (chunk + 1) * VERTEX_CHUNK;
+}
 
 static const double *vertex(const mcsg_mesh *m, uint32_t v)
 {
@@ -180,67 +194,67 @@ static bool corners_by_vertex(splitter *sp)
     return start && corner && by_target;
 }
 
-/* The run of vertex u's corners whose edge goes to v, from *cursor on: cursor[u] only
- * moves forward, which is enough because the queries to each vertex come with
- * increasing targets (pair_edges walks u in order and asks v for its edges back to u).
- * Returns the run's start; *count is its length. */
-static uint32_t run_to(const splitter *sp, uint32_t *cursor, uint32_t u, uint32_t v,
-                       size_t *count)
+/* The run of vertex u's corners whose edge goes to v (u's corners are ordered by the
+ * vertex their edge goes to: a binary search). Returns the run's start; *count is its
+ * length. */
+static uint32_t run_to(const splitter *sp, uint32_t u, uint32_t v, size_t *count)
 {
-    uint32_t k = cursor[u], end = sp->start[u + 1], first;
-    while (k < end && slot_to(sp->m, sp->corner[k]) < v)
-        k++;
-    cursor[u] = first = k;
-    while (k < end && slot_to(sp->m, sp->corner[k]) == v)
-        k++;
-    *count = k - first;
+    uint32_t lo = sp->start[u], hi = sp->start[u + 1], first;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (slot_to(sp->m, sp->corner[mid]) < v)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    first = lo;
+    while (lo < sp->start[u + 1] && slot_to(sp->m, sp->corner[lo]) == v)
+        lo++;
+    *count = lo - first;
     return first;
 }
 
-/* Pair every edge's slots: the two opposite ones of a manifold edge directly, the 2k
- * of a non-manifold edge by angle. Each edge is handled once, from its smaller vertex:
- * the corners of u (ordered by target) come in runs u -> v, and the run v -> u is found
- * with v's cursor. */
-static bool pair_edges(splitter *sp)
+/* Pair the slots of every edge u-v with u < v in the chunk's vertices: the two opposite
+ * ones of a manifold edge directly, the 2k of a non-manifold edge by angle. u's corners
+ * come in runs u -> v; the run v -> u is found by a binary search among v's. */
+static mcsg_status pair_chunk(void *user, size_t chunk, mcsg_error *err)
 {
+    splitter *sp = user;
     const mcsg_mesh *m = sp->m;
-    size_t room = 64;
-    uint32_t *slots = mci_malloc_array(sp->ctx, room, sizeof *slots);
-    uint32_t *cursor = mci_malloc_array(sp->ctx, m->vertex_count + 1, sizeof *cursor);
-    if (!slots || !cursor) {
-        mci_free(sp->ctx, slots);
-        mci_free(sp->ctx, cursor);
-        return false;
-    }
-    for (size_t s = 0; s < 3 * m->triangle_count; s++)
-        sp->mate[s] = MCI_NONE;
-    memcpy(cursor, sp->start, m->vertex_count * sizeof *cursor);
-    for (uint32_t u = 0; u < m->vertex_count; u++)
+    uint32_t slots[64];
+    (void)err;
+    for (uint32_t u = (uint32_t)(chunk * VERTEX_CHUNK); u < chunk_end(sp, chunk); u++)
         for (uint32_t k = sp->start[u]; k < sp->start[u + 1];) {
             uint32_t v = slot_to(m, sp->corner[k]), back_first;
-            size_t ahead, back;
-            uint32_t ahead_first = run_to(sp, cursor, u, v, &ahead);
-            k = ahead_first + (uint32_t)ahead;
+            size_t ahead = 1, back;
+            while (k + ahead < sp->start[u + 1] && slot_to(m, sp->corner[k + ahead]) == v)
+                ahead++;
+            k += (uint32_t)ahead;
             if (v < u)
                 continue;
-            back_first = run_to(sp, cursor, v, u, &back);
+            back_first = run_to(sp, v, u, &back);
             if (ahead == 1 && back == 1) {
-                sp->mate[sp->corner[ahead_first]] = sp->corner[back_first];
-                sp->mate[sp->corner[back_first]] = sp->corner[ahead_first];
+                sp->mate[sp->corner[k - 1]] = sp->corner[back_first];
+                sp->mate[sp->corner[back_first]] = sp->corner[k - 1];
                 continue;
             }
-            if (ahead != back || ahead + back > room) {
-                sp->bad_edges++;
+            if (ahead != back || ahead + back > sizeof slots / sizeof slots[0]) {
+                sp->bad_edges[chunk]++;
                 continue;
             }
-            memcpy(slots, sp->corner + ahead_first, ahead * sizeof *slots);
+            memcpy(slots, sp->corner + k - ahead, ahead * sizeof *slots);
             memcpy(slots + ahead, sp->corner + back_first, back * sizeof *slots);
             if (!pair_around_edge(sp, slots, ahead + back))
-                sp->bad_edges++;
+                sp->bad_edges[chunk]++;
         }
-    mci_free(sp->ctx, slots);
-    mci_free(sp->ctx, cursor);
-    return true;
+    return MCSG_OK;
+}
+
+static bool pair_edges(splitter *sp)
+{
+    for (size_t s = 0; s < 3 * sp->m->triangle_count; s++)
+        sp->mate[s] = MCI_NONE;
+    return mci_parallel_for(sp->ctx, sp->chunks, pair_chunk, sp, NULL) == MCSG_OK;
 }
 
 /* The corner of the triangle holding slot s (paired with an edge at vertex x) at x. */
@@ -273,70 +287,113 @@ static void group_corners(const splitter *sp, const uint32_t *corners, size_t n,
     }
 }
 
+/* Group the chunk's corners and count the umbrellas beyond each vertex's first (copy[]
+ * marks the roots seen). */
+static mcsg_status group_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    splitter *sp = user;
+    const uint32_t *start = sp->start, *corner = sp->corner;
+    size_t extra = 0;
+    (void)err;
+    for (size_t v = chunk * VERTEX_CHUNK; v < chunk_end(sp, chunk); v++) {
+        uint32_t first_root;
+        if (start[v] == start[v + 1])
+            continue;
+        group_corners(sp, corner + start[v], start[v + 1] - start[v], sp->parent);
+        first_root = find(sp->parent, corner[start[v]]);
+        for (uint32_t k = start[v]; k < start[v + 1]; k++) {
+            uint32_t root = find(sp->parent, corner[k]);
+            if (root != first_root && sp->copy[root] == MCI_NONE) {
+                sp->copy[root] = 0;
+                extra++;
+            }
+        }
+    }
+    sp->extra[chunk] = extra;
+    return MCSG_OK;
+}
+
+/* Give the chunk's extra umbrellas their vertices, numbered from extra[chunk] on in vertex
+ * and corner order, with the coordinates of the vertex they copy. */
+static mcsg_status number_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    splitter *sp = user;
+    mcsg_mesh *m = sp->m;
+    const uint32_t *start = sp->start, *corner = sp->corner;
+    size_t next = sp->extra[chunk];
+    (void)err;
+    for (size_t v = chunk * VERTEX_CHUNK; v < chunk_end(sp, chunk); v++) {
+        uint32_t first_root = start[v] < start[v + 1] ? find(sp->parent, corner[start[v]]) : 0;
+        for (uint32_t k = start[v]; k < start[v + 1]; k++) {
+            uint32_t c = corner[k], root = find(sp->parent, c);
+            if (root == first_root)
+                continue;
+            if (sp->copy[root] == 0) {
+                sp->copy[root] = (uint32_t)next++;
+                memcpy(m->vertices + 3 * (size_t)sp->copy[root], m->vertices + 3 * v,
+                       3 * sizeof(double));
+            }
+            m->triangles[c] = sp->copy[root];
+        }
+    }
+    return MCSG_OK;
+}
+
 /* New vertices for every umbrella of a vertex but the one with its first corner. */
 static bool split_vertices(splitter *sp, size_t *added)
 {
     mcsg_mesh *m = sp->m;
     size_t n = 3 * m->triangle_count, nv = m->vertex_count, extra = 0;
-    const uint32_t *start = sp->start, *corner = sp->corner;
-    uint32_t *parent = mci_malloc_array(sp->ctx, n + 1, sizeof *parent);
-    uint32_t *copy = mci_malloc_array(sp->ctx, n + 1, sizeof *copy);
-    bool ok = parent && copy;
-    if (!ok) {
-        mci_free(sp->ctx, parent);
-        mci_free(sp->ctx, copy);
+    double *grown;
+    sp->parent = mci_malloc_array(sp->ctx, n + 1, sizeof *sp->parent);
+    sp->copy = mci_malloc_array(sp->ctx, n + 1, sizeof *sp->copy);
+    sp->extra = mci_malloc_array(sp->ctx, sp->chunks + 1, sizeof *sp->extra);
+    *added = 0;
+    if (!sp->parent || !sp->copy || !sp->extra)
         return false;
-    }
     for (size_t c = 0; c < n; c++)
-        parent[c] = (uint32_t)c, copy[c] = MCI_NONE;
-    for (size_t v = 0; v < nv; v++)
-        group_corners(sp, corner + start[v], start[v + 1] - start[v], parent);
-    for (size_t v = 0; v < nv; v++) {
-        uint32_t first_root = start[v] < start[v + 1] ? find(parent, corner[start[v]]) : 0;
-        for (uint32_t k = start[v]; k < start[v + 1]; k++) {
-            uint32_t c = corner[k], root = find(parent, c);
-            if (root == first_root)
-                continue;
-            if (copy[root] == MCI_NONE)
-                copy[root] = (uint32_t)(nv + extra++);
-            m->triangles[c] = copy[root];
-        }
+        sp->parent[c] = (uint32_t)c, sp->copy[c] = MCI_NONE;
+    mci_parallel_for(sp->ctx, sp->chunks, group_chunk, sp, NULL);
+    for (size_t c = 0; c < sp->chunks; c++) {
+        size_t count = sp->extra[c];
+        sp->extra[c] = nv + extra;
+        extra += count;
     }
-    /* Second pass over the roots to fill the new vertices' coordinates. */
-    if (extra > 0) {
-        double *grown = mci_realloc_array(sp->ctx, m->vertices, nv + extra, 3 * sizeof(double));
-        ok = grown != NULL;
-        if (ok) {
-            m->vertices = grown;
-            for (size_t v = 0; v < nv; v++)
-                for (uint32_t k = start[v]; k < start[v + 1]; k++) {
-                    uint32_t id = m->triangles[corner[k]];
-                    if (id >= nv)
-                        memcpy(m->vertices + 3 * (size_t)id, m->vertices + 3 * v,
-                               3 * sizeof(double));
-                }
-            m->vertex_count = nv + extra;
-        }
-    }
+    if (extra == 0)
+        return true;
+    if (nv + extra >= UINT32_MAX ||
+        !(grown = mci_realloc_array(sp->ctx, m->vertices, nv + extra, 3 * sizeof(double))))
+        return false;
+    m->vertices = grown;
+    mci_parallel_for(sp->ctx, sp->chunks, number_chunk, sp, NULL);
+    m->vertex_count = nv + extra;
     *added = extra;
-    mci_free(sp->ctx, parent);
-    mci_free(sp->ctx, copy);
-    return ok;
+    return true;
 }
 
 bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *result)
 {
-    splitter sp = {ctx, m, NULL, NULL, NULL, 0};
+    splitter sp;
     bool ok;
+    memset(&sp, 0, sizeof sp);
     memset(result, 0, sizeof *result);
     if (m->triangle_count == 0)
         return true;
+    sp.ctx = ctx;
+    sp.m = m;
+    sp.chunks = (m->vertex_count + VERTEX_CHUNK - 1) / VERTEX_CHUNK;
     sp.mate = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *sp.mate);
-    ok = sp.mate && corners_by_vertex(&sp) && pair_edges(&sp) &&
+    sp.bad_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.bad_edges);
+    ok = sp.mate && sp.bad_edges && corners_by_vertex(&sp) && pair_edges(&sp) &&
          split_vertices(&sp, &result->new_vertices);
-    result->unpaired_edges = sp.bad_edges;
+    for (size_t c = 0; sp.bad_edges && c < sp.chunks; c++)
+        result->unpaired_edges += sp.bad_edges[c];
     mci_free(ctx, sp.mate);
+    mci_free(ctx, sp.bad_edges);
     mci_free(ctx, sp.start);
     mci_free(ctx, sp.corner);
+    mci_free(ctx, sp.parent);
+    mci_free(ctx, sp.copy);
+    mci_free(ctx, sp.extra);
     return ok;
 }

@@ -470,6 +470,42 @@ TEST(output_is_independent_of_memory_layout_and_threads)
     free(arena.base);
 }
 
+/* Touching parts at both ends of a big output: vertex copies are made in chunks of 4,096
+ * vertices on the threads and numbered in vertex order, so the mesh is the same for any
+ * thread count, with copies from the first chunk and from a later one. */
+TEST(touching_parts_in_a_big_output)
+{
+    const char *sphere = "translate([5, 0, 0]) sphere(1, $fn = 160);";
+    char text[256];
+    mcsg_options one = {0}, three = {0};
+    mcsg_mesh a, b, alone;
+    mcsg_eval_stats stats;
+    mcsg_error err;
+    one.threads = 1;
+    three.threads = 3;
+    snprintf(text, sizeof text, "union() { cube(1); translate([1, 1, 0]) cube(1); %s "
+             "translate([10, 0, 0]) cube(1); translate([11, 1, 0]) cube(1); }", sphere);
+    if (!eval_with(sphere, &one, &alone))
+        return;
+    CHECK_OK(test_eval_scad(text, &three, &a, &stats, &err), &err);
+    CHECK_EQ_SIZE(stats.touching_vertices_split, 4);
+    CHECK(a.vertex_count > 3 * 4096);
+    CHECK(test_index_manifold_defects(&a) == 0);
+    CHECK(fabs(test_signed_volume(&a) - test_signed_volume(&alone) - 4) < 1e-9);
+    if (eval_with(text, &one, &b)) {
+        CHECK(a.vertex_count == b.vertex_count && a.triangle_count == b.triangle_count);
+        if (a.vertex_count == b.vertex_count && a.triangle_count == b.triangle_count) {
+            CHECK(memcmp(a.vertices, b.vertices, 3 * a.vertex_count * sizeof(double)) == 0);
+            CHECK(memcmp(a.triangles, b.triangles, 3 * a.triangle_count * sizeof(uint32_t)) == 0);
+        }
+        mcsg_mesh_free(&b, NULL);
+    }
+    /* One pair of cubes is numbered before the sphere, one after it. */
+    CHECK(a.vertex_count > 4096 && a.vertices[0] < 3 && a.vertices[3 * (a.vertex_count - 5)] > 9);
+    mcsg_mesh_free(&a, NULL);
+    mcsg_mesh_free(&alone, NULL);
+}
+
 static mcsg_status eval_under(const void *ctx, const mcsg_options *opts, mcsg_error *err)
 {
     mcsg_mesh out;
@@ -600,6 +636,7 @@ int main(void)
     RUN(buried_faces_are_dropped_whole);
     RUN(copies_are_evaluated_once);
     RUN(touching_solids);
+    RUN(touching_parts_in_a_big_output);
     RUN(coplanar_overlaps);
     RUN(curved_volumes_add_up);
     RUN(aligned_edges_and_close_points);
