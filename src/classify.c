@@ -333,10 +333,11 @@ static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
     const mci_octree *o = &s->octree;
     size_t total = 0, size = 16;
     coord_table t;
+    uint8_t *seen;
     bool ok;
     for (size_t l = 0; l < o->leaf_count; l++)
         total += o->leaves[l]->vertex_count;
-    while (size < 2 * (total + s->gid_start[s->arr_count]))
+    while (size < 2 * (total + s->point_count)) /* keys: numbers once, then leaf vertices */
         size *= 2;
     t.size = size;
     t.key = mci_calloc_array(ctx, size, sizeof *t.key);
@@ -344,12 +345,20 @@ static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
     cl->vertex_first = mci_malloc_array(ctx, o->leaf_count + 1, sizeof *cl->vertex_first);
     cl->vertex_id = mci_malloc_array(ctx, total + 1, sizeof *cl->vertex_id);
     cl->new_vertex = mci_malloc_array(ctx, total + 1, sizeof *cl->new_vertex);
-    ok = t.key && t.value && cl->vertex_first && cl->vertex_id && cl->new_vertex &&
+    seen = mci_calloc_array(ctx, s->point_count / 8 + 1, 1);
+    ok = t.key && t.value && cl->vertex_first && cl->vertex_id && cl->new_vertex && seen &&
          s->point_count + total < UINT32_MAX;
+    /* Equal coordinates have one number (point numbering joined them): each number is
+     * stored once, found through the numbering's bytes, not by reading every point. */
     for (size_t k = 0; ok && k < s->arr_count; k++)
-        for (size_t p = 0; p < s->arrs[k].point_count; p++)
-            if (s->arrs[k].points[p].kind == MCI_POINT_EXPLICIT)
-                coord_lookup(&t, s->arrs[k].points[p].v[0], s->gid[s->gid_start[k] + p]);
+        for (size_t p = 0, slot = s->gid_start[k]; p < s->arrs[k].point_count; p++, slot++) {
+            uint32_t g = s->gid[slot];
+            if (!s->explicit_slot[slot] || (seen[g / 8] >> (g % 8)) & 1)
+                continue;
+            seen[g / 8] |= (uint8_t)(1u << (g % 8));
+            coord_lookup(&t, s->arrs[k].points[p].v[0], g);
+        }
+    mci_free(ctx, seen);
     for (size_t l = 0, at = 0; ok && l < o->leaf_count; l++) {
         const mcsg_mesh *m = o->leaves[l];
         cl->vertex_first[l] = at;

@@ -145,11 +145,11 @@ static uint64_t *point_representatives(const eval_state *e)
     /* The first copy, or the first explicit one: every copy rounds to the same doubles
      * but for the sign of a zero, which only an input vertex's copy knows. */
     for (size_t k = 0; k < s->arr_count; k++)
-        for (size_t p = 0; p < s->arrs[k].point_count; p++) {
-            uint32_t g = s->gid[s->gid_start[k] + p];
+        for (size_t p = 0, slot = s->gid_start[k]; p < s->arrs[k].point_count; p++, slot++) {
+            uint32_t g = s->gid[slot];
             if (rep[g] == UINT64_MAX ||
-                (s->arrs[k].points[p].kind == MCI_POINT_EXPLICIT &&
-                 s->arrs[rep[g] >> 32].points[(uint32_t)rep[g]].kind != MCI_POINT_EXPLICIT))
+                (s->explicit_slot[slot] &&
+                 !s->explicit_slot[s->gid_start[rep[g] >> 32] + (uint32_t)rep[g]]))
                 rep[g] = (uint64_t)k << 32 | p;
         }
     return rep;

@@ -897,6 +897,7 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->neighbour);
     mci_free(ctx, scene->gid_start);
     mci_free(ctx, scene->gid);
+    mci_free(ctx, scene->explicit_slot);
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);
@@ -915,6 +916,7 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
 typedef struct numbering {
     const mci_ctx *ctx;
     const mci_point **table; /* by slot */
+    uint8_t *explicit_slot;  /* by slot, filled with the hashes */
     uint32_t *parent;        /* union-find over slots */
     size_t total;
 } numbering;
@@ -960,8 +962,10 @@ static mcsg_status hash_chunk(void *user, size_t chunk, mcsg_error *err)
     size_t end = j->nb->total - chunk * HASH_CHUNK < HASH_CHUNK ? j->nb->total
                                                                  : (chunk + 1) * HASH_CHUNK;
     (void)err;
-    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
         j->hash[slot] = definition_hash(j->nb->table[slot]);
+        j->nb->explicit_slot[slot] = j->nb->table[slot]->kind == MCI_POINT_EXPLICIT;
+    }
     return MCSG_OK;
 }
 
@@ -1088,7 +1092,7 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
 
 mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
-    numbering nb = {ctx, NULL, NULL, 0};
+    numbering nb = {ctx, NULL, NULL, NULL, 0};
     size_t id = 0;
     bool ok;
     mcsg_status st;
@@ -1099,9 +1103,10 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
         return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", nb.total);
     s->gid_start = mci_malloc_array(ctx, s->arr_count + 1, sizeof *s->gid_start);
     s->gid = mci_malloc_array(ctx, nb.total + 1, sizeof *s->gid);
+    s->explicit_slot = nb.explicit_slot = mci_malloc_array(ctx, nb.total + 1, 1);
     nb.table = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.table);
     nb.parent = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.parent);
-    ok = s->gid_start && s->gid && nb.table && nb.parent;
+    ok = s->gid_start && s->gid && s->explicit_slot && nb.table && nb.parent;
     for (size_t k = 0, slot = 0; ok && k < s->arr_count; k++) {
         s->gid_start[k] = (uint32_t)slot;
         for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {

@@ -22,6 +22,8 @@ typedef struct mci_scene {
     /* Global identity (mci_scene_number_points): gid[gid_start[k] + i] numbers point
      * i of arrs[k]; equal points have equal numbers, across all faces. */
     uint32_t *gid_start, *gid;
+    uint8_t *explicit_slot; /* per gid slot: 1 when the point is an input vertex (kept so
+                               that later passes need not read every point again) */
     size_t point_count;
     /* Per face, the leaves whose surface it meets: touch_leaf[touch_start[f] ..
      * touch_start[f + 1]), from the pair tests (which report every contact, so a face
