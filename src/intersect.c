@@ -429,8 +429,41 @@ static void free_face_facts(const mci_ctx *ctx, face_facts *ff)
     ff->crease = NULL;
 }
 
+/* Crease tests cost an exact zero on planar quads: only the bits used are computed
+ * (edges between two faces in hits, for the union below, and coplanar faces), in parallel
+ * chunks of faces, from the cached planes. */
+typedef struct crease_job {
+    const mci_scene *s;
+    const plane_cache *planes;
+    const uint8_t *in_hits;
+    face_facts *ff;
+} crease_job;
+
+static mcsg_status crease_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const crease_job *j = user;
+    const mci_scene *s = j->s;
+    size_t end = s->face_count - chunk * PLANE_CHUNK < PLANE_CHUNK ? s->face_count
+                                                                   : (chunk + 1) * PLANE_CHUNK;
+    (void)err;
+    for (uint32_t f = (uint32_t)(chunk * PLANE_CHUNK); f < end; f++) {
+        const mci_plane *plane;
+        j->ff->plane_rep[f] = f;
+        if (!j->in_hits[f])
+            continue;
+        plane = &j->planes->planes[j->planes->slot[f]]; /* a face in a hit was in a pair */
+        for (int i = 0; i < 3; i++) {
+            uint32_t nb = s->neighbour[3 * (size_t)f + i];
+            bool used = (j->in_hits[f] & 2) || (nb != MCI_NONE && nb > f && j->in_hits[nb]);
+            if (used)
+                j->ff->crease[f] |= (uint8_t)(edge_is_crease(s, plane, f, i) << i);
+        }
+    }
+    return MCSG_OK;
+}
+
 static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit_list *hits,
-                               face_facts *ff)
+                               const plane_cache *planes, face_facts *ff)
 {
     uint32_t *parent = mci_malloc_array(ctx, s->face_count + 1, sizeof *parent);
     uint8_t *in_hits = mci_calloc_array(ctx, s->face_count + 1, sizeof *in_hits);
@@ -447,19 +480,13 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit
         in_hits[hits->v[h].f] |= mark;
         in_hits[hits->v[h].g] |= mark;
     }
-    /* Crease tests cost an exact zero on planar quads: only the bits used are computed
-     * (edges between two faces in hits, for the union below, and coplanar faces). */
-    for (uint32_t f = 0; f < s->face_count; f++) {
-        mci_plane plane;
-        parent[f] = f;
-        if (!in_hits[f])
-            continue;
-        face_plane(s, f, &plane);
-        for (int i = 0; i < 3; i++) {
-            uint32_t nb = s->neighbour[3 * (size_t)f + i];
-            bool used = (in_hits[f] & 2) || (nb != MCI_NONE && nb > f && in_hits[nb]);
-            if (used)
-                ff->crease[f] |= (uint8_t)(edge_is_crease(s, &plane, f, i) << i);
+    {
+        crease_job job = {s, planes, in_hits, ff};
+        if (mci_parallel_for(ctx, (s->face_count + PLANE_CHUNK - 1) / PLANE_CHUNK, crease_chunk,
+                             &job, NULL) != MCSG_OK) { /* cannot happen: no task fails */
+            mci_free(ctx, in_hits);
+            free_face_facts(ctx, ff);
+            return false;
         }
     }
     for (uint32_t f = 0; f < s->face_count; f++) {
@@ -781,7 +808,7 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
     face_facts ff = {NULL, NULL};
     arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes};
     mcsg_status st = MCSG_OK;
-    if (!compute_face_facts(ctx, s, hits, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
+    if (!compute_face_facts(ctx, s, hits, planes, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
         !number_arranged_faces(ctx, s, start, &face_of) ||
         !record_touches(ctx, s, hits, start, list))
         st = mci_fail_nomem(err, "arranging faces");
