@@ -356,6 +356,8 @@ typedef struct record_job {
     size_t vertex_blocks; /* blocks 0 .. vertex_blocks-1 hold vertices, the rest triangles */
     size_t first_block;   /* of the current wave */
     mci_buf *text;        /* per block of the wave */
+    unsigned char *dest;  /* where the wave's text goes */
+    size_t *offset;       /* per block of the wave: its place after dest */
 } record_job;
 
 static char *put_vertex(char *p, const char *prefix, const double *xyz)
@@ -401,29 +403,60 @@ static mcsg_status format_record_block(void *user, size_t i, mcsg_error *err)
     return MCSG_OK;
 }
 
+static mcsg_status copy_record_block(void *user, size_t i, mcsg_error *err)
+{
+    const record_job *j = user;
+    (void)err;
+    if (j->text[i].len)
+        memcpy(j->dest + j->offset[i], j->text[i].data, j->text[i].len);
+    return MCSG_OK;
+}
+
+/* Room for every record at its longest, reserved once (untouched pages cost nothing), so
+ * the waves never move the text; false when the size overflows or on allocation failure. */
+static bool reserve_records(const mci_ctx *ctx, const mcsg_mesh *mesh, size_t vertex_room,
+                            size_t triangle_room, mci_buf *out)
+{
+    if (mesh->vertex_count > SIZE_MAX / 2 / vertex_room ||
+        mesh->triangle_count > SIZE_MAX / 2 / triangle_room)
+        return false;
+    return mci_buf_reserve(ctx, out,
+                           mesh->vertex_count * vertex_room + mesh->triangle_count * triangle_room + 1);
+}
+
 mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
                                       const char *vertex_prefix, const char *triangle_prefix,
                                       uint32_t index_base, mci_buf *out)
 {
     mci_buf text[RECORD_WAVE];
+    size_t offset[RECORD_WAVE];
     record_job j = {ctx, mesh, vertex_prefix, triangle_prefix, index_base,
-                    (mesh->vertex_count + RECORD_BLOCK - 1) / RECORD_BLOCK, 0, text};
+                    (mesh->vertex_count + RECORD_BLOCK - 1) / RECORD_BLOCK, 0, text, NULL, offset};
     size_t blocks = j.vertex_blocks + (mesh->triangle_count + RECORD_BLOCK - 1) / RECORD_BLOCK;
     mcsg_status st = MCSG_OK;
     mcsg_error err;
     memset(text, 0, sizeof text);
+    if (!reserve_records(ctx, mesh, strlen(vertex_prefix) + 3 * MCI_DOUBLE_TEXT_MAX + 3,
+                         strlen(triangle_prefix) + 3 * 21 + 3, out))
+        return MCSG_ERR_NOMEM;
     for (; st == MCSG_OK && j.first_block < blocks; j.first_block += RECORD_WAVE) {
         size_t wave = blocks - j.first_block < RECORD_WAVE ? blocks - j.first_block : RECORD_WAVE;
+        size_t len = 0;
         st = mci_parallel_for(ctx, wave, format_record_block, &j, &err);
-        for (size_t i = 0; i < wave; i++) {
-            if (st == MCSG_OK && !mci_buf_append(ctx, out, text[i].data, text[i].len))
-                st = MCSG_ERR_NOMEM;
-            mci_buf_free(ctx, &text[i]);
+        for (size_t i = 0; st == MCSG_OK && i < wave; i++) {
+            offset[i] = len;
+            len += text[i].len;
         }
+        if (st == MCSG_OK && !mci_buf_reserve(ctx, out, len + 1))
+            st = MCSG_ERR_NOMEM;
+        if (st == MCSG_OK) {
+            j.dest = out->data + out->len;
+            st = mci_parallel_for(ctx, wave, copy_record_block, &j, &err);
+            out->len += len;
+        }
+        for (size_t i = 0; i < wave; i++)
+            mci_buf_free(ctx, &text[i]);
     }
-    /* An empty mesh still yields a buffer. */
-    if (st == MCSG_OK && !mci_io_reserve_text(ctx, out, 1))
-        st = MCSG_ERR_NOMEM;
     return st;
 }
 
