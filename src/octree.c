@@ -289,21 +289,41 @@ static bool face_touches_cell(const builder *b, uint32_t f, const mci_cell *cell
     }
 }
 
-static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
+/* Face boxes in parallel chunks of faces (each face writes its own six numbers). */
+enum { FACE_CHUNK = 16384 };
+
+typedef struct box_job {
+    const mci_octree *t;
+    double *box;
+} box_job;
+
+static mcsg_status box_chunk(void *user, size_t chunk, mcsg_error *err)
 {
-    uint32_t faces = t->face_base[t->leaf_count];
-    double *box = mci_malloc_array(ctx, (size_t)faces + 1, 6 * sizeof *box);
-    for (uint32_t f = 0; box && f < faces; f++) {
-        double *out = box + 6 * (size_t)f;
+    const box_job *j = user;
+    uint32_t faces = j->t->face_base[j->t->leaf_count];
+    uint32_t end = faces - chunk * FACE_CHUNK < FACE_CHUNK ? faces
+                                                           : (uint32_t)((chunk + 1) * FACE_CHUNK);
+    (void)err;
+    for (uint32_t f = (uint32_t)(chunk * FACE_CHUNK); f < end; f++) {
+        double *out = j->box + 6 * (size_t)f;
         for (int v = 0; v < 3; v++) {
-            const double *p = mci_octree_face_vertex(t, f, v);
+            const double *p = mci_octree_face_vertex(j->t, f, v);
             for (int k = 0; k < 3; k++) {
                 out[k] = v == 0 || p[k] < out[k] ? p[k] : out[k];
                 out[3 + k] = v == 0 || p[k] > out[3 + k] ? p[k] : out[3 + k];
             }
         }
     }
-    return box;
+    return MCSG_OK;
+}
+
+static double *face_boxes(const mci_ctx *ctx, const mci_octree *t)
+{
+    uint32_t faces = t->face_base[t->leaf_count];
+    box_job job = {t, mci_malloc_array(ctx, (size_t)faces + 1, 6 * sizeof *job.box)};
+    if (job.box)
+        mci_parallel_for(ctx, (faces + FACE_CHUNK - 1) / FACE_CHUNK, box_chunk, &job, NULL);
+    return job.box;
 }
 
 /* The octree is built level by level: the cells of one level are split in parallel,
@@ -376,49 +396,84 @@ static uint8_t children_touched(const builder *b, const mci_cell *cell,
     return mask;
 }
 
+/* The children each face of a cell touches, for a range of its faces. */
+typedef struct mask_job {
+    const builder *b;
+    const mci_cell *cell, *child;
+    const double *mid;
+    const uint32_t *faces;
+    uint8_t *mask;
+} mask_job;
+
+static void masks(const mask_job *j, size_t first, size_t end)
+{
+    for (size_t k = first; k < end; k++)
+        j->mask[k] = children_touched(j->b, j->cell, j->child, j->mid, j->faces[k]);
+}
+
+static mcsg_status mask_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const mask_job *j = user;
+    size_t n = j->cell->count;
+    (void)err;
+    masks(j, chunk * FACE_CHUNK, n - chunk * FACE_CHUNK < FACE_CHUNK ? n : (chunk + 1) * FACE_CHUNK);
+    return MCSG_OK;
+}
+
 /* The faces of the parent that touch each child. When no child has fewer faces than
  * the parent (many faces through one point, e.g. the centre of a cylinder's cap fan),
- * splitting cannot help: the cell stays a leaf. One pass computes each face's children,
- * a second lists the faces child after child, in the parent's order. */
-static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
+ * splitting cannot help: the cell stays a leaf. One pass computes each face's children
+ * (on the threads when the level has a cell or two: the root holds every face), a
+ * second lists the faces child after child, in the parent's order. */
+static mcsg_status split_cell(level_job *j, size_t i, bool parallel, mcsg_error *err)
 {
-    level_job *j = user;
     const mci_octree *t = j->b->tree;
     const mci_cell *cell = &t->cells[j->cells[i]];
-    const uint32_t *faces;
     cell_split *out = &j->out[i];
     uint32_t largest = 0, offset[8];
     mci_cell child[8];
-    uint8_t *mask;
+    mask_job m = {j->b, cell, child, out->mid, NULL, NULL};
+    mcsg_status st = MCSG_OK;
     out->critical = cell_is_critical(t, cell);
     if (!out->critical || cell->count <= j->b->params.max_cell_faces ||
         cell->depth >= j->b->params.max_depth || !split_points(cell, out->mid))
         return MCSG_OK;
-    faces = t->face_ids + cell->first;
-    if (!(mask = mci_malloc_array(j->b->ctx, cell->count, sizeof *mask)))
+    m.faces = t->face_ids + cell->first;
+    if (!(m.mask = mci_malloc_array(j->b->ctx, cell->count, sizeof *m.mask)))
         return mci_fail_nomem(err, "building the octree");
     for (int c = 0; c < 8; c++)
         child_box(cell, c, out->mid, &child[c]);
-    for (uint32_t k = 0; k < cell->count; k++) {
-        mask[k] = children_touched(j->b, cell, child, out->mid, faces[k]);
-        for (int c = 0; mask[k] >> c; c++)
-            out->counts[c] += (mask[k] >> c) & 1;
-    }
+    if (parallel)
+        st = mci_parallel_for(j->b->ctx, (cell->count + FACE_CHUNK - 1) / FACE_CHUNK, mask_chunk,
+                              &m, err);
+    else
+        masks(&m, 0, cell->count);
+    for (uint32_t k = 0; st == MCSG_OK && k < cell->count; k++)
+        for (int c = 0; m.mask[k] >> c; c++)
+            out->counts[c] += (m.mask[k] >> c) & 1;
     for (int c = 0; c < 8; c++) {
         offset[c] = c == 0 ? 0 : offset[c - 1] + out->counts[c - 1];
         largest = out->counts[c] > largest ? out->counts[c] : largest;
     }
     out->id_count = offset[7] + out->counts[7];
-    out->ids = mci_malloc_array(j->b->ctx, out->id_count + 1, sizeof *out->ids);
+    out->ids = st == MCSG_OK ? mci_malloc_array(j->b->ctx, out->id_count + 1, sizeof *out->ids)
+                             : NULL;
     for (uint32_t k = 0; out->ids && k < cell->count; k++)
-        for (int c = 0; mask[k] >> c; c++)
-            if ((mask[k] >> c) & 1)
-                out->ids[offset[c]++] = faces[k];
-    mci_free(j->b->ctx, mask);
+        for (int c = 0; m.mask[k] >> c; c++)
+            if ((m.mask[k] >> c) & 1)
+                out->ids[offset[c]++] = m.faces[k];
+    mci_free(j->b->ctx, m.mask);
+    if (st != MCSG_OK)
+        return st;
     if (!out->ids)
         return mci_fail_nomem(err, "building the octree");
     out->split = largest < cell->count;
     return MCSG_OK;
+}
+
+static mcsg_status split_task(void *user, size_t i, mcsg_error *err)
+{
+    return split_cell(user, i, false, err);
 }
 
 /* Appends the children of a split cell (its faces in out->ids) to the tree. */
@@ -458,8 +513,11 @@ static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg
     level_job job = {b, *level, out};
     uint32_t *next = NULL;
     size_t splits = 0, next_count = 0;
-    mcsg_status st = out ? mci_parallel_for(b->ctx, *count, split_task, &job, err)
-                         : mci_fail_nomem(err, "building the octree");
+    mcsg_status st = out ? MCSG_OK : mci_fail_nomem(err, "building the octree");
+    if (st == MCSG_OK && *count < 2) /* the root: split its faces across the threads */
+        st = split_cell(&job, 0, true, err);
+    else if (st == MCSG_OK)
+        st = mci_parallel_for(b->ctx, *count, split_task, &job, err);
     for (size_t i = 0; st == MCSG_OK && i < *count; i++)
         splits += out[i].split;
     if (st == MCSG_OK && !(next = mci_malloc_array(b->ctx, 8 * splits + 1, sizeof *next)))
