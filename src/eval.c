@@ -45,10 +45,17 @@ static mcsg_status triangulate_one(void *user, size_t k, mcsg_error *err)
     return mci_arr_triangulate(&e->ctx, &e->scene.arrs[k], NULL, err);
 }
 
+static uint32_t triangulate_cost(const void *user, size_t k)
+{
+    const mci_face_arr *arr = &((const eval_state *)user)->scene.arrs[k];
+    return (uint32_t)(arr->point_count + arr->edge_count);
+}
+
 static mcsg_status triangulate_all(eval_state *e, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
-    mcsg_status st = mci_parallel_for(&e->ctx, e->scene.arr_count, triangulate_one, e, err);
+    mcsg_status st = mci_parallel_for_heaviest_first(&e->ctx, e->scene.arr_count,
+                                                     triangulate_cost, triangulate_one, e, err);
     e->stats.seconds_triangulate = mci_seconds_now() - t0;
     return st;
 }
@@ -66,6 +73,13 @@ static mcsg_status classify_one(void *user, size_t leaf, mcsg_error *err)
     leaf_jobs *j = user;
     return mci_classify_leaf(&j->e->ctx, &j->e->cl, (uint32_t)leaf, j->kept, &j->stats[leaf],
                              err);
+}
+
+/* A leaf's faces, as a rough measure of its classification's work. */
+static uint32_t classify_cost(const void *user, size_t leaf)
+{
+    const leaf_jobs *j = user;
+    return (uint32_t)j->e->tree.leaf_mesh[leaf]->triangle_count;
 }
 
 static bool join_kept(eval_state *e, const leaf_jobs *j)
@@ -108,7 +122,7 @@ static mcsg_status classify_all(eval_state *e, mcsg_error *err)
                                                              &e->cl, err)
                                        : mci_fail_nomem(err, "classifying faces");
     if (st == MCSG_OK)
-        st = mci_parallel_for(&e->ctx, n, classify_one, &j, err);
+        st = mci_parallel_for_heaviest_first(&e->ctx, n, classify_cost, classify_one, &j, err);
     if (st == MCSG_OK && !join_kept(e, &j))
         st = mci_fail_nomem(err, "classifying faces");
     for (size_t l = 0; j.kept && j.stats && l < n; l++) {

@@ -58,6 +58,19 @@ bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t n
 typedef mcsg_status (*mci_task_fn)(void *user, size_t index, mcsg_error *err);
 mcsg_status mci_parallel_for(const mci_ctx *ctx, size_t count, mci_task_fn fn, void *user,
                              mcsg_error *err);
+/* The same, running task order[i] at position i: with mci_heaviest_first's order the
+ * longest tasks start first and the threads finish together. A failure is reported for
+ * the smallest failing position. */
+mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint32_t *order,
+                                   mci_task_fn fn, void *user, mcsg_error *err);
+/* Indices 0 .. n-1 with the heaviest tasks (each over 1/256 of the total cost) first by
+ * decreasing cost, then the others in index order (NULL when out of memory). */
+uint32_t *mci_heaviest_first(const mci_ctx *ctx, const uint32_t *cost, size_t n);
+/* mci_parallel_for with that order for the costs cost(user, i) (a task's work, roughly):
+ * one big task coming last would otherwise run alone. */
+typedef uint32_t (*mci_cost_fn)(const void *user, size_t index);
+mcsg_status mci_parallel_for_heaviest_first(const mci_ctx *ctx, size_t count, mci_cost_fn cost,
+                                            mci_task_fn fn, void *user, mcsg_error *err);
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 
