@@ -1,11 +1,15 @@
 /*
  * Core helpers: the keyed sort (introsort, and an in-place radix sort for long arrays)
  * against a qsort reference on random, sorted, reversed, constant, organ-pipe, edge-key
- * and equal-rank inputs of many sizes, and the key lookup on the sorted result.
+ * and equal-rank inputs of many sizes, and the key lookup on the sorted result; the
+ * parallel loop (every task once, the first failing position reported whatever the
+ * thread count) and the heaviest-first order.
  */
 #include "testlib.h"
 #include "internal.h"
 
+#include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -98,9 +102,96 @@ TEST(find_key_reports_missing_keys)
     CHECK_EQ_SIZE(mci_find_key(items, 0, 2), 0);
 }
 
+enum { TASKS = 1000 };
+
+typedef struct task_log {
+    atomic_int runs[TASKS];
+    const int *fail; /* tasks that fail, ended by -1 */
+} task_log;
+
+static mcsg_status logged_task(void *user, size_t i, mcsg_error *err)
+{
+    task_log *log = user;
+    atomic_fetch_add(&log->runs[i], 1);
+    for (const int *f = log->fail; *f >= 0; f++)
+        if ((size_t)*f == i) {
+            err->status = MCSG_ERR_INTERNAL;
+            snprintf(err->message, sizeof err->message, "task %zu failed", i);
+            return MCSG_ERR_INTERNAL;
+        }
+    return MCSG_OK;
+}
+
+static void run_tasks(int threads, const uint32_t *order, const int *fail, task_log *log,
+                      mcsg_status *st, mcsg_error *err)
+{
+    mci_ctx ctx;
+    mcsg_options opts = {0};
+    opts.threads = threads;
+    mci_ctx_init(&ctx, &opts);
+    for (int i = 0; i < TASKS; i++)
+        atomic_init(&log->runs[i], 0);
+    log->fail = fail;
+    *st = mci_parallel_for_order(&ctx, TASKS, order, logged_task, log, err);
+}
+
+TEST(parallel_loop_runs_every_task_once_and_reports_the_first_failure)
+{
+    static const int none[] = {-1}, two[] = {800, 37, -1};
+    static task_log log;
+    uint32_t reversed[TASKS];
+    mcsg_error err;
+    mcsg_status st;
+    for (int i = 0; i < TASKS; i++)
+        reversed[i] = (uint32_t)(TASKS - 1 - i);
+    for (int threads = 1; threads <= 4; threads++) {
+        int once = 0;
+        run_tasks(threads, NULL, none, &log, &st, &err);
+        CHECK(st == MCSG_OK);
+        for (int i = 0; i < TASKS; i++)
+            once += atomic_load(&log.runs[i]) == 1;
+        CHECK_MSG(once == TASKS, "%d threads: %d of %d tasks ran once", threads, once, TASKS);
+        run_tasks(threads, reversed, none, &log, &st, &err);
+        once = 0;
+        for (int i = 0; i < TASKS; i++)
+            once += atomic_load(&log.runs[i]) == 1;
+        CHECK_MSG(once == TASKS, "%d threads, reversed: %d tasks ran once", threads, once);
+        /* In index order task 37 comes first; in reversed order task 800 does. */
+        run_tasks(threads, NULL, two, &log, &st, &err);
+        CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 37 failed") == 0);
+        run_tasks(threads, reversed, two, &log, &st, &err);
+        CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 800 failed") == 0);
+    }
+}
+
+TEST(heaviest_first_moves_only_heavy_tasks)
+{
+    mci_ctx ctx;
+    uint32_t cost[300], *order;
+    mci_ctx_init(&ctx, NULL);
+    for (int i = 0; i < 300; i++)
+        cost[i] = 1;
+    cost[7] = 500;  /* over 1/256 of the total: ahead */
+    cost[250] = 900;
+    cost[100] = 2;  /* not: keeps its place */
+    order = mci_heaviest_first(&ctx, cost, 300);
+    CHECK(order != NULL);
+    if (!order)
+        return;
+    CHECK(order[0] == 250 && order[1] == 7);
+    for (uint32_t i = 2, expect = 0; i < 300; i++, expect++) {
+        expect += expect == 7;
+        expect += expect == 250;
+        CHECK_MSG(order[i] == expect, "position %u: %u, want %u", i, order[i], expect);
+    }
+    mci_free(&ctx, order);
+}
+
 int main(void)
 {
     RUN(keyed_sort_matches_qsort);
     RUN(find_key_reports_missing_keys);
+    RUN(parallel_loop_runs_every_task_once_and_reports_the_first_failure);
+    RUN(heaviest_first_moves_only_heavy_tasks);
     return test_summary();
 }
