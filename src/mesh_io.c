@@ -344,8 +344,9 @@ void mci_io_commit_text(mci_buf *out, const char *stop)
 }
 
 /* Text records are formatted in blocks, several blocks at once on the context's threads,
- * each into its own buffer, and appended in block order: the text does not depend on the
- * thread count. Blocks go in waves so that only a wave's text is held twice. */
+ * each into its own buffer, and copied into place in block order (also on the threads):
+ * the text does not depend on the thread count. Blocks go in waves so that only a wave's
+ * text is held twice. */
 enum { RECORD_BLOCK = 4096, RECORD_WAVE = 32 };
 
 typedef struct record_job {
@@ -412,18 +413,6 @@ static mcsg_status copy_record_block(void *user, size_t i, mcsg_error *err)
     return MCSG_OK;
 }
 
-/* Room for every record at its longest, reserved once (untouched pages cost nothing), so
- * the waves never move the text; false when the size overflows or on allocation failure. */
-static bool reserve_records(const mci_ctx *ctx, const mcsg_mesh *mesh, size_t vertex_room,
-                            size_t triangle_room, mci_buf *out)
-{
-    if (mesh->vertex_count > SIZE_MAX / 2 / vertex_room ||
-        mesh->triangle_count > SIZE_MAX / 2 / triangle_room)
-        return false;
-    return mci_buf_reserve(ctx, out,
-                           mesh->vertex_count * vertex_room + mesh->triangle_count * triangle_room + 1);
-}
-
 mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
                                       const char *vertex_prefix, const char *triangle_prefix,
                                       uint32_t index_base, mci_buf *out)
@@ -433,14 +422,14 @@ mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
     record_job j = {ctx, mesh, vertex_prefix, triangle_prefix, index_base,
                     (mesh->vertex_count + RECORD_BLOCK - 1) / RECORD_BLOCK, 0, text, NULL, offset};
     size_t blocks = j.vertex_blocks + (mesh->triangle_count + RECORD_BLOCK - 1) / RECORD_BLOCK;
+    /* Two blocks per thread in flight: a block's text is held twice until copied. */
+    size_t per_wave = 2 * (size_t)mci_thread_count(ctx) < RECORD_WAVE
+                          ? 2 * (size_t)mci_thread_count(ctx) : RECORD_WAVE;
     mcsg_status st = MCSG_OK;
     mcsg_error err;
     memset(text, 0, sizeof text);
-    if (!reserve_records(ctx, mesh, strlen(vertex_prefix) + 3 * MCI_DOUBLE_TEXT_MAX + 3,
-                         strlen(triangle_prefix) + 3 * 21 + 3, out))
-        return MCSG_ERR_NOMEM;
-    for (; st == MCSG_OK && j.first_block < blocks; j.first_block += RECORD_WAVE) {
-        size_t wave = blocks - j.first_block < RECORD_WAVE ? blocks - j.first_block : RECORD_WAVE;
+    for (; st == MCSG_OK && j.first_block < blocks; j.first_block += per_wave) {
+        size_t wave = blocks - j.first_block < per_wave ? blocks - j.first_block : per_wave;
         size_t len = 0;
         st = mci_parallel_for(ctx, wave, format_record_block, &j, &err);
         for (size_t i = 0; st == MCSG_OK && i < wave; i++) {
@@ -457,6 +446,9 @@ mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
         for (size_t i = 0; i < wave; i++)
             mci_buf_free(ctx, &text[i]);
     }
+    /* An empty mesh still yields a buffer. */
+    if (st == MCSG_OK && !mci_io_reserve_text(ctx, out, 1))
+        st = MCSG_ERR_NOMEM;
     return st;
 }
 
