@@ -194,7 +194,7 @@ static mcsg_status round_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const round_job *j = user;
     size_t ids = j->e->scene.point_count + j->e->cl.new_vertex_count;
-    size_t end = ids - chunk * ROUND_CHUNK < ROUND_CHUNK ? ids : (chunk + 1) * ROUND_CHUNK;
+    size_t end = mci_chunk_end(ids, chunk, ROUND_CHUNK);
     (void)err;
     for (size_t id = chunk * ROUND_CHUNK; id < end; id++)
         if (j->r->dense[id] != MCI_NONE)

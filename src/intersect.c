@@ -99,7 +99,7 @@ static mcsg_status plane_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const plane_job *j = user;
     size_t n = j->s->face_count;
-    size_t end = n - chunk * PLANE_CHUNK < PLANE_CHUNK ? n : (chunk + 1) * PLANE_CHUNK;
+    size_t end = mci_chunk_end(n, chunk, PLANE_CHUNK);
     (void)err;
     for (size_t f = chunk * PLANE_CHUNK; f < end; f++)
         if (j->c->slot[f] != MCI_NONE)
@@ -443,8 +443,7 @@ static mcsg_status crease_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const crease_job *j = user;
     const mci_scene *s = j->s;
-    size_t end = s->face_count - chunk * PLANE_CHUNK < PLANE_CHUNK ? s->face_count
-                                                                   : (chunk + 1) * PLANE_CHUNK;
+    size_t end = mci_chunk_end(s->face_count, chunk, PLANE_CHUNK);
     (void)err;
     for (uint32_t f = (uint32_t)(chunk * PLANE_CHUNK); f < end; f++) {
         const mci_plane *plane;
@@ -1002,8 +1001,7 @@ typedef struct same_job {
 static mcsg_status hash_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const same_job *j = user;
-    size_t end = j->nb->total - chunk * HASH_CHUNK < HASH_CHUNK ? j->nb->total
-                                                                 : (chunk + 1) * HASH_CHUNK;
+    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
     (void)err;
     for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
         j->hash[slot] = definition_hash(j->nb->table[slot]);
@@ -1089,7 +1087,7 @@ typedef struct bounds_job {
 static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const bounds_job *j = user;
-    size_t end = j->n - chunk * HASH_CHUNK < HASH_CHUNK ? j->n : (chunk + 1) * HASH_CHUNK;
+    size_t end = mci_chunk_end(j->n, chunk, HASH_CHUNK);
     (void)err;
     for (size_t i = chunk * HASH_CHUNK; i < end; i++) {
         boxed_slot *item = &j->items[i];

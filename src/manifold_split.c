@@ -41,8 +41,7 @@ typedef struct splitter {
 
 static size_t chunk_end(const splitter *sp, size_t chunk)
 {
-    size_t nv = sp->m->vertex_count;
-    return nv - chunk * VERTEX_CHUNK < VERTEX_CHUNK ? nv : (chunk + 1) * VERTEX_CHUNK;
+    return mci_chunk_end(sp->m->vertex_count, chunk, VERTEX_CHUNK);
 }
 
 static const double *vertex(const mcsg_mesh *m, uint32_t v)

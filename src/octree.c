@@ -301,8 +301,7 @@ static mcsg_status box_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     const box_job *j = user;
     uint32_t faces = j->t->face_base[j->t->leaf_count];
-    uint32_t end = faces - chunk * FACE_CHUNK < FACE_CHUNK ? faces
-                                                           : (uint32_t)((chunk + 1) * FACE_CHUNK);
+    uint32_t end = (uint32_t)mci_chunk_end(faces, chunk, FACE_CHUNK);
     (void)err;
     for (uint32_t f = (uint32_t)(chunk * FACE_CHUNK); f < end; f++) {
         double *out = j->box + 6 * (size_t)f;
@@ -416,7 +415,7 @@ static mcsg_status mask_chunk(void *user, size_t chunk, mcsg_error *err)
     const mask_job *j = user;
     size_t n = j->cell->count;
     (void)err;
-    masks(j, chunk * FACE_CHUNK, n - chunk * FACE_CHUNK < FACE_CHUNK ? n : (chunk + 1) * FACE_CHUNK);
+    masks(j, chunk * FACE_CHUNK, mci_chunk_end(n, chunk, FACE_CHUNK));
     return MCSG_OK;
 }
 
