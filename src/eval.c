@@ -611,12 +611,14 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
         *provenance = NULL;
     if (!tree || !out)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_eval: NULL %s", tree ? "out" : "tree");
+    mci_pool_start(&e.ctx);
     st = run(&e, tree, out, provenance, err);
     mci_classifier_free(&e.ctx, &e.cl);
     mci_kept_free(&e.ctx, &e.kept);
     mci_scene_free(&e.ctx, &e.scene);
     mci_ptree_free(&e.ctx, &e.tree);
     mci_free(&e.ctx, e.alias);
+    mci_pool_stop(&e.ctx);
     e.stats.seconds_total = mci_seconds_now() - t0;
     if (stats)
         *stats = e.stats;

@@ -1282,6 +1282,7 @@ mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg
     leaves = mci_malloc_array(&ctx, mcsg_tree_node_count(tree) + 1, sizeof *leaves);
     if (!leaves)
         return mci_fail_nomem(err, "intersecting faces");
+    mci_pool_start(&ctx);
     st = mci_scene_build(&ctx, leaves, collect_leaves(tree, leaves), &scene, err);
     if (st == MCSG_OK)
         st = mci_scene_number_points(&ctx, &scene, err);
@@ -1291,6 +1292,7 @@ mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg
         *stats = scene.stats;
     mci_scene_free(&ctx, &scene);
     mci_free(&ctx, leaves);
+    mci_pool_stop(&ctx);
     return st;
 }
 

@@ -427,11 +427,14 @@ mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
                           ? 2 * (size_t)mci_thread_count(ctx) : RECORD_WAVE;
     mcsg_status st = MCSG_OK;
     mcsg_error err;
+    mci_ctx pooled = *ctx; /* workers kept across the waves' loops */
     memset(text, 0, sizeof text);
+    if (blocks > per_wave)
+        mci_pool_start(&pooled);
     for (; st == MCSG_OK && j.first_block < blocks; j.first_block += per_wave) {
         size_t wave = blocks - j.first_block < per_wave ? blocks - j.first_block : per_wave;
         size_t len = 0;
-        st = mci_parallel_for(ctx, wave, format_record_block, &j, &err);
+        st = mci_parallel_for(&pooled, wave, format_record_block, &j, &err);
         for (size_t i = 0; st == MCSG_OK && i < wave; i++) {
             offset[i] = len;
             len += text[i].len;
@@ -440,12 +443,13 @@ mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
             st = MCSG_ERR_NOMEM;
         if (st == MCSG_OK) {
             j.dest = out->data + out->len;
-            st = mci_parallel_for(ctx, wave, copy_record_block, &j, &err);
+            st = mci_parallel_for(&pooled, wave, copy_record_block, &j, &err);
             out->len += len;
         }
         for (size_t i = 0; i < wave; i++)
             mci_buf_free(ctx, &text[i]);
     }
+    mci_pool_stop(&pooled);
     /* An empty mesh still yields a buffer. */
     if (st == MCSG_OK && !mci_io_reserve_text(ctx, out, 1))
         st = MCSG_ERR_NOMEM;

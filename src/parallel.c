@@ -3,12 +3,14 @@
  * The first failure (the smallest failing index, whatever the thread timing) is reported,
  * and no new index is started after a failure, so results and errors are the same as a
  * sequential run's. A thread that cannot be created leaves its share to the others.
+ * A public call that runs many loops keeps its workers in a pool (mci_pool_start).
  */
 #define _POSIX_C_SOURCE 200809L
 
 #include "internal.h"
 
 #include <pthread.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <string.h>
 #include <unistd.h>
@@ -54,6 +56,163 @@ static void *worker(void *arg)
     return NULL;
 }
 
+/* ---------------------------------------------------------------------------------- */
+/* The pool                                                                            */
+
+/* How long a worker spins for the next loop, and the caller for the workers' last
+ * tasks, before sleeping. Most serial stretches between an evaluation's loops are
+ * shorter; a sleeping worker took from 0.01 to several milliseconds to wake here. */
+#define SPIN_SECONDS 0.002
+
+struct mci_pool {
+    int workers;
+    pthread_t threads[MAX_THREADS];
+    pthread_mutex_t lock;
+    pthread_cond_t posted;   /* generation moved */
+    pthread_cond_t finished; /* active fell to 0 */
+    atomic_uint generation;  /* bumped for each loop posted, and for shutdown */
+    atomic_int active;       /* workers between taking a loop and leaving it */
+    _Atomic(loop *) job;     /* the loop on offer, NULL once its caller is done */
+    atomic_bool in_use;      /* a loop runs on the pool (a nested loop runs alone) */
+    atomic_bool shutdown;
+};
+
+/* Spins (yielding) until done(p) or SPIN_SECONDS pass; false when the time ran out. */
+static bool spin_until(mci_pool *p, bool (*done)(mci_pool *, unsigned), unsigned arg)
+{
+    double until = mci_seconds_now() + SPIN_SECONDS;
+    for (unsigned i = 1; !done(p, arg); i++) {
+        if (i % 64 == 0 && mci_seconds_now() > until)
+            return false;
+        sched_yield();
+    }
+    return true;
+}
+
+static bool generation_moved(mci_pool *p, unsigned seen)
+{
+    return atomic_load(&p->generation) != seen;
+}
+
+static bool workers_idle(mci_pool *p, unsigned unused)
+{
+    (void)unused;
+    return atomic_load(&p->active) == 0;
+}
+
+/* Blocks until done(p), with cond signalled (under lock) whenever it may have become true. */
+static void sleep_until(mci_pool *p, pthread_cond_t *cond, bool (*done)(mci_pool *, unsigned),
+                        unsigned arg)
+{
+    if (spin_until(p, done, arg))
+        return;
+    pthread_mutex_lock(&p->lock);
+    while (!done(p, arg))
+        pthread_cond_wait(cond, &p->lock);
+    pthread_mutex_unlock(&p->lock);
+}
+
+static void announce(mci_pool *p, pthread_cond_t *cond)
+{
+    pthread_mutex_lock(&p->lock);
+    pthread_cond_broadcast(cond);
+    pthread_mutex_unlock(&p->lock);
+}
+
+static void post(mci_pool *p, loop *l)
+{
+    atomic_store(&p->job, l);
+    pthread_mutex_lock(&p->lock);
+    atomic_fetch_add(&p->generation, 1);
+    pthread_cond_broadcast(&p->posted);
+    pthread_mutex_unlock(&p->lock);
+}
+
+/* A worker counts itself active before it looks at the job, and the caller withdraws the
+ * job before it waits for active to reach 0 (both sequentially consistent): a worker
+ * either is waited for or finds no job, so none touches a loop after its caller left. */
+static void *pool_worker(void *arg)
+{
+    mci_pool *p = arg;
+    unsigned seen = 0;
+    for (;;) {
+        loop *l;
+        sleep_until(p, &p->posted, generation_moved, seen);
+        seen = atomic_load(&p->generation);
+        if (atomic_load(&p->shutdown))
+            return NULL;
+        atomic_fetch_add(&p->active, 1);
+        if ((l = atomic_load(&p->job)) != NULL)
+            worker(l);
+        if (atomic_fetch_sub(&p->active, 1) == 1)
+            announce(p, &p->finished);
+    }
+}
+
+static void run_on_pool(mci_pool *p, loop *l)
+{
+    post(p, l);
+    worker(l);
+    atomic_store(&p->job, NULL);
+    sleep_until(p, &p->finished, workers_idle, 0);
+}
+
+static void pool_free(const mci_ctx *ctx, mci_pool *p, int sync_objects)
+{
+    if (sync_objects > 2)
+        pthread_cond_destroy(&p->finished);
+    if (sync_objects > 1)
+        pthread_cond_destroy(&p->posted);
+    if (sync_objects > 0)
+        pthread_mutex_destroy(&p->lock);
+    mci_free(ctx, p);
+}
+
+void mci_pool_start(mci_ctx *ctx)
+{
+    int wanted = mci_thread_count(ctx);
+    mci_pool *p = wanted > 1 && !ctx->pool ? mci_malloc(ctx, sizeof *p) : NULL;
+    if (!p)
+        return;
+    memset(p, 0, sizeof *p);
+    atomic_init(&p->generation, 0);
+    atomic_init(&p->active, 0);
+    atomic_init(&p->job, NULL);
+    atomic_init(&p->in_use, false);
+    atomic_init(&p->shutdown, false);
+    if (pthread_mutex_init(&p->lock, NULL) != 0) {
+        pool_free(ctx, p, 0);
+    } else if (pthread_cond_init(&p->posted, NULL) != 0) {
+        pool_free(ctx, p, 1);
+    } else if (pthread_cond_init(&p->finished, NULL) != 0) {
+        pool_free(ctx, p, 2);
+    } else {
+        for (int t = 1; t < wanted; t++)
+            if (pthread_create(&p->threads[p->workers], NULL, pool_worker, p) == 0)
+                p->workers++;
+        if (p->workers > 0)
+            ctx->pool = p;
+        else
+            pool_free(ctx, p, 3);
+    }
+}
+
+void mci_pool_stop(mci_ctx *ctx)
+{
+    mci_pool *p = ctx->pool;
+    if (!p)
+        return;
+    atomic_store(&p->shutdown, true);
+    post(p, NULL);
+    for (int t = 0; t < p->workers; t++)
+        pthread_join(p->threads[t], NULL);
+    pool_free(ctx, p, 3);
+    ctx->pool = NULL;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Loops                                                                               */
+
 int mci_thread_count(const mci_ctx *ctx)
 {
     long n = ctx->threads > 0 ? ctx->threads : sysconf(_SC_NPROCESSORS_ONLN);
@@ -71,8 +230,9 @@ mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint3
 {
     pthread_t threads[MAX_THREADS];
     int wanted = mci_thread_count(ctx), started = 0;
+    mci_pool *pool = ctx->pool;
     loop l;
-    if (wanted <= 1 || count <= 1) {
+    if (wanted <= 1 || count <= 1 || (pool && atomic_exchange(&pool->in_use, true))) {
         for (size_t i = 0; i < count; i++) {
             mcsg_status st = fn(user, order ? order[i] : i, err);
             if (st != MCSG_OK)
@@ -91,14 +251,21 @@ mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint3
     if (pthread_mutex_init(&l.lock, NULL) != 0) {
         mci_ctx one = *ctx;
         one.threads = 1;
+        if (pool)
+            atomic_store(&pool->in_use, false);
         return mci_parallel_for_order(&one, count, order, fn, user, err);
     }
-    for (int t = 1; t < wanted && (size_t)t < count; t++)
-        if (pthread_create(&threads[started], NULL, worker, &l) == 0)
-            started++;
-    worker(&l);
-    for (int t = 0; t < started; t++)
-        pthread_join(threads[t], NULL);
+    if (pool) {
+        run_on_pool(pool, &l);
+        atomic_store(&pool->in_use, false);
+    } else {
+        for (int t = 1; t < wanted && (size_t)t < count; t++)
+            if (pthread_create(&threads[started], NULL, worker, &l) == 0)
+                started++;
+        worker(&l);
+        for (int t = 0; t < started; t++)
+            pthread_join(threads[t], NULL);
+    }
     pthread_mutex_destroy(&l.lock);
     if (l.fail_index == SIZE_MAX)
         return MCSG_OK;

@@ -3,7 +3,8 @@
  * against a qsort reference on random, sorted, reversed, constant, organ-pipe, edge-key
  * and equal-rank inputs of many sizes, and the key lookup on the sorted result; the
  * parallel loop (every task once, the first failing position reported whatever the
- * thread count) and the heaviest-first order.
+ * thread count, with threads per loop or a pool), the pool's short and nested loops and
+ * the heaviest-first order.
  */
 #include "testlib.h"
 #include "internal.h"
@@ -122,19 +123,36 @@ static mcsg_status logged_task(void *user, size_t i, mcsg_error *err)
     return MCSG_OK;
 }
 
-static void run_tasks(int threads, const uint32_t *order, const int *fail, task_log *log,
-                      mcsg_status *st, mcsg_error *err)
+static void run_tasks(const mci_ctx *ctx, const uint32_t *order, const int *fail,
+                      task_log *log, mcsg_status *st, mcsg_error *err)
+{
+    for (int i = 0; i < TASKS; i++)
+        atomic_init(&log->runs[i], 0);
+    log->fail = fail;
+    *st = mci_parallel_for_order(ctx, TASKS, order, logged_task, log, err);
+}
+
+static int ran_once(const task_log *log)
+{
+    int once = 0;
+    for (int i = 0; i < TASKS; i++)
+        once += atomic_load(&log->runs[i]) == 1;
+    return once;
+}
+
+static mci_ctx ctx_with_threads(int threads, bool pooled)
 {
     mci_ctx ctx;
     mcsg_options opts = {0};
     opts.threads = threads;
     mci_ctx_init(&ctx, &opts);
-    for (int i = 0; i < TASKS; i++)
-        atomic_init(&log->runs[i], 0);
-    log->fail = fail;
-    *st = mci_parallel_for_order(&ctx, TASKS, order, logged_task, log, err);
+    if (pooled)
+        mci_pool_start(&ctx);
+    return ctx;
 }
 
+/* With threads started per loop and with a pool: the pool's workers must pick up every
+ * loop posted after the first and never run a task twice. */
 TEST(parallel_loop_runs_every_task_once_and_reports_the_first_failure)
 {
     static const int none[] = {-1}, two[] = {800, 37, -1};
@@ -145,22 +163,74 @@ TEST(parallel_loop_runs_every_task_once_and_reports_the_first_failure)
     for (int i = 0; i < TASKS; i++)
         reversed[i] = (uint32_t)(TASKS - 1 - i);
     for (int threads = 1; threads <= 4; threads++) {
-        int once = 0;
-        run_tasks(threads, NULL, none, &log, &st, &err);
-        CHECK(st == MCSG_OK);
-        for (int i = 0; i < TASKS; i++)
-            once += atomic_load(&log.runs[i]) == 1;
-        CHECK_MSG(once == TASKS, "%d threads: %d of %d tasks ran once", threads, once, TASKS);
-        run_tasks(threads, reversed, none, &log, &st, &err);
-        once = 0;
-        for (int i = 0; i < TASKS; i++)
-            once += atomic_load(&log.runs[i]) == 1;
-        CHECK_MSG(once == TASKS, "%d threads, reversed: %d tasks ran once", threads, once);
-        /* In index order task 37 comes first; in reversed order task 800 does. */
-        run_tasks(threads, NULL, two, &log, &st, &err);
-        CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 37 failed") == 0);
-        run_tasks(threads, reversed, two, &log, &st, &err);
-        CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 800 failed") == 0);
+        for (int pooled = 0; pooled < 2; pooled++) {
+            mci_ctx ctx = ctx_with_threads(threads, pooled);
+            CHECK_MSG((ctx.pool != NULL) == (pooled && threads > 1), "%d threads: pool %p",
+                      threads, (void *)ctx.pool);
+            run_tasks(&ctx, NULL, none, &log, &st, &err);
+            CHECK(st == MCSG_OK);
+            CHECK_MSG(ran_once(&log) == TASKS, "%d threads, pool %d: %d of %d tasks ran once",
+                      threads, pooled, ran_once(&log), TASKS);
+            run_tasks(&ctx, reversed, none, &log, &st, &err);
+            CHECK_MSG(ran_once(&log) == TASKS, "%d threads, pool %d, reversed: %d tasks ran once",
+                      threads, pooled, ran_once(&log));
+            /* In index order task 37 comes first; in reversed order task 800 does. */
+            run_tasks(&ctx, NULL, two, &log, &st, &err);
+            CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 37 failed") == 0);
+            run_tasks(&ctx, reversed, two, &log, &st, &err);
+            CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 800 failed") == 0);
+            mci_pool_stop(&ctx);
+            CHECK(ctx.pool == NULL);
+        }
+    }
+}
+
+/* Many short loops in a row on one pool (workers arrive late, or after the caller has
+ * withdrawn the loop), and loops started from inside a task (they run in that thread). */
+enum { OUTER = 6, SHORT_LOOPS = 400 };
+
+typedef struct nest_job {
+    const mci_ctx *ctx;
+    task_log inner[OUTER];
+    mcsg_status inner_status[OUTER];
+} nest_job;
+
+static mcsg_status nested_task(void *user, size_t i, mcsg_error *err)
+{
+    static const int none[] = {-1};
+    nest_job *j = user;
+    run_tasks(j->ctx, NULL, none, &j->inner[i], &j->inner_status[i], err);
+    return j->inner_status[i];
+}
+
+static mcsg_status count_task(void *user, size_t i, mcsg_error *err)
+{
+    (void)err;
+    atomic_fetch_add(&((atomic_int *)user)[i], 1);
+    return MCSG_OK;
+}
+
+TEST(pool_runs_short_and_nested_loops)
+{
+    static nest_job nest;
+    for (int threads = 2; threads <= 4; threads++) {
+        mci_ctx ctx = ctx_with_threads(threads, true);
+        atomic_int counts[3];
+        mcsg_error err;
+        int wrong = 0;
+        for (int k = 0; k < 3; k++)
+            atomic_init(&counts[k], 0);
+        for (int loop = 0; loop < SHORT_LOOPS; loop++)
+            CHECK(mci_parallel_for(&ctx, 3, count_task, counts, &err) == MCSG_OK);
+        for (int k = 0; k < 3; k++)
+            CHECK_MSG(atomic_load(&counts[k]) == SHORT_LOOPS, "%d threads: task %d ran %d times",
+                      threads, k, atomic_load(&counts[k]));
+        nest.ctx = &ctx;
+        CHECK(mci_parallel_for(&ctx, OUTER, nested_task, &nest, &err) == MCSG_OK);
+        for (int k = 0; k < OUTER; k++)
+            wrong += nest.inner_status[k] != MCSG_OK || ran_once(&nest.inner[k]) != TASKS;
+        CHECK_MSG(wrong == 0, "%d threads: %d nested loops wrong", threads, wrong);
+        mci_pool_stop(&ctx);
     }
 }
 
@@ -192,6 +262,7 @@ int main(void)
     RUN(keyed_sort_matches_qsort);
     RUN(find_key_reports_missing_keys);
     RUN(parallel_loop_runs_every_task_once_and_reports_the_first_failure);
+    RUN(pool_runs_short_and_nested_loops);
     RUN(heaviest_first_moves_only_heavy_tasks);
     return test_summary();
 }
