@@ -337,21 +337,47 @@ static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const
     return ok;
 }
 
+/* Leaves in parallel, the largest first (each writes only its own faces' entries). */
+typedef struct neighbour_job {
+    const mci_ctx *ctx;
+    mci_scene *s;
+    const bool *wanted;
+} neighbour_job;
+
+static mcsg_status neighbours_of_leaf(void *user, size_t leaf, mcsg_error *err)
+{
+    const neighbour_job *j = user;
+    return leaf_neighbours(j->ctx, j->s, leaf, j->wanted)
+               ? MCSG_OK
+               : mci_fail_nomem(err, "finding neighbouring faces");
+}
+
+static uint32_t leaf_size(const void *user, size_t leaf)
+{
+    const neighbour_job *j = user;
+    return (uint32_t)j->s->octree.leaves[leaf]->triangle_count;
+}
+
 /* Neighbours of every face that takes part in a hit (the others are never asked). */
-static bool build_neighbours(const mci_ctx *ctx, mci_scene *s, const hit_list *hits)
+static mcsg_status build_neighbours(const mci_ctx *ctx, mci_scene *s, const hit_list *hits,
+                                    mcsg_error *err)
 {
     bool *wanted = mci_calloc_array(ctx, s->face_count + 1, sizeof *wanted);
-    bool ok = wanted != NULL;
+    neighbour_job job = {ctx, s, wanted};
+    mcsg_status st;
     s->neighbour = mci_malloc_array(ctx, 3 * s->face_count + 1, sizeof *s->neighbour);
-    ok = ok && s->neighbour;
-    for (size_t h = 0; ok && h < hits->count; h++)
+    if (!wanted || !s->neighbour) {
+        mci_free(ctx, wanted);
+        return mci_fail_nomem(err, "finding neighbouring faces");
+    }
+    for (size_t h = 0; h < hits->count; h++)
         wanted[hits->v[h].f] = wanted[hits->v[h].g] = true;
-    for (size_t i = 0; ok && i < 3 * s->face_count; i++)
+    for (size_t i = 0; i < 3 * s->face_count; i++)
         s->neighbour[i] = MCI_NONE;
-    for (size_t leaf = 0; ok && leaf < s->octree.leaf_count; leaf++)
-        ok = leaf_neighbours(ctx, s, leaf, wanted);
+    st = mci_parallel_for_heaviest_first(ctx, s->octree.leaf_count, leaf_size,
+                                         neighbours_of_leaf, &job, err);
     mci_free(ctx, wanted);
-    return ok;
+    return st;
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -631,13 +657,22 @@ typedef struct lack_job {
     uint8_t *lacking;
 } lack_job;
 
-static mcsg_status find_lacking(void *user, size_t k, mcsg_error *err)
+/* In chunks of arrangements: one task per arrangement wrote neighbouring bytes of
+ * `lacking` from both threads, and the step ran slower on two threads than on one. */
+enum { LACK_CHUNK = 256 };
+
+static mcsg_status find_lacking(void *user, size_t chunk, mcsg_error *err)
 {
     const lack_job *j = user;
-    const mci_face_arr *arr = &j->s->arrs[k];
+    size_t end = mci_chunk_end(j->s->arr_count, chunk, LACK_CHUNK);
     (void)err;
-    for (size_t p = 3; p < arr->point_count && !j->lacking[k]; p++)
-        j->lacking[k] = share_target(j->s, arr, p) != NULL;
+    for (size_t k = chunk * LACK_CHUNK; k < end; k++) {
+        const mci_face_arr *arr = &j->s->arrs[k];
+        bool lacking = false;
+        for (size_t p = 3; p < arr->point_count && !lacking; p++)
+            lacking = share_target(j->s, arr, p) != NULL;
+        j->lacking[k] = lacking;
+    }
     return MCSG_OK;
 }
 
@@ -681,7 +716,8 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
     if (st == MCSG_OK && !(job.lacking = mci_calloc_array(ctx, s->arr_count + 1, 1)))
         st = mci_fail_nomem(err, "arranging faces");
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, s->arr_count, find_lacking, &job, err);
+        st = mci_parallel_for(ctx, (s->arr_count + LACK_CHUNK - 1) / LACK_CHUNK, find_lacking,
+                              &job, err);
     if (st == MCSG_OK)
         st = reserve_shared(ctx, s, job.lacking, err);
     for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
@@ -871,8 +907,8 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     st = intersect_pairs(ctx, s, pairs, count, &planes, &hits, err);
     mci_free(ctx, pairs);
     t2 = mci_seconds_now();
-    if (st == MCSG_OK && !build_neighbours(ctx, s, &hits))
-        st = mci_fail_nomem(err, "finding neighbouring faces");
+    if (st == MCSG_OK)
+        st = build_neighbours(ctx, s, &hits, err);
     if (st == MCSG_OK)
         st = build_arrangements(ctx, s, &hits, &planes, err);
     free_hits(ctx, &hits);
