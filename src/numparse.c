@@ -8,7 +8,8 @@
  *     where one IEEE multiply or divide of two exact doubles rounds once, correctly.
  *  2. A 128-bit integer path for up to 19 significant digits: the value is an exact
  *     integer product m * 10^e, or the quotient (m * 2^s) / 10^k with a sticky bit for
- *     the remainder, rounded to 53 bits by round_to_double.
+ *     the remainder, rounded to 53 bits by round_to_double. Numbers for these two paths
+ *     are read in one pass (scan_short), the others through the digit array below.
  *  3. A GMP mpn path for everything else, on fixed-size stack arrays so that it never
  *     allocates (mpn functions leave memory management to the caller). Only the first
  *     MAX_SIG_DIGITS digits are kept, plus a sticky digit: a double or a midpoint
@@ -283,29 +284,43 @@ static double parse_big_fraction(const decimal *d)
 /* ---------------------------------------------------------------------------------- */
 /* Choosing the path                                                                   */
 
-/* Exact value of d for at most 19 digits. */
-static double parse_small(const decimal *d)
+/* m * 10^e, m != 0, by paths 1 and 2 of the file comment; false when neither applies
+ * (the exponent is out of their range). */
+static bool small_to_double(uint64_t m, int64_t e, double *out)
 {
-    uint64_t m = 0;
-    int64_t e = d->exp10;
-    for (size_t i = 0; i < d->count; i++)
-        m = m * 10 + d->digits[i];
 #if FLT_EVAL_METHOD == 0 /* one rounding per operation (not x87 extended precision) */
-    if (m < ((uint64_t)1 << 53) && e >= -22 && e <= 22)
-        return e >= 0 ? (double)m * exact_pow10[e] : (double)m / exact_pow10[-e];
+    if (m < ((uint64_t)1 << 53) && e >= -22 && e <= 22) {
+        *out = e >= 0 ? (double)m * exact_pow10[e] : (double)m / exact_pow10[-e];
+        return true;
+    }
 #endif
     if (e >= 0 && e <= 38) {
         u128 p = pow10_u128((int)e);
-        if ((u128)m <= ~(u128)0 / p)
-            return round_u128((u128)m * p, 0, false);
+        if ((u128)m <= ~(u128)0 / p) {
+            *out = round_u128((u128)m * p, 0, false);
+            return true;
+        }
     }
     if (e < 0 && e >= -21) {
         /* 10^21 < 2^70 and the numerator has 127 bits: the quotient has >= 57. */
         int shift = 127 - bit_length64(m);
         u128 num = (u128)m << shift, den = pow10_u128((int)-e);
-        return round_u128(num / den, -shift, num % den != 0);
+        *out = round_u128(num / den, -shift, num % den != 0);
+        return true;
     }
-    return e >= 0 ? parse_big_integer(d) : parse_big_fraction(d);
+    return false;
+}
+
+/* Exact value of d for at most 19 digits. */
+static double parse_small(const decimal *d)
+{
+    uint64_t m = 0;
+    double value;
+    for (size_t i = 0; i < d->count; i++)
+        m = m * 10 + d->digits[i];
+    if (small_to_double(m, d->exp10, &value))
+        return value;
+    return d->exp10 >= 0 ? parse_big_integer(d) : parse_big_fraction(d);
 }
 
 static double decimal_to_double(const decimal *d)
@@ -419,6 +434,45 @@ static const char *scan_special(const char *s, const char *end, double *value)
     return NULL;
 }
 
+/* The common case in one pass: at most 19 significant digits (leading zeros do not
+ * count, trailing ones do), accumulated as they are read, and an exponent within the
+ * 64- and 128-bit paths. Returns the first byte after the number, or NULL when the
+ * general scanner must decide (more digits, no digit, a far exponent). Mesh files are
+ * mostly 17-digit numbers: storing each digit and converting afterwards cost some 600
+ * instructions per number. */
+static const char *scan_short(const char *s, const char *end, double *value)
+{
+    uint64_t m = 0; /* wraps past 19 digits, and is then not used */
+    const char *p = s, *first;
+    size_t significant, fraction = 0;
+    int64_t e;
+    while (p < end && *p == '0')
+        p++;
+    for (first = p; p < end && is_digit(*p); p++)
+        m = m * 10 + (uint64_t)(*p - '0');
+    significant = (size_t)(p - first);
+    if (p < end && *p == '.') {
+        const char *point = p++;
+        if (significant == 0)
+            while (p < end && *p == '0')
+                p++;
+        for (first = p; p < end && is_digit(*p); p++)
+            m = m * 10 + (uint64_t)(*p - '0');
+        significant += (size_t)(p - first);
+        fraction = (size_t)(p - point - 1);
+        if (p - s == 1)
+            return NULL; /* "." alone */
+    }
+    if (p == s || significant > 19)
+        return NULL;
+    e = scan_exponent(&p, end) - (int64_t)fraction;
+    if (m == 0) {
+        *value = 0.0;
+        return p;
+    }
+    return small_to_double(m, e, value) ? p : NULL;
+}
+
 bool mci_parse_double(const char *s, const char *end, double *out, const char **next)
 {
     bool negative = false;
@@ -427,6 +481,11 @@ bool mci_parse_double(const char *s, const char *end, double *out, const char **
     decimal d;
     if (s < end && (*s == '+' || *s == '-'))
         negative = *s++ == '-';
+    if (s < end && (is_digit(*s) || *s == '.') && (after = scan_short(s, end, &value))) {
+        *out = negative ? -value : value;
+        *next = after;
+        return true;
+    }
     if (s < end && (is_digit(*s) || *s == '.')) {
         after = scan_decimal(s, end, &d);
         if (after)

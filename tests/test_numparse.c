@@ -23,6 +23,7 @@
 #define RANDOM_BIT_PATTERNS 1000000
 #define RANDOM_DIGIT_STRINGS 300000
 #define HALFWAY_CASES 12000
+#define SHORT_NUMBERS 400000
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 
@@ -188,6 +189,45 @@ TEST(random_digit_strings)
     int before = test_failures;
     for (int i = 0; i < RANDOM_DIGIT_STRINGS && test_failures - before < 10; i++) {
         random_digit_string(text);
+        quick_compare(text);
+    }
+}
+
+/* Numbers as mesh files write them, for the one-pass path (scan_short): 1 to 21
+ * significant digits (over 19 goes to the general scanner), leading zeros, a point
+ * anywhere or none, trailing zeros, and often an exponent near the edges of the 64- and
+ * 128-bit paths (-21 and 38 after the point's shift). */
+static void random_short_number(char *text)
+{
+    int digits = 1 + (int)(next_random() % 21);
+    int leading = (int)(next_random() % 4), trailing = (int)(next_random() % 3);
+    int total = leading + digits + trailing;
+    int point = (int)(next_random() % (uint64_t)(total + 2)) - 1; /* -1: no point */
+    char *p = text;
+    if (next_random() % 3 == 0)
+        *p++ = next_random() & 1 ? '-' : '+';
+    for (int i = 0; i < total; i++) {
+        if (i == point)
+            *p++ = '.';
+        if (i < leading || i >= leading + digits)
+            *p++ = '0';
+        else
+            *p++ = (char)('0' + (i == leading ? 1 + next_random() % 9 : next_random() % 10));
+    }
+    if (point == total)
+        *p++ = '.';
+    if (next_random() & 1)
+        sprintf(p, "e%d", (int)(next_random() % 81) - 40);
+    else
+        *p = '\0';
+}
+
+TEST(short_numbers)
+{
+    char text[128];
+    int before = test_failures;
+    for (int i = 0; i < SHORT_NUMBERS && test_failures - before < 10; i++) {
+        random_short_number(text);
         quick_compare(text);
     }
 }
@@ -439,6 +479,7 @@ int main(void)
     RUN(special_values);
     RUN(random_bit_patterns);
     RUN(random_digit_strings);
+    RUN(short_numbers);
     RUN(halfway_cases);
     RUN(format_round_trip);
     RUN(format_short_decimals);
