@@ -737,6 +737,84 @@ static bool format_round_trips(double value, int precision, char text[64], size_
            (mci_parse_double(text, text + *len, &back, &next) && back == value);
 }
 
+/* floor(|value| * 10^scale) and whether anything was cut off, for 0 <= scale <= 32
+ * (m 5^scale < 2^128, as in scaled_decimal). False when that does not fit 64 bits. */
+static bool scaled_floor(double value, int scale, uint64_t *floor_out, bool *sticky)
+{
+    int e, shift;
+    uint64_t mantissa;
+    u128 m;
+    split_double(value, &mantissa, &e);
+    m = (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale */
+    shift = e - 53 + scale;
+    if (shift >= 0) {
+        if (bit_length128(m) + shift > 63)
+            return false;
+        *floor_out = (uint64_t)(m << shift);
+        *sticky = false;
+        return true;
+    }
+    if (-shift >= 128 || bit_length128(m) + shift > 63)
+        return false;
+    *floor_out = (uint64_t)(m >> -shift);
+    *sticky = (m & ((((u128)1) << -shift) - 1)) != 0;
+    return true;
+}
+
+/* The digits exact_digits gives for 15, 16 and 17 significant digits, from one exact
+ * product: with F = floor(|value| * 10^(17 - E)) in [10^17, 10^18) (E the exact decimal
+ * exponent) and the sticky bit, p digits are F / 10^(18 - p) rounded half-even on the
+ * remainder; a carry to 10^p moves to the next exponent. False outside decimal exponents
+ * -15..17 (the caller then takes the general path). */
+static bool digits_15_to_17(double value, u128 digits[3], int exponents[3])
+{
+    int estimate = decimal_exponent_estimate(value);
+    for (int exponent = estimate; exponent <= estimate + 1; exponent++) {
+        uint64_t f, div = 1000;
+        bool sticky;
+        if (17 - exponent < 0 || 17 - exponent > 32 ||
+            !scaled_floor(value, 17 - exponent, &f, &sticky))
+            return false;
+        if (f < 100000000000000000u)
+            return false; /* the estimate is never one too high: not expected */
+        if (f >= 1000000000000000000u)
+            continue;
+        for (int p = 15; p <= 17; p++, div /= 10) {
+            uint64_t q = f / div, r = f % div, half = div / 2;
+            q += r > half || (r == half && (sticky || (q & 1)));
+            digits[p - 15] = q;
+            exponents[p - 15] = exponent;
+            if (q == (uint64_t)pow10_u128(p)) {
+                digits[p - 15] = q / 10;
+                exponents[p - 15] = exponent + 1;
+            }
+        }
+        return true;
+    }
+    return false;
+}
+
+/* mci_format_double's search with the digits of all three precisions from one product;
+ * false when it cannot decide (the caller then tries each precision on its own). */
+static bool format_from_one_product(double value, char text[64], size_t *len)
+{
+    u128 digits[3];
+    int exponents[3];
+    if (value == 0 || !digits_15_to_17(value, digits, exponents))
+        return false;
+    for (int p = 15; p <= 17; p++) {
+        int back = p == 17 ? 1
+                           : reads_back(value, digits[p - 15], p - 1 - exponents[p - 15]);
+        if (back < 0)
+            return false;
+        if (back == 1) {
+            *len = layout_g(text, value, digits[p - 15], p, exponents[p - 15]);
+            return true;
+        }
+    }
+    return false;
+}
+
 size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
 {
     char text[64] = "0";
@@ -750,9 +828,10 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
     /* The shortest of 15, 16 and 17 significant digits that reads back as value: each
      * try costs two 128-bit products (the digits and the read-back test), and the text is
      * laid out once. */
-    for (int precision = 15; precision <= 17; precision++)
-        if (format_round_trips(value, precision, text, &len))
-            break;
+    if (!format_from_one_product(value, text, &len))
+        for (int precision = 15; precision <= 17; precision++)
+            if (format_round_trips(value, precision, text, &len))
+                break;
     memcpy(buf, text, len + 1);
     return len;
 }
