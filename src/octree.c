@@ -350,6 +350,19 @@ static void child_box(const mci_cell *parent, int index, const double mid[3], mc
     }
 }
 
+/* The index of the lowest set bit of a child mask (lowest_bit[0] is never used). */
+static const uint8_t lowest_bit[256] = {
+    0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0,
+    2, 0, 1, 0, 5, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0,
+    3, 0, 1, 0, 2, 0, 1, 0, 6, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0,
+    2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 5, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0,
+    4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 7, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0,
+    2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 5, 0, 1, 0, 2, 0, 1, 0,
+    3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 6, 0, 1, 0,
+    2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0,
+    5, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0, 4, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0,
+    2, 0, 1, 0};
+
 /* Children on one side of the split along axis k (bit k of a child's index: upper
  * half): side_children[k][s] for s = 1 lower, 2 upper, 3 both. */
 static const uint8_t side_children[3][4] = {
@@ -386,12 +399,14 @@ static uint8_t children_touched(const builder *b, const mci_cell *cell,
     uint8_t candidates = 0xFF, mask;
     for (int k = 0; k < 3; k++)
         candidates &= side_children[k][(box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1];
-    mask = candidates & (candidates - 1) ? candidates & children_holding_corners(b, cell, mid, f)
-                                         : 0;
-    candidates &= (uint8_t)~mask;
-    for (int c = 0; candidates >> c; c++)
-        if (((candidates >> c) & 1) && face_touches_cell(b, f, &child[c]))
+    if (!(candidates & (candidates - 1))) /* one child (most faces, deep down) */
+        return face_touches_cell(b, f, &child[lowest_bit[candidates]]) ? candidates : 0;
+    mask = candidates & children_holding_corners(b, cell, mid, f);
+    for (candidates &= (uint8_t)~mask; candidates; candidates &= (uint8_t)(candidates - 1)) {
+        int c = lowest_bit[candidates];
+        if (face_touches_cell(b, f, &child[c]))
             mask |= (uint8_t)(1u << c);
+    }
     return mask;
 }
 
@@ -448,8 +463,8 @@ static mcsg_status split_cell(level_job *j, size_t i, bool parallel, mcsg_error 
     else
         masks(&m, 0, cell->count);
     for (uint32_t k = 0; st == MCSG_OK && k < cell->count; k++)
-        for (int c = 0; m.mask[k] >> c; c++)
-            out->counts[c] += (m.mask[k] >> c) & 1;
+        for (unsigned bits = m.mask[k]; bits; bits &= bits - 1)
+            out->counts[lowest_bit[bits]]++;
     for (int c = 0; c < 8; c++) {
         offset[c] = c == 0 ? 0 : offset[c - 1] + out->counts[c - 1];
         largest = out->counts[c] > largest ? out->counts[c] : largest;
@@ -458,9 +473,8 @@ static mcsg_status split_cell(level_job *j, size_t i, bool parallel, mcsg_error 
     out->ids = st == MCSG_OK ? mci_malloc_array(j->b->ctx, out->id_count + 1, sizeof *out->ids)
                              : NULL;
     for (uint32_t k = 0; out->ids && k < cell->count; k++)
-        for (int c = 0; m.mask[k] >> c; c++)
-            if ((m.mask[k] >> c) & 1)
-                out->ids[offset[c]++] = m.faces[k];
+        for (unsigned bits = m.mask[k]; bits; bits &= bits - 1)
+            out->ids[offset[lowest_bit[bits]]++] = m.faces[k];
     mci_free(j->b->ctx, m.mask);
     if (st != MCSG_OK)
         return st;
