@@ -78,6 +78,20 @@ static bool next_content_line(off_reader *r)
     return false;
 }
 
+/* The next integer on the line, read where it starts (no separate token scan: face lines
+ * are most of a mesh file). *begin is where it starts, for messages; false when the line
+ * has no more tokens (*begin == r->stop) or the token is not an integer. */
+static bool next_integer_on_line(off_reader *r, const char **begin, int64_t *value)
+{
+    const char *p = mci_io_skip_blanks(r->p, r->stop), *next;
+    *begin = p;
+    if (p == r->stop || !mci_io_integer(p, r->stop, value, &next) ||
+        (next < r->stop && !mci_io_is_blank(*next)))
+        return false;
+    r->p = next;
+    return true;
+}
+
 static bool next_token_on_line(off_reader *r, const char **begin, const char **stop)
 {
     const char *p = mci_io_skip_blanks(r->p, r->stop);
@@ -205,25 +219,25 @@ static mcsg_status read_vertex(off_reader *r)
 /* "n i0 ... i(n-1)" followed by ignored colour values; fan-triangulated. */
 static mcsg_status read_face(off_reader *r, uint32_t vertex_count)
 {
-    const char *begin, *stop, *next;
+    const char *begin;
     int64_t corners, index;
     uint32_t first = 0, previous = 0;
-    take_first_token(r, &begin, &stop);
-    if (!parse_count(begin, stop, &corners))
+    if (!next_integer_on_line(r, &begin, &corners) || corners < 0)
         return fail_token(r, "corner count", begin);
     if (corners < 3)
         return mci_io_fail_line(r->src, MCSG_ERR_PARSE, line_number(r), "polygon with %lld "
                                 "corners (at least 3 needed)", (long long)corners);
     for (int64_t k = 0; k < corners; k++) {
-        if (!next_token_on_line(r, &begin, &stop))
-            return mci_io_fail_line(r->src, MCSG_ERR_PARSE, line_number(r), "expected %lld "
-                                    "vertex indices, found %lld", (long long)corners,
-                                    (long long)k);
-        if (!mci_io_integer(begin, stop, &index, &next) || next != stop)
+        if (!next_integer_on_line(r, &begin, &index)) {
+            if (begin == r->stop)
+                return mci_io_fail_line(r->src, MCSG_ERR_PARSE, line_number(r), "expected "
+                                        "%lld vertex indices, found %lld", (long long)corners,
+                                        (long long)k);
             return fail_token(r, "vertex index", begin);
+        }
         if (index < 0 || index >= vertex_count) {
             char excerpt[48];
-            mci_io_excerpt_span(excerpt, begin, stop);
+            mci_io_excerpt_span(excerpt, begin, r->p);
             return mci_io_fail_line(r->src, MCSG_ERR_PARSE, line_number(r), "vertex index "
                                     "%s out of range (%u vertices)", excerpt,
                                     (unsigned)vertex_count);
