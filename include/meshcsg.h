@@ -96,7 +96,9 @@ typedef struct mcsg_options {
                                  of a CSG text's import() calls and for writing text
                                  meshes; 0: all cores. With more than one, the allocator
                                  is called from several threads at once and must be
-                                 thread-safe (malloc is). Results do not depend on it */
+                                 thread-safe (malloc is). Results do not depend on it.
+                                 The workers live for one call; between its parallel
+                                 steps they spin (yielding) up to 2 ms, then sleep */
     mcsg_progress_fn progress; /* NULL: no progress reports */
     void *progress_user;       /* passed to progress */
     int check_self_intersections; /* mcsg_eval: nonzero tests every leaf for
