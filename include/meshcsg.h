@@ -14,7 +14,8 @@
  *    are only read, never kept: the library copies what it needs.
  *  - The library never exits, never prints and keeps no global mutable state; it
  *    reports through return values and the optional logging callback only. Distinct
- *    objects may be used from different threads at the same time.
+ *    objects may be used from different threads at the same time (a worker pool may
+ *    be shared: see mcsg_options.pool).
  *  - On error, output arguments are left empty (zeroed mesh, NULL pointers) and nothing
  *    is leaked, including when an allocation fails half-way.
  */
@@ -87,6 +88,9 @@ typedef void (*mcsg_log_fn)(void *user, mcsg_log_level level, const char *messag
  * "classify") starts and done = 1 when it ends, from the thread that called the library. */
 typedef void (*mcsg_progress_fn)(void *user, const char *step, int done);
 
+/* Worker threads that several calls share (mcsg_pool_create). */
+typedef struct mcsg_pool mcsg_pool;
+
 /* Zero means default for every field. */
 typedef struct mcsg_options {
     mcsg_allocator allocator; /* zero: malloc/realloc/free */
@@ -105,7 +109,22 @@ typedef struct mcsg_options {
                                      self-intersections before evaluating (exact, costs
                                      about as much as an evaluation) and names the first
                                      such leaf with MCSG_ERR_INVALID_MESH */
+    mcsg_pool *pool;          /* NULL: each call starts its own workers. Else the calls
+                                 made with these options use this pool's workers
+                                 (worth it for many short calls: starting a thread
+                                 costs from 0.05 to a few milliseconds); calls running
+                                 at the same time take turns with it, a call that finds
+                                 it busy runs its parallel steps on its own thread */
 } mcsg_options;
+
+/* Start worker threads for calls to share: opts->threads of them in all counting the
+ * caller's (0: all cores), with the allocator of opts. *out is NULL (and the status
+ * MCSG_OK) when that is one thread: calls then need no workers. The pool must outlive
+ * every call that uses it. */
+mcsg_status mcsg_pool_create(const mcsg_options *opts, mcsg_pool **out, mcsg_error *err);
+
+/* Stop and release the workers (NULL is a no-op). No call may be using the pool. */
+void mcsg_pool_free(mcsg_pool *pool);
 
 /* Release a buffer returned by the library (e.g. from mcsg_mesh_write_memory).
  * free(NULL) is a no-op. */

@@ -19,7 +19,7 @@
 #define MCI_PRINTF(fmt, args)
 #endif
 
-typedef struct mci_pool mci_pool;
+typedef struct mcsg_pool mci_pool; /* the public pool type, opaque outside parallel.c */
 
 /* Resolved options: the allocator is always complete, the logger may be NULL. */
 typedef struct mci_ctx {
@@ -30,7 +30,8 @@ typedef struct mci_ctx {
     mcsg_progress_fn progress;
     void *progress_user;
     int check_self_intersections;
-    mci_pool *pool; /* worker threads kept for one call (mci_pool_start), or NULL */
+    mci_pool *pool; /* worker threads: the options' (borrowed) or the call's own */
+    bool owns_pool; /* started by mci_pool_start, stopped by mci_pool_stop */
 } mci_ctx;
 
 /* Report the start (done = 0) or end (done = 1) of a step, if asked to. */
@@ -54,13 +55,15 @@ char *mci_strdup(const mci_ctx *ctx, const char *s);
 bool mci_grow_array(const mci_ctx *ctx, void **array, size_t *capacity, size_t need,
                     size_t elem_size, size_t min_capacity);
 
-/* Worker threads kept waiting for the parallel loops of one public call: starting a
- * thread per loop cost 0.05-5 ms per loop on the two-core test machine (the new thread
- * waited for a sleeping processor), which the short loops could not repay. Workers spin
- * briefly between loops, then sleep. mci_pool_start does nothing with one thread or when
- * threads or memory are short (loops then start their own threads); mci_pool_stop joins
- * and frees the workers. A loop started from inside a loop of the same pool runs in the
- * calling thread. */
+/* Worker threads kept waiting for the parallel loops of one public call (or of many,
+ * through mcsg_options.pool): starting a thread per loop cost 0.05-5 ms per loop on the
+ * two-core test machine (the new thread waited for a sleeping processor), which the
+ * short loops could not repay. Workers spin briefly between loops, then sleep.
+ * mci_pool_start does nothing when ctx has a pool already (the options'), with one
+ * thread, or when threads or memory are short (loops then start their own threads);
+ * mci_pool_stop joins and frees the workers it started. A loop started while the pool
+ * runs another (from inside a task, or from another call sharing it) runs in the calling
+ * thread. */
 void mci_pool_start(mci_ctx *ctx);
 void mci_pool_stop(mci_ctx *ctx);
 

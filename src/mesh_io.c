@@ -429,6 +429,7 @@ mcsg_status mci_io_write_text_records(const mci_ctx *ctx, const mcsg_mesh *mesh,
     mcsg_error err;
     mci_ctx pooled = *ctx; /* workers kept across the waves' loops */
     memset(text, 0, sizeof text);
+    pooled.owns_pool = false; /* a pool ctx has stays ctx's */
     if (blocks > per_wave)
         mci_pool_start(&pooled);
     for (; st == MCSG_OK && j.first_block < blocks; j.first_block += per_wave) {

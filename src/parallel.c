@@ -64,7 +64,8 @@ static void *worker(void *arg)
  * shorter; a sleeping worker took from 0.01 to several milliseconds to wake here. */
 #define SPIN_SECONDS 0.002
 
-struct mci_pool {
+struct mcsg_pool {
+    mcsg_allocator alloc; /* the pool's own memory comes from and goes back to it */
     int workers;
     pthread_t threads[MAX_THREADS];
     pthread_mutex_t lock;
@@ -157,57 +158,94 @@ static void run_on_pool(mci_pool *p, loop *l)
     sleep_until(p, &p->finished, workers_idle, 0);
 }
 
-static void pool_free(const mci_ctx *ctx, mci_pool *p, int sync_objects)
+static void pool_free(mci_pool *p, int sync_objects)
 {
+    mcsg_allocator alloc = p->alloc;
     if (sync_objects > 2)
         pthread_cond_destroy(&p->finished);
     if (sync_objects > 1)
         pthread_cond_destroy(&p->posted);
     if (sync_objects > 0)
         pthread_mutex_destroy(&p->lock);
-    mci_free(ctx, p);
+    alloc.free_fn(alloc.user, p);
 }
 
-void mci_pool_start(mci_ctx *ctx)
+/* A pool with `wanted` - 1 workers, or NULL (out of memory or no thread started). */
+static mci_pool *pool_new(const mci_ctx *ctx, int wanted)
 {
-    int wanted = mci_thread_count(ctx);
-    mci_pool *p = wanted > 1 && !ctx->pool ? mci_malloc(ctx, sizeof *p) : NULL;
+    mci_pool *p = mci_malloc(ctx, sizeof *p);
     if (!p)
-        return;
+        return NULL;
     memset(p, 0, sizeof *p);
+    p->alloc = ctx->alloc;
     atomic_init(&p->generation, 0);
     atomic_init(&p->active, 0);
     atomic_init(&p->job, NULL);
     atomic_init(&p->in_use, false);
     atomic_init(&p->shutdown, false);
     if (pthread_mutex_init(&p->lock, NULL) != 0) {
-        pool_free(ctx, p, 0);
+        pool_free(p, 0);
     } else if (pthread_cond_init(&p->posted, NULL) != 0) {
-        pool_free(ctx, p, 1);
+        pool_free(p, 1);
     } else if (pthread_cond_init(&p->finished, NULL) != 0) {
-        pool_free(ctx, p, 2);
+        pool_free(p, 2);
     } else {
         for (int t = 1; t < wanted; t++)
             if (pthread_create(&p->threads[p->workers], NULL, pool_worker, p) == 0)
                 p->workers++;
         if (p->workers > 0)
-            ctx->pool = p;
-        else
-            pool_free(ctx, p, 3);
+            return p;
+        pool_free(p, 3);
     }
+    return NULL;
 }
 
-void mci_pool_stop(mci_ctx *ctx)
+static void pool_delete(mci_pool *p)
 {
-    mci_pool *p = ctx->pool;
-    if (!p)
-        return;
     atomic_store(&p->shutdown, true);
     post(p, NULL);
     for (int t = 0; t < p->workers; t++)
         pthread_join(p->threads[t], NULL);
-    pool_free(ctx, p, 3);
-    ctx->pool = NULL;
+    pool_free(p, 3);
+}
+
+void mci_pool_start(mci_ctx *ctx)
+{
+    int wanted = mci_thread_count(ctx);
+    if (wanted > 1 && !ctx->pool && (ctx->pool = pool_new(ctx, wanted)) != NULL)
+        ctx->owns_pool = true;
+}
+
+void mci_pool_stop(mci_ctx *ctx)
+{
+    if (ctx->pool && ctx->owns_pool)
+        pool_delete(ctx->pool);
+    if (ctx->owns_pool)
+        ctx->pool = NULL;
+    ctx->owns_pool = false;
+}
+
+mcsg_status mcsg_pool_create(const mcsg_options *opts, mcsg_pool **out, mcsg_error *err)
+{
+    mci_ctx ctx;
+    int wanted;
+    if (!out)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_pool_create: NULL output");
+    mci_ctx_init(&ctx, opts);
+    wanted = mci_thread_count(&ctx);
+    *out = NULL;
+    if (wanted <= 1)
+        return MCSG_OK;
+    if (!(*out = pool_new(&ctx, wanted)))
+        return mci_fail(err, MCSG_ERR_NOMEM, "starting %d worker threads: out of memory or "
+                        "threads", wanted - 1);
+    return MCSG_OK;
+}
+
+void mcsg_pool_free(mcsg_pool *pool)
+{
+    if (pool)
+        pool_delete(pool);
 }
 
 /* ---------------------------------------------------------------------------------- */

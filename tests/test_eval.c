@@ -8,6 +8,7 @@
 #include "testlib.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -470,6 +471,92 @@ TEST(output_is_independent_of_memory_layout_and_threads)
     free(arena.base);
 }
 
+static bool same_mesh(const mcsg_mesh *a, const mcsg_mesh *b)
+{
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
+           memcmp(a->vertices, b->vertices, 3 * a->vertex_count * sizeof(double)) == 0 &&
+           memcmp(a->triangles, b->triangles, 3 * a->triangle_count * sizeof(uint32_t)) == 0;
+}
+
+static const char *const pool_scene =
+    "difference() { union() { rotate([10,20,30]) sphere(r=2,$fn=24);"
+    " translate([1.3,0.2,0.1]) rotate([40,5,70]) sphere(r=1.7,$fn=20); }"
+    " translate([0.4,1.1,-0.3]) rotate([3,60,9]) cylinder(h=4,r=1,center=true,$fn=18); }";
+
+typedef struct pool_user {
+    const mcsg_options *opts;
+    mcsg_mesh out;
+    int runs, same;
+    const mcsg_mesh *expected;
+} pool_user;
+
+static void *evaluate_repeatedly(void *arg)
+{
+    pool_user *u = arg;
+    for (int r = 0; r < u->runs; r++) {
+        mcsg_mesh m;
+        if (test_eval_scad(pool_scene, u->opts, &m, NULL, NULL) != MCSG_OK)
+            continue;
+        u->same += same_mesh(&m, u->expected);
+        mcsg_mesh_free(&m, u->opts);
+    }
+    return NULL;
+}
+
+/* Workers shared through mcsg_options.pool: the same output as without, call after call,
+ * and with two threads evaluating at once (one of them finds the pool busy and runs its
+ * loops alone). One thread needs no pool. */
+TEST(shared_worker_pool)
+{
+    mcsg_options own = {0}, shared = {0}, single = {0};
+    mcsg_pool *pool = NULL, *none = (mcsg_pool *)&none;
+    mcsg_mesh reference;
+    mcsg_error err;
+    pthread_t other;
+    pool_user users[2];
+    single.threads = 1;
+    CHECK(mcsg_pool_create(&single, &none, &err) == MCSG_OK && none == NULL);
+    own.threads = 3;
+    if (!eval_with(pool_scene, &own, &reference))
+        return;
+    CHECK_OK(mcsg_pool_create(&own, &pool, &err), &err);
+    CHECK(pool != NULL);
+    shared.threads = 3;
+    shared.pool = pool;
+    for (int k = 0; k < 2; k++)
+        users[k] = (pool_user){&shared, {0}, 6, 0, &reference};
+    evaluate_repeatedly(&users[0]);
+    CHECK_MSG(users[0].same == 6, "%d of 6 runs gave the same mesh", users[0].same);
+    users[0].same = 0;
+    CHECK(pthread_create(&other, NULL, evaluate_repeatedly, &users[1]) == 0);
+    evaluate_repeatedly(&users[0]);
+    pthread_join(other, NULL);
+    CHECK_MSG(users[0].same == 6 && users[1].same == 6, "concurrent runs: %d and %d of 6 the "
+              "same", users[0].same, users[1].same);
+    mcsg_pool_free(pool);
+    mcsg_pool_free(NULL);
+    mcsg_mesh_free(&reference, &own);
+}
+
+static mcsg_status create_pool_under(const void *ctx, const mcsg_options *opts,
+                                     mcsg_error *err)
+{
+    mcsg_options three = *opts;
+    mcsg_pool *pool = NULL;
+    mcsg_status st;
+    (void)ctx;
+    three.threads = 3;
+    st = mcsg_pool_create(&three, &pool, err);
+    CHECK((st == MCSG_OK) == (pool != NULL));
+    mcsg_pool_free(pool);
+    return st;
+}
+
+TEST(pool_creation_reports_allocation_failure)
+{
+    CHECK(test_allocation_failures("mcsg_pool_create", create_pool_under, NULL, false) >= 1);
+}
+
 /* Touching parts at both ends of a big output: vertex copies are made in chunks of 4,096
  * vertices on the threads and numbered in vertex order, so the mesh is the same for any
  * thread count, with copies from the first chunk and from a later one. */
@@ -637,6 +724,8 @@ int main(void)
     RUN(copies_are_evaluated_once);
     RUN(touching_solids);
     RUN(touching_parts_in_a_big_output);
+    RUN(shared_worker_pool);
+    RUN(pool_creation_reports_allocation_failure);
     RUN(coplanar_overlaps);
     RUN(curved_volumes_add_up);
     RUN(aligned_edges_and_close_points);

@@ -636,17 +636,54 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  total            %8.3f s\n", s->seconds_total);
 }
 
-static int cmd_eval(int argc, char **argv)
+/* Read, evaluate and write one CSG file with the given options. */
+static int eval_file(mcsg_options *opts, const char *in, const char *out,
+                     int show_stats)
 {
-    mcsg_options opts = cli_options();
-    const char *in = NULL, *out = NULL;
-    int show_stats = 0, ok;
+    int ok;
     double read_seconds, write_seconds;
     mcsg_status st;
     mcsg_tree *tree;
     mcsg_mesh result;
     mcsg_eval_stats stats;
     mcsg_error err;
+    read_seconds = now_seconds();
+    if (mcsg_scad_read(in, opts, &tree, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    read_seconds = now_seconds() - read_seconds;
+    start_progress(opts);
+    st = mcsg_eval(tree, opts, &result, NULL, &stats, &err);
+    stop_progress();
+    if (st != MCSG_OK) {
+        fail_line(&err);
+        mcsg_tree_free(tree);
+        return EXIT_PROBLEM;
+    }
+    write_seconds = now_seconds();
+    ok = !out || mcsg_mesh_write(out, MCSG_FORMAT_AUTO, &result, opts, &err) == MCSG_OK;
+    write_seconds = now_seconds() - write_seconds;
+    if (!ok)
+        fail_line(&err);
+    if (show_stats) {
+        print_eval_stats(&stats, read_seconds);
+        printf("  write output     %8.3f s\n", write_seconds);
+        printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
+    }
+    else
+        printf("%zu vertices, %zu triangles\n", result.vertex_count, result.triangle_count);
+    mcsg_mesh_free(&result, opts);
+    mcsg_tree_free(tree);
+    return ok ? 0 : EXIT_PROBLEM;
+}
+
+static int cmd_eval(int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    const char *in = NULL, *out = NULL;
+    int show_stats = 0, code;
+    mcsg_pool *pool = NULL;
     for (int i = 0; i < argc; i++) {
         if (strcmp(argv[i], "-o") == 0 && i + 1 < argc)
             out = argv[++i];
@@ -664,35 +701,14 @@ static int cmd_eval(int argc, char **argv)
                 "[--check-inputs]\n");
         return EXIT_USAGE;
     }
-    read_seconds = now_seconds();
-    if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
-        fail_line(&err);
-        return EXIT_PROBLEM;
-    }
-    read_seconds = now_seconds() - read_seconds;
-    start_progress(&opts);
-    st = mcsg_eval(tree, &opts, &result, NULL, &stats, &err);
-    stop_progress();
-    if (st != MCSG_OK) {
-        fail_line(&err);
-        mcsg_tree_free(tree);
-        return EXIT_PROBLEM;
-    }
-    write_seconds = now_seconds();
-    ok = !out || mcsg_mesh_write(out, MCSG_FORMAT_AUTO, &result, &opts, &err) == MCSG_OK;
-    write_seconds = now_seconds() - write_seconds;
-    if (!ok)
-        fail_line(&err);
-    if (show_stats) {
-        print_eval_stats(&stats, read_seconds);
-        printf("  write output     %8.3f s\n", write_seconds);
-        printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
-    }
-    else
-        printf("%zu vertices, %zu triangles\n", result.vertex_count, result.triangle_count);
-    mcsg_mesh_free(&result, &opts);
-    mcsg_tree_free(tree);
-    return ok ? 0 : EXIT_PROBLEM;
+    /* One set of workers for reading, evaluating and writing: each call would start its
+     * own, and a new thread took up to milliseconds to get going. Without the pool (no
+     * threads to spare) every call runs as before. */
+    if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK)
+        opts.pool = pool;
+    code = eval_file(&opts, in, out, show_stats);
+    mcsg_pool_free(pool);
+    return code;
 }
 
 static int demo_check_leaves(const mcsg_tree *tree, const mcsg_options *opts,
@@ -784,6 +800,7 @@ static int cmd_demo(int argc, char **argv)
     size_t faces = 0;
     const char *out = NULL;
     mcsg_tree *tree;
+    mcsg_pool *pool = NULL;
     mcsg_error err;
     double t0, t1, t2;
     for (int i = 0; i < argc; i++) {
@@ -796,9 +813,12 @@ static int cmd_demo(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
+    if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK) /* shared by the calls below */
+        opts.pool = pool;
     t0 = now_seconds();
     if (scene_ring_spheres(spheres, 1, &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
+        mcsg_pool_free(pool);
         return EXIT_PROBLEM;
     }
     t1 = now_seconds();
@@ -813,6 +833,7 @@ static int cmd_demo(int argc, char **argv)
     if (valid)
         valid = demo_evaluate(tree, &opts, out, spheres);
     mcsg_tree_free(tree);
+    mcsg_pool_free(pool);
     return valid ? 0 : EXIT_PROBLEM;
 }
 
