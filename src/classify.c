@@ -729,12 +729,12 @@ static bool pair_by_vertex(leaf_work *w, size_t n, bool *nomem)
     ok = n > 0 && (vs.last - vs.first) / 8 < n && list_sides_by_vertex(w, n, &vs, nomem);
     for (size_t s = 0; ok && s < n; s++) {
         uint32_t k = vs.sides[s].slot, u = slot_from(w, k), v = vs.sides[s].to;
-        uint32_t back = MCI_NONE, self;
+        uint32_t back = MCI_NONE, ignored;
         uint64_t key = mci_edge_key(u, v);
         size_t ahead, behind;
         if (w->mate[k] != MCI_NONE)
             continue;
-        ahead = sides_between(&vs, u, v, &self);
+        ahead = sides_between(&vs, u, v, &ignored);
         behind = sides_between(&vs, v, u, &back);
         if (u != v && ahead == 1 && behind == 1) {
             w->mate[k] = back;
@@ -752,7 +752,8 @@ static bool pair_by_vertex(leaf_work *w, size_t n, bool *nomem)
 /* Pair every directed piece edge with its opposite; a closed, consistently oriented
  * edge-manifold surface has exactly one. Sides on face borders are sorted by edge key
  * and walked along the sorted separators (collect_separators), which marks the
- * separator slots (is_sep); large leaves are paired by vertex first (pair_by_vertex). */
+ * separator slots (is_sep); leaves with dense vertex ids are paired by vertex first
+ * (pair_by_vertex). */
 static mcsg_status pair_edges(leaf_work *w)
 {
     size_t n, i = 0, sep = 0, m = 0;
