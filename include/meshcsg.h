@@ -110,11 +110,12 @@ typedef struct mcsg_options {
                                      about as much as an evaluation) and names the first
                                      such leaf with MCSG_ERR_INVALID_MESH */
     mcsg_pool *pool;          /* NULL: each call starts its own workers. Else the calls
-                                 made with these options use this pool's workers
-                                 (worth it for many short calls: starting a thread
-                                 costs from 0.05 to a few milliseconds); calls running
-                                 at the same time take turns with it, a call that finds
-                                 it busy runs its parallel steps on its own thread */
+                                 made with these options use this pool's workers (all
+                                 of them, whenever threads is not 1; worth it for many
+                                 short calls: starting a thread costs from 0.05 to a
+                                 few milliseconds); calls running at the same time
+                                 take turns with it, a call that finds it busy runs its
+                                 parallel steps on its own thread */
 } mcsg_options;
 
 /* Start worker threads for calls to share: opts->threads of them in all counting the
