@@ -481,14 +481,9 @@ bool mci_parse_double(const char *s, const char *end, double *out, const char **
     decimal d;
     if (s < end && (*s == '+' || *s == '-'))
         negative = *s++ == '-';
-    if (s < end && (is_digit(*s) || *s == '.') && (after = scan_short(s, end, &value))) {
-        *out = negative ? -value : value;
-        *next = after;
-        return true;
-    }
     if (s < end && (is_digit(*s) || *s == '.')) {
-        after = scan_decimal(s, end, &d);
-        if (after)
+        after = scan_short(s, end, &value);
+        if (!after && (after = scan_decimal(s, end, &d)) != NULL)
             value = decimal_to_double(&d);
     } else {
         after = scan_special(s, end, &value);
@@ -544,18 +539,24 @@ static void split_double(double value, uint64_t *m, int *e)
 
 /* round_half_even(|value| * 10^scale) for 0 <= scale <= 32, exactly: |value| = m 2^e,
  * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
-static bool scaled_decimal(double value, int scale, u128 *out)
+/* |value| * 10^scale as m * 2^shift with m = mantissa * 5^scale, 0 <= scale <= 32 (so m
+ * < 2^53 * 5^32 < 2^128). */
+static u128 times_power_of_ten(double value, int scale, int *shift)
 {
     int e;
     uint64_t mantissa;
+    split_double(value, &mantissa, &e);
+    *shift = e - 53 + scale;
+    return (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale: 10^scale / 2^scale */
+}
+
+static bool scaled_decimal(double value, int scale, u128 *out)
+{
     u128 m, q, rest, half;
     int shift;
-    split_double(value, &mantissa, &e);
-    m = mantissa;
     if (scale < 0 || scale > 32)
         return false;
-    m *= pow10_u128(scale) >> scale; /* 5^scale: 10^scale / 2^scale */
-    shift = e - 53 + scale;          /* value * 10^scale = m 5^scale 2^shift */
+    m = times_power_of_ten(value, scale, &shift);
     if (shift >= 0) {
         if (bit_length128(m) + shift > 127)
             return false;
@@ -737,16 +738,12 @@ static bool format_round_trips(double value, int precision, char text[64], size_
            (mci_parse_double(text, text + *len, &back, &next) && back == value);
 }
 
-/* floor(|value| * 10^scale) and whether anything was cut off, for 0 <= scale <= 32
- * (m 5^scale < 2^128, as in scaled_decimal). False when that does not fit 64 bits. */
+/* floor(|value| * 10^scale) and whether anything was cut off, for 0 <= scale <= 32.
+ * False when that does not fit 64 bits. */
 static bool scaled_floor(double value, int scale, uint64_t *floor_out, bool *sticky)
 {
-    int e, shift;
-    uint64_t mantissa;
-    u128 m;
-    split_double(value, &mantissa, &e);
-    m = (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale */
-    shift = e - 53 + scale;
+    int shift;
+    u128 m = times_power_of_ten(value, scale, &shift);
     if (shift >= 0) {
         if (bit_length128(m) + shift > 63)
             return false;
