@@ -399,8 +399,12 @@ static uint8_t children_touched(const builder *b, const mci_cell *cell,
     uint8_t candidates = 0xFF, mask;
     for (int k = 0; k < 3; k++)
         candidates &= side_children[k][(box[k] <= mid[k]) | (box[3 + k] >= mid[k]) << 1];
-    if (!(candidates & (candidates - 1))) /* one child (most faces, deep down) */
-        return face_touches_cell(b, f, &child[lowest_bit[candidates]]) ? candidates : 0;
+    /* One child (most faces, deep down): the face's box meets the parent only within
+     * that child, so whatever part of the face the parent holds, the child holds. The
+     * face touches the parent (or is kept there because that could not be ruled out),
+     * so it stays listed: the lists remain supersets of the touching faces. */
+    if (!(candidates & (candidates - 1)))
+        return candidates;
     mask = candidates & children_holding_corners(b, cell, mid, f);
     for (candidates &= (uint8_t)~mask; candidates; candidates &= (uint8_t)(candidates - 1)) {
         int c = lowest_bit[candidates];
