@@ -33,7 +33,7 @@ typedef struct dd {
 } dd;
 
 /* a + b = s + t exactly (Knuth's TwoSum). */
-static double two_sum(double a, double b, double *t)
+static inline double two_sum(double a, double b, double *t)
 {
     double s = a + b, bb = s - a;
     *t = (a - (s - bb)) + (b - bb);
@@ -41,20 +41,20 @@ static double two_sum(double a, double b, double *t)
 }
 
 /* a + b = s + t exactly when |a| >= |b| or a = 0 (Dekker's Fast2Sum). */
-static double fast_two_sum(double a, double b, double *t)
+static inline double fast_two_sum(double a, double b, double *t)
 {
     double s = a + b;
     *t = b - (s - a);
     return s;
 }
 
-static double magnitude(dd x)
+static inline double magnitude(dd x)
 {
     return fabs(x.hi) + fabs(x.lo);
 }
 
 /* The difference of two input coordinates, exactly. */
-static dd dd_diff(double a, double b)
+static inline dd dd_diff(double a, double b)
 {
     dd r;
     r.hi = two_sum(a, -b, &r.lo);
@@ -62,7 +62,7 @@ static dd dd_diff(double a, double b)
     return r;
 }
 
-static dd dd_add(dd x, dd y)
+static inline dd dd_add(dd x, dd y)
 {
     double sl, tl, th, vl;
     dd r;
@@ -76,17 +76,17 @@ static dd dd_add(dd x, dd y)
     return r;
 }
 
-static dd dd_neg(dd x)
+static inline dd dd_neg(dd x)
 {
     return (dd){-x.hi, -x.lo, x.e};
 }
 
-static dd dd_sub(dd x, dd y)
+static inline dd dd_sub(dd x, dd y)
 {
     return dd_add(x, dd_neg(y));
 }
 
-static dd dd_mul(dd x, dd y)
+static inline dd dd_mul(dd x, dd y)
 {
     double ch = x.hi * y.hi, cl1 = fma(x.hi, y.hi, -ch);
     double tl1 = fma(x.hi, y.lo, x.lo * y.lo), cl2 = fma(x.lo, y.hi, tl1);
