@@ -586,6 +586,31 @@ static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg
     return st;
 }
 
+/* Once the tree is built only the leaf cells' lists are read (candidate pairs, rays);
+ * the split cells' lists repeat every face once per level (bunny400k: 4.1M entries, of
+ * which the leaves hold 1M) and are dropped. The lists lie in cell order, so the leaves'
+ * lists move down in place. */
+static bool keep_leaf_lists(const mci_ctx *ctx, mci_octree *t)
+{
+    size_t kept = 0;
+    uint32_t *fit;
+    for (size_t c = 0; c < t->cell_count; c++) {
+        mci_cell *cell = &t->cells[c];
+        if (cell->child != NO_CHILD) {
+            cell->first = cell->count = 0;
+            continue;
+        }
+        memmove(t->face_ids + kept, t->face_ids + cell->first, cell->count * sizeof *t->face_ids);
+        cell->first = (uint32_t)kept;
+        kept += cell->count;
+    }
+    t->face_id_count = kept;
+    fit = mci_realloc_array(ctx, t->face_ids, kept + 1, sizeof *fit);
+    if (fit)
+        t->face_ids = fit;
+    return fit != NULL;
+}
+
 static mcsg_status build_cells(builder *b, mcsg_error *err)
 {
     mci_octree *t = b->tree;
@@ -609,6 +634,8 @@ static mcsg_status build_cells(builder *b, mcsg_error *err)
     while (st == MCSG_OK && count > 0)
         st = build_level(b, &level, &count, err);
     mci_free(b->ctx, level);
+    if (st == MCSG_OK && !keep_leaf_lists(b->ctx, t))
+        st = mci_fail_nomem(err, "building the octree");
     return st;
 }
 

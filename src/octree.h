@@ -11,10 +11,11 @@
 
 #include "internal.h"
 
-/* A cell's faces are face_ids[first .. first + count) (global face ids: faces of leaf i
- * are numbered from face_base[i]). Leaf cells have child == UINT32_MAX; otherwise the
- * eight children are cells child .. child + 7 (bit 0 of the index: upper half in x,
- * bit 1: in y, bit 2: in z). */
+/* A leaf cell's faces are face_ids[first .. first + count) (global face ids: faces of
+ * leaf i are numbered from face_base[i]). Leaf cells have child == UINT32_MAX; otherwise
+ * the eight children are cells child .. child + 7 (bit 0 of the index: upper half in x,
+ * bit 1: in y, bit 2: in z), and the built tree keeps no list for the cell (first and
+ * count are 0). */
 typedef struct mci_cell {
     double lo[3], hi[3];
     uint32_t first, count;
@@ -30,7 +31,7 @@ typedef struct mci_octree {
     uint32_t *face_leaf;   /* owning leaf per global face id */
     mci_cell *cells;
     size_t cell_count;
-    uint32_t *face_ids;    /* the cells' face lists */
+    uint32_t *face_ids;    /* the leaf cells' face lists */
     size_t face_id_count;
     size_t critical_leaf_cells;
     unsigned max_depth;
