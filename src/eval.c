@@ -377,6 +377,11 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
     rounded r = {NULL, NULL, NULL, 0};
     uint32_t *kept_tri = NULL;
     mcsg_status st = round_vertices(e, &r, err);
+    /* Once the vertices are rounded, only the kept triangles and the face indexing are
+     * read: the arrangements and the octree's cells go before the output is built (the
+     * assembly was the peak of the two-model scenes). */
+    mci_classifier_free(&e->ctx, &e->cl);
+    mci_scene_free_geometry(&e->ctx, &e->scene);
     if (st == MCSG_OK)
         st = build_output(e, &r, out, &kept_tri, err);
     if (st == MCSG_OK)

@@ -966,7 +966,7 @@ mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *
     return st;
 }
 
-void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
+void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
 {
     for (size_t k = 0; scene->arrs && k < scene->arr_count; k++)
         mci_arr_free(ctx, &scene->arrs[k]);
@@ -979,6 +979,17 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);
+    scene->arrs = NULL;
+    scene->arr_of = scene->neighbour = scene->gid_start = scene->gid = NULL;
+    scene->explicit_slot = scene->arr_dropped = NULL;
+    scene->touch_start = scene->touch_leaf = NULL;
+    scene->arr_count = scene->point_count = 0;
+    mci_octree_free_cells(ctx, &scene->octree);
+}
+
+void mci_scene_free(const mci_ctx *ctx, mci_scene *scene)
+{
+    mci_scene_free_geometry(ctx, scene);
     mci_octree_free(ctx, &scene->octree);
     memset(scene, 0, sizeof *scene);
 }

@@ -589,11 +589,15 @@ static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg
 /* Once the tree is built only the leaf cells' lists are read (candidate pairs, rays);
  * the split cells' lists repeat every face once per level (bunny400k: 4.1M entries, of
  * which the leaves hold 1M) and are dropped. The lists lie in cell order, so the leaves'
- * lists move down in place. */
+ * lists move down in place. The cells, grown by doubling, are trimmed too. */
 static bool keep_leaf_lists(const mci_ctx *ctx, mci_octree *t)
 {
     size_t kept = 0;
     uint32_t *fit;
+    mci_cell *cells = mci_realloc_array(ctx, t->cells, t->cell_count, sizeof *cells);
+    if (!cells)
+        return false;
+    t->cells = cells;
     for (size_t c = 0; c < t->cell_count; c++) {
         mci_cell *cell = &t->cells[c];
         if (cell->child != NO_CHILD) {
@@ -668,12 +672,20 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     return st;
 }
 
-void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
+void mci_octree_free_cells(const mci_ctx *ctx, mci_octree *tree)
 {
-    mci_free(ctx, tree->face_base);
-    mci_free(ctx, tree->face_leaf);
     mci_free(ctx, tree->cells);
     mci_free(ctx, tree->face_ids);
+    tree->cells = NULL;
+    tree->face_ids = NULL;
+    tree->cell_count = tree->face_id_count = 0;
+}
+
+void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
+{
+    mci_octree_free_cells(ctx, tree);
+    mci_free(ctx, tree->face_base);
+    mci_free(ctx, tree->face_leaf);
     memset(tree, 0, sizeof *tree);
 }
 

@@ -54,6 +54,10 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                              mci_octree *out, mcsg_error *err);
 void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
 
+/* Free the cells and their face lists only: the face indexing (leaves, face_base,
+ * face_leaf) stays usable. mci_octree_free is still needed afterwards. */
+void mci_octree_free_cells(const mci_ctx *ctx, mci_octree *tree);
+
 /* Corner k (0..2) of a face given by its global id. */
 const double *mci_octree_face_vertex(const mci_octree *tree, uint32_t face, int k);
 

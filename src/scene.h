@@ -65,6 +65,11 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *scene, mcsg_e
 
 void mci_scene_free(const mci_ctx *ctx, mci_scene *scene);
 
+/* Free everything but the face indexing of the octree (leaves, face_base, face_leaf:
+ * what maps result triangles back to input faces): the arrangements, point numbers,
+ * adjacency, contacts and cells. mci_scene_free is still needed afterwards. */
+void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene);
+
 /* Corner k of global face f. */
 const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k);
 
