@@ -900,6 +900,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     plane_cache planes = {NULL, NULL};
     double t0 = mci_seconds_now(), t1, t2;
     mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);
+    mci_octree_free_boxes(ctx, &s->octree);
     if (st != MCSG_OK)
         return st;
     t1 = mci_seconds_now();

@@ -666,14 +666,21 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                  (b.face_box = face_boxes(ctx, out)) != NULL
              ? build_cells(&b, err)
              : mci_fail_nomem(err, "building the octree");
-    mci_free(ctx, b.face_box);
+    out->face_box = b.face_box;
     if (st != MCSG_OK)
         mci_octree_free(ctx, out);
     return st;
 }
 
+void mci_octree_free_boxes(const mci_ctx *ctx, mci_octree *tree)
+{
+    mci_free(ctx, tree->face_box);
+    tree->face_box = NULL;
+}
+
 void mci_octree_free_cells(const mci_ctx *ctx, mci_octree *tree)
 {
+    mci_octree_free_boxes(ctx, tree);
     mci_free(ctx, tree->cells);
     mci_free(ctx, tree->face_ids);
     tree->cells = NULL;
@@ -817,10 +824,10 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
                                        uint64_t **pairs, size_t *count, mcsg_error *err)
 {
     size_t unique = 0, chunk_count = 0;
-    /* Contiguous boxes: a pair's test reads 48 bytes instead of 12 vertices. The build
-     * computed them too (a pass over the faces, ~1 ms per 100K); they are not kept in
-     * the tree, which lives through the whole evaluation, to spare 24 bytes per face. */
-    pair_job job = {ctx, tree, face_boxes(ctx, tree), NULL, 0, NULL};
+    /* Contiguous boxes: a pair's test reads 48 bytes instead of 12 vertices. The build's
+     * when the tree still has them, else computed again (a pass over the faces). */
+    pair_job job = {ctx, tree, tree->face_box ? tree->face_box : face_boxes(ctx, tree), NULL,
+                    0, NULL};
     mcsg_status st = MCSG_OK;
     *pairs = NULL;
     *count = 0;
@@ -839,7 +846,8 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
         mci_free(ctx, job.chunks[c].pairs);
     mci_free(ctx, job.chunks);
     mci_free(ctx, job.cells);
-    mci_free(ctx, job.box);
+    if (job.box != tree->face_box)
+        mci_free(ctx, job.box);
     /* A pair sharing several cells was collected once per cell: keep one. */
     if (st == MCSG_OK && *count && !radix_sort_u64(ctx, *pairs, *count))
         st = mci_fail_nomem(err, "collecting candidate pairs");

@@ -32,6 +32,9 @@ typedef struct mci_octree {
     mci_cell *cells;
     size_t cell_count;
     uint32_t *face_ids;    /* the leaf cells' face lists */
+    float *face_box;       /* per face: its box rounded outward to floats (min x, y, z, max
+                              x, y, z), from the build, for the candidate pairs; freed by
+                              mci_octree_free_boxes (24 bytes per face) */
     size_t face_id_count;
     size_t critical_leaf_cells;
     unsigned max_depth;
@@ -54,8 +57,11 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                              mci_octree *out, mcsg_error *err);
 void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
 
-/* Free the cells and their face lists only: the face indexing (leaves, face_base,
- * face_leaf) stays usable. mci_octree_free is still needed afterwards. */
+/* Free the face boxes (once the candidate pairs are taken). */
+void mci_octree_free_boxes(const mci_ctx *ctx, mci_octree *tree);
+
+/* Free the cells, their face lists and the face boxes only: the face indexing (leaves,
+ * face_base, face_leaf) stays usable. mci_octree_free is still needed afterwards. */
 void mci_octree_free_cells(const mci_ctx *ctx, mci_octree *tree);
 
 /* Corner k (0..2) of a face given by its global id. */
