@@ -145,27 +145,35 @@ bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_
     return true;
 }
 
+static uint64_t line_id(const mci_point_lines *l, int i)
+{
+    return (uint64_t)l->high[i] << 32 | l->low[i];
+}
+
+static void add_line(mci_point_lines *l, uint64_t line)
+{
+    for (int i = 0; i < l->count; i++)
+        if (line_id(l, i) == line)
+            return;
+    if (line != 0 && l->count < 3) {
+        l->low[l->count] = (uint32_t)line;
+        l->high[l->count++] = (uint8_t)(line >> 32);
+    }
+}
+
 /* Add a point known to lie on `line` (0: none known). */
 static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
                          uint64_t line)
 {
     if (!grow_points(ctx, arr))
         return false;
-    arr->lines[arr->point_count].count = line != 0;
-    arr->lines[arr->point_count].id[0] = line;
+    arr->lines[arr->point_count].count = 0;
+    add_line(&arr->lines[arr->point_count], line);
     arr->points[arr->point_count++] = *p;
     arr->dirty = true;
     return true;
 }
 
-static void add_line(mci_point_lines *l, uint64_t line)
-{
-    for (int i = 0; i < l->count; i++)
-        if (l->id[i] == line)
-            return;
-    if (line != 0 && l->count < 3)
-        l->id[l->count++] = line;
-}
 
 /* The corner an explicit point coincides with, or -1. */
 static int coinciding_corner(const mci_face_arr *arr, const mci_point *p)
@@ -219,8 +227,9 @@ static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *
 }
 
 /* Line ids: a crossing's line is this face's plane ∩ the other plane, named by the
- * plane's id (+1, so that 0 means none); a coplanar edge's line is named by the edge. */
-#define COPLANAR_LINE (1ull << 40)
+ * plane's id (+1, so that 0 means none: at most 2^32); a coplanar edge's line is named
+ * by the edge (2^39 + 3 face + edge < 2^40). Point line lists keep 40 bits. */
+#define COPLANAR_LINE (1ull << 39)
 
 bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
                           const mci_point *b, uint32_t other, const mci_plane *other_plane,
@@ -559,7 +568,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
             if (remap[i] >= 3 || arr->points[i].kind == MCI_POINT_EXPLICIT)
                 merged[remap[i]] = arr->points[i];
             for (int l = 0; l < arr->lines[i].count; l++)
-                add_line(&merged_lines[remap[i]], arr->lines[i].id[l]);
+                add_line(&merged_lines[remap[i]], line_id(&arr->lines[i], l));
         }
         for (size_t s = 0; s < arr->segment_count; s++) {
             mci_arr_segment seg = arr->segments[s];
@@ -608,7 +617,7 @@ static uint8_t edge_mask_of(const mci_face_arr *arr, uint32_t p)
 static bool shares_line(const mci_point_lines *l, uint64_t line)
 {
     for (int i = 0; i < l->count; i++)
-        if (l->id[i] == line)
+        if (line_id(l, i) == line)
             return true;
     return false;
 }
@@ -624,7 +633,8 @@ static bool known_collinear(const void *user, uint32_t a, uint32_t b, uint32_t c
     if (edge_mask_of(arr, a) & edge_mask_of(arr, b) & edge_mask_of(arr, c))
         return true;
     for (int i = 0; i < la->count; i++)
-        if (shares_line(&arr->lines[b], la->id[i]) && shares_line(&arr->lines[c], la->id[i]))
+        if (shares_line(&arr->lines[b], line_id(la, i)) &&
+            shares_line(&arr->lines[c], line_id(la, i)))
             return true;
     return false;
 }
