@@ -699,15 +699,6 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
 /* ---------------------------------------------------------------------------------- */
 /* Candidate pairs                                                                     */
 
-static bool face_boxes_overlap(const float *box, uint32_t f, uint32_t g)
-{
-    const float *a = box + 6 * (size_t)f, *b = box + 6 * (size_t)g;
-    for (int k = 0; k < 3; k++)
-        if (a[3 + k] < b[k] || b[3 + k] < a[k])
-            return false;
-    return true;
-}
-
 /* Least-significant-digit radix sort, 16 bits per pass; passes over digits that are
  * the same in every key are skipped (face ids rarely use all 32 bits). */
 static bool radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
@@ -740,23 +731,12 @@ static bool radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
 }
 
 
-static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const float *box,
-                               const mci_cell *cell, uint64_t **pairs, size_t *count,
-                               size_t *capacity)
-{
-    for (uint32_t i = 0; i < cell->count; i++) {
-        uint32_t f = t->face_ids[cell->first + i];
-        for (uint32_t j = i + 1; j < cell->count; j++) {
-            uint32_t g = t->face_ids[cell->first + j];
-            if (t->face_leaf[f] == t->face_leaf[g] || !face_boxes_overlap(box, f, g))
-                continue;
-            if (!mci_grow_array(ctx, (void **)pairs, capacity, *count + 1, sizeof **pairs, 64))
-                return false;
-            (*pairs)[(*count)++] = f < g ? (uint64_t)f << 32 | g : (uint64_t)g << 32 | f;
-        }
-    }
-    return true;
-}
+/* A cell's face with what the pair loop reads, copied once per cell (the loop reads each
+ * face's box and leaf once per other face of the cell). */
+typedef struct cell_face {
+    float box[6];
+    uint32_t face, run_end; /* run_end: the first later face of another leaf */
+} cell_face;
 
 /* Pairs are collected in parallel, in chunks of critical leaf cells fixed in advance
  * (not by the thread count); the chunks' lists are joined and then sorted, so the
@@ -766,7 +746,47 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
 typedef struct pair_chunk_list {
     uint64_t *pairs;
     size_t count, capacity;
+    cell_face *faces; /* scratch: the current cell's faces */
+    size_t face_capacity;
 } pair_chunk_list;
+
+static bool cell_faces_overlap(const cell_face *a, const cell_face *b)
+{
+    for (int k = 0; k < 3; k++)
+        if (a->box[3 + k] < b->box[k] || b->box[3 + k] < a->box[k])
+            return false;
+    return true;
+}
+
+/* A cell lists its faces in increasing id order, so each leaf's faces form one run: a
+ * face is paired with the faces after its run only. */
+static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const float *box,
+                               const mci_cell *cell, pair_chunk_list *out)
+{
+    const uint32_t *ids = t->face_ids + cell->first;
+    uint32_t n = cell->count;
+    if (!mci_grow_array(ctx, (void **)&out->faces, &out->face_capacity, n, sizeof *out->faces,
+                        64))
+        return false;
+    for (uint32_t i = n; i-- > 0;) {
+        cell_face *c = &out->faces[i];
+        c->face = ids[i];
+        memcpy(c->box, box + 6 * (size_t)ids[i], sizeof c->box);
+        c->run_end = i + 1 < n && t->face_leaf[ids[i + 1]] == t->face_leaf[ids[i]]
+                         ? out->faces[i + 1].run_end
+                         : i + 1;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        const cell_face *a = &out->faces[i];
+        if (!mci_grow_array(ctx, (void **)&out->pairs, &out->capacity,
+                            out->count + (n - a->run_end), sizeof *out->pairs, 64))
+            return false;
+        for (uint32_t j = a->run_end; j < n; j++)
+            if (cell_faces_overlap(a, &out->faces[j]))
+                out->pairs[out->count++] = (uint64_t)a->face << 32 | out->faces[j].face;
+    }
+    return true;
+}
 
 typedef struct pair_job {
     const mci_ctx *ctx;
@@ -782,11 +802,12 @@ static mcsg_status collect_chunk(void *user, size_t chunk, mcsg_error *err)
     const pair_job *j = user;
     pair_chunk_list *out = &j->chunks[chunk];
     size_t end = (chunk + 1) * PAIR_CELLS_PER_CHUNK;
-    for (size_t k = chunk * PAIR_CELLS_PER_CHUNK; k < end && k < j->cell_count; k++)
-        if (!collect_cell_pairs(j->ctx, j->tree, j->box, &j->tree->cells[j->cells[k]],
-                                &out->pairs, &out->count, &out->capacity))
-            return mci_fail_nomem(err, "collecting candidate pairs");
-    return MCSG_OK;
+    bool ok = true;
+    for (size_t k = chunk * PAIR_CELLS_PER_CHUNK; ok && k < end && k < j->cell_count; k++)
+        ok = collect_cell_pairs(j->ctx, j->tree, j->box, &j->tree->cells[j->cells[k]], out);
+    mci_free(j->ctx, out->faces);
+    out->faces = NULL;
+    return ok ? MCSG_OK : mci_fail_nomem(err, "collecting candidate pairs");
 }
 
 /* The critical leaf cells, in cell order. */
