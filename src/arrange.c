@@ -105,7 +105,7 @@ static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity
     mci_point_lines *lines;
     mci_point *points;
     uint8_t *where;
-    if (!(points = point_block(ctx, capacity, &lines, &where)))
+    if (capacity > UINT32_MAX || !(points = point_block(ctx, capacity, &lines, &where)))
         return false;
     if (arr->point_count) { /* the first block has nothing to copy (and memcpy no NULL) */
         memcpy(points, arr->points, arr->point_count * sizeof *points);
@@ -117,7 +117,7 @@ static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity
     arr->points = points;
     arr->lines = lines;
     arr->where = where;
-    arr->point_capacity = capacity;
+    arr->point_capacity = (uint32_t)capacity;
     return true;
 }
 
@@ -127,7 +127,7 @@ static bool grow_points(const mci_ctx *ctx, mci_face_arr *arr)
     size_t capacity = arr->point_capacity < 4 ? 8 : 2 * arr->point_capacity;
     if (arr->point_count < arr->point_capacity)
         return true;
-    return capacity <= SIZE_MAX / 2 && resize_points(ctx, arr, capacity);
+    return resize_points(ctx, arr, capacity);
 }
 
 bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_t segments)
@@ -135,12 +135,12 @@ bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_
     if (points > arr->point_capacity && !resize_points(ctx, arr, points))
         return false;
     if (segments > arr->segment_capacity) {
-        mci_arr_segment *grown = mci_realloc_array(ctx, arr->segments, segments,
-                                                   sizeof *grown);
+        mci_arr_segment *grown = segments > UINT32_MAX ? NULL
+                                 : mci_realloc_array(ctx, arr->segments, segments, sizeof *grown);
         if (!grown)
             return false;
         arr->segments = grown;
-        arr->segment_capacity = segments;
+        arr->segment_capacity = (uint32_t)segments;
     }
     return true;
 }
@@ -216,10 +216,12 @@ static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *
 {
     uint32_t ia = add_point_once(ctx, arr, a, s->line);
     uint32_t ib = ia == UINT32_MAX ? UINT32_MAX : add_point_once(ctx, arr, b, s->line);
-    if (ib == UINT32_MAX ||
-        !mci_grow_array(ctx, (void **)&arr->segments, &arr->segment_capacity,
-                        arr->segment_count + 1, sizeof *arr->segments, 8))
+    size_t capacity = arr->segment_capacity;
+    if (ib == UINT32_MAX || arr->segment_count == UINT32_MAX ||
+        !mci_grow_array(ctx, (void **)&arr->segments, &capacity, arr->segment_count + 1,
+                        sizeof *arr->segments, 8) || capacity > UINT32_MAX)
         return false;
+    arr->segment_capacity = (uint32_t)capacity;
     arr->segments[arr->segment_count] = *s;
     arr->segments[arr->segment_count].a = ia;
     arr->segments[arr->segment_count++].b = ib;
