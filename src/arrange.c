@@ -174,7 +174,6 @@ static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point 
     return true;
 }
 
-
 /* The corner an explicit point coincides with, or -1. */
 static int coinciding_corner(const mci_face_arr *arr, const mci_point *p)
 {
