@@ -48,9 +48,45 @@ static const double *add_aux(mci_face_arr *arr, const double *x)
     return r;
 }
 
+/* Blocks of points an arrangement made itself. A block is never moved (points are
+ * referred to by address); a full one is followed by one twice its size. */
+struct mci_point_pool {
+    mci_point_pool *next;
+    uint32_t count, capacity;
+    mci_point p[];
+};
+
+static const mci_point *pool_copy(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    mci_point_pool *pool = arr->own;
+    if (!pool || pool->count == pool->capacity) {
+        uint32_t capacity = pool ? 2 * pool->capacity : 4;
+        mci_point_pool *block =
+            mci_malloc(ctx, sizeof *block + (size_t)capacity * sizeof block->p[0]);
+        if (!block)
+            return NULL;
+        block->next = pool;
+        block->count = 0;
+        block->capacity = capacity;
+        arr->own = pool = block;
+    }
+    pool->p[pool->count] = *p;
+    return &pool->p[pool->count++];
+}
+
+static void free_pool(const mci_ctx *ctx, mci_point_pool *pool)
+{
+    while (pool) {
+        mci_point_pool *next = pool->next;
+        mci_free(ctx, pool);
+        pool = next;
+    }
+}
+
 mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const double *a, const double *b, const double *c,
-                         size_t max_coplanar, size_t points, mcsg_error *err)
+                         const mci_point *const corners[3], size_t max_coplanar,
+                         size_t points, mcsg_error *err)
 {
     memset(arr, 0, sizeof *arr);
     arr->face = face;
@@ -65,10 +101,14 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
         return mci_fail_nomem(err, "arranging a face");
     }
     for (int i = 0; i < 3; i++) {
-        mci_point p;
-        mci_point_explicit(&p, corner(arr, i));
+        const mci_point *kept = corners ? corners[i] : NULL;
         add_aux(arr, corner(arr, i)); /* aux[i]: for the face's edge i */
-        if (!mci_arr_add_point(ctx, arr, &p)) {
+        if (!kept) {
+            mci_point p;
+            mci_point_explicit(&p, corner(arr, i));
+            kept = pool_copy(ctx, arr, &p);
+        }
+        if (!kept || !mci_arr_add_point(ctx, arr, kept)) {
             mci_arr_free(ctx, arr);
             return mci_fail_nomem(err, "arranging a face");
         }
@@ -84,15 +124,16 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     mci_free(ctx, arr->aux);
     mci_free(ctx, arr->tris);
     mci_free(ctx, arr->adj);
+    free_pool(ctx, arr->own);
     memset(arr, 0, sizeof *arr);
 }
 
 /* A block for `capacity` points followed by their line lists and their locations (one
  * allocation where there were three: arrangements are many and small). */
-static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lines **lines,
-                              uint8_t **where)
+static const mci_point **point_block(const mci_ctx *ctx, size_t capacity,
+                                     mci_point_lines **lines, uint8_t **where)
 {
-    mci_point *points = mci_malloc_array(ctx, capacity ? capacity : 1,
+    const mci_point **points = mci_malloc_array(ctx, capacity ? capacity : 1,
                                          sizeof *points + sizeof **lines + sizeof **where);
     *lines = points ? (mci_point_lines *)(void *)(points + capacity) : NULL;
     *where = points ? (uint8_t *)(void *)(*lines + capacity) : NULL;
@@ -103,7 +144,7 @@ static mci_point *point_block(const mci_ctx *ctx, size_t capacity, mci_point_lin
 static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity)
 {
     mci_point_lines *lines;
-    mci_point *points;
+    const mci_point **points;
     uint8_t *where;
     if (capacity > UINT32_MAX || !(points = point_block(ctx, capacity, &lines, &where)))
         return false;
@@ -169,7 +210,7 @@ static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point 
         return false;
     arr->lines[arr->point_count].count = 0;
     add_line(&arr->lines[arr->point_count], line);
-    arr->points[arr->point_count++] = *p;
+    arr->points[arr->point_count++] = p;
     arr->dirty = true;
     return true;
 }
@@ -199,7 +240,7 @@ static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_
     int k = coinciding_corner(arr, p);
     if (k < 0)
         return add_point_on(ctx, arr, p, line) ? (uint32_t)arr->point_count - 1 : UINT32_MAX;
-    arr->points[k] = *p;
+    arr->points[k] = p;
     add_line(&arr->lines[k], line);
     arr->dirty = true;
     return (uint32_t)k;
@@ -208,6 +249,23 @@ static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
 {
     return add_point_once(ctx, arr, p, 0) != UINT32_MAX;
+}
+
+/* The stored corner when p is an explicit point at the same vertex (p's very
+ * definition: a face receives copies of its corners from every neighbour and twin),
+ * else a copy in the pool. */
+const mci_point *mci_arr_keep(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    int k = coinciding_corner(arr, p);
+    if (k >= 0 && arr->points[k]->kind == MCI_POINT_EXPLICIT && arr->points[k]->v[0] == p->v[0])
+        return arr->points[k];
+    return pool_copy(ctx, arr, p);
+}
+
+static bool add_point_copy(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
+{
+    const mci_point *kept = mci_arr_keep(ctx, arr, p);
+    return kept && mci_arr_add_point(ctx, arr, kept);
 }
 
 static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
@@ -250,7 +308,7 @@ bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point
  * copy will do. */
 static const mci_point *corner_point(const mci_face_arr *arr, int i, mci_point *scratch)
 {
-    const mci_point *p = arr->point_count > (size_t)i ? &arr->points[i] : NULL;
+    const mci_point *p = arr->point_count > (size_t)i ? arr->points[i] : NULL;
     if (p && p->kind == MCI_POINT_EXPLICIT)
         return p;
     mci_point_explicit(scratch, corner(arr, i));
@@ -319,15 +377,17 @@ static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t o
     if (c.empty || (order = mci_order_on_edge_line(c.start, c.end, u, v)) > 0)
         return true;
     if (order == 0)
-        return mci_arr_add_point(ctx, arr, c.start);
+        return add_point_copy(ctx, arr, c.start);
     if (c.on_boundary)
-        return mci_arr_add_point(ctx, arr, c.start) && mci_arr_add_point(ctx, arr, c.end);
+        return add_point_copy(ctx, arr, c.start) && add_point_copy(ctx, arr, c.end);
     {
         const double *aux = add_aux(arr, u);
+        const mci_point *start = mci_arr_keep(ctx, arr, c.start);
+        const mci_point *end = start ? mci_arr_keep(ctx, arr, c.end) : NULL;
         mci_arr_segment s = {0, 0, other, 1, {u, v, aux},
                              COPLANAR_LINE + 3 * (uint64_t)other + (uint64_t)edge, group, 1,
                              !crease};
-        return aux && add_segment(ctx, arr, c.start, c.end, &s);
+        return aux && end && add_segment(ctx, arr, start, end, &s);
     }
 }
 
@@ -358,7 +418,7 @@ bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
             mci_point a, b;
             mci_point_explicit(&a, v[i]);
             mci_point_explicit(&b, v[(i + 1) % 3]);
-            if (!mci_arr_add_point(ctx, arr, &a) || !mci_arr_add_point(ctx, arr, &b))
+            if (!add_point_copy(ctx, arr, &a) || !add_point_copy(ctx, arr, &b))
                 return false;
         }
         return true;
@@ -436,7 +496,7 @@ static size_t merge_ids(const mci_face_arr *arr, const uint32_t *sorted, uint32_
     for (size_t i = 0; i < n;) {
         size_t j = i + 1;
         uint32_t id = UINT32_MAX;
-        while (j < n && mci_points_equal(&arr->points[sorted[j]], &arr->points[sorted[i]]))
+        while (j < n && mci_points_equal(arr->points[sorted[j]], arr->points[sorted[i]]))
             j++;
         for (size_t k = i; k < j; k++)
             if (sorted[k] < 3)
@@ -494,7 +554,7 @@ static mcsg_status locate_new_points(mci_face_arr *arr, mcsg_error *err)
     for (size_t i = 0; i < arr->point_count; i++) {
         if (where[i] != WHERE_UNKNOWN)
             continue;
-        where[i] = i < 3 ? (uint8_t)(MCI_AT_CORNER + i) : locate_in_face(arr, &arr->points[i]);
+        where[i] = i < 3 ? (uint8_t)(MCI_AT_CORNER + i) : locate_in_face(arr, arr->points[i]);
         if (i >= 3 && where[i] < MCI_AT_EDGE)
             return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a corner "
                             "appears twice", arr->face);
@@ -536,14 +596,14 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
     uint32_t *idx = table ? (uint32_t *)(void *)(table + n + 1) : NULL;
     uint32_t *tmp = idx ? idx + n + 1 : NULL;
     uint32_t *remap = tmp ? tmp + n + 1 : NULL;
-    mci_point *merged = NULL;
+    const mci_point **merged = NULL;
     mci_point_lines *merged_lines = NULL;
     uint8_t *merged_where = NULL;
     mcsg_status st = table ? MCSG_OK : mci_fail_nomem(err, "arranging a face");
     /* After a merge, where_count is its point count and only appends follow. */
     size_t before = arr->where_count >= 3 && arr->where_count <= n ? arr->where_count : 0;
     for (size_t i = 0; table && i < n; i++)
-        set_key(&table[i], &arr->points[i]);
+        set_key(&table[i], arr->points[i]);
     if (st == MCSG_OK) {
         if (before) {
             sort_after_merge(table, before, n, idx, tmp);
@@ -566,7 +626,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
             /* A corner stays explicit: an implicit copy (an LPI exactly there) has the
              * same value, but rounding it would lose the input's sign of zero. Other
              * points keep their last copy. */
-            if (remap[i] >= 3 || arr->points[i].kind == MCI_POINT_EXPLICIT)
+            if (remap[i] >= 3 || arr->points[i]->kind == MCI_POINT_EXPLICIT)
                 merged[remap[i]] = arr->points[i];
             for (int l = 0; l < arr->lines[i].count; l++)
                 add_line(&merged_lines[remap[i]], line_id(&arr->lines[i], l));
@@ -643,13 +703,13 @@ static bool known_collinear(const void *user, uint32_t a, uint32_t b, uint32_t c
 /* Orientation of three points of the face in its own orientation. */
 static int orient_ids(const mci_face_arr *arr, uint32_t a, uint32_t b, uint32_t c)
 {
-    const mci_point *p = arr->points;
-    int s = mci_orient2d_projected_quick(&p[a], &p[b], &p[c], arr->axis);
+    const mci_point *const *p = arr->points;
+    int s = mci_orient2d_projected_quick(p[a], p[b], p[c], arr->axis);
     if (s != MCI_UNCERTAIN)
         return arr->sign * s; /* never where known_collinear holds: the filter is exact */
     if (known_collinear(arr, a, b, c))
         return 0;
-    return arr->sign * mci_orient2d_projected_rest(&p[a], &p[b], &p[c], arr->axis);
+    return arr->sign * mci_orient2d_projected_rest(p[a], p[b], p[c], arr->axis);
 }
 
 /* A sweep item: a segment or a lone point, with a certified box in the projection. */
@@ -682,9 +742,9 @@ static void cut(splitter *sp, uint32_t s, uint32_t p)
 static void cut_if_inside(splitter *sp, uint32_t s, uint32_t p)
 {
     const mci_arr_segment *seg = &sp->arr->segments[s];
-    const mci_point *pts = sp->arr->points;
+    const mci_point *const *pts = sp->arr->points;
     if (p != seg->a && p != seg->b &&
-        mci_compare_lex(&pts[seg->a], &pts[p]) * mci_compare_lex(&pts[p], &pts[seg->b]) > 0) {
+        mci_compare_lex(pts[seg->a], pts[p]) * mci_compare_lex(pts[p], pts[seg->b]) > 0) {
         cut(sp, s, p);
         add_line(&sp->arr->lines[p], seg->line);
     }
@@ -739,8 +799,10 @@ static void relate_segments(splitter *sp, uint32_t s, uint32_t t)
     ob = orient_ids(arr, T.a, T.b, S.b);
     if (oc * od < 0 && oa * ob < 0) {
         mci_point x;
+        const mci_point *kept;
         uint32_t id = (uint32_t)arr->point_count;
-        if (!crossing_point(arr, &S, &T, &x) || !add_point_on(sp->ctx, arr, &x, S.line)) {
+        if (!crossing_point(arr, &S, &T, &x) || !(kept = pool_copy(sp->ctx, arr, &x)) ||
+            !add_point_on(sp->ctx, arr, kept, S.line)) {
             sp->ok = false;
             return;
         }
@@ -820,8 +882,8 @@ static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size
         const mci_arr_segment *seg = &arr->segments[s];
         items[n].id = (uint32_t)s;
         items[n].is_point = false;
-        item_bounds(arr, face_lo, face_hi, &arr->points[seg->a], &items[n], true);
-        item_bounds(arr, face_lo, face_hi, &arr->points[seg->b], &items[n], false);
+        item_bounds(arr, face_lo, face_hi, arr->points[seg->a], &items[n], true);
+        item_bounds(arr, face_lo, face_hi, arr->points[seg->b], &items[n], false);
         is_end[seg->a] = is_end[seg->b] = true;
     }
     for (size_t p = 0; p < arr->point_count; p++) {
@@ -829,7 +891,7 @@ static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size
             continue;
         items[n].id = (uint32_t)p;
         items[n].is_point = true;
-        item_bounds(arr, face_lo, face_hi, &arr->points[p], &items[n], true);
+        item_bounds(arr, face_lo, face_hi, arr->points[p], &items[n], true);
         n++;
     }
     if (n > 0)
@@ -909,7 +971,7 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
     uint32_t *ids = table ? (uint32_t *)(void *)(table + arr->point_count) : NULL;
     uint32_t *tmp = ids ? ids + 2 + cut_count : NULL;
     for (size_t i = 0; table && i < arr->point_count; i++)
-        set_key(&table[i], &arr->points[i]);
+        set_key(&table[i], arr->points[i]);
     mci_free(ctx, arr->edges);
     arr->edge_count = 0;
     arr->edges = mci_malloc_array(ctx, max_pieces ? max_pieces : 1, sizeof *arr->edges);

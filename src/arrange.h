@@ -52,9 +52,17 @@ typedef struct mci_point_lines {
     uint8_t count;
 } mci_point_lines;
 
+/* Points an arrangement made itself (corners, clipped coplanar edges, crossings), in
+ * blocks that never move (see arrange.c). */
+typedef struct mci_point_pool mci_point_pool;
+
 typedef struct mci_face_arr {
     mci_plane plane;     /* the face's plane; corners plane.a, .b, .c */
-    mci_point *points;   /* [0..2] are the corners */
+    /* [0..2] are the corners. The points are referred to, not copied: those given by
+     * the caller live in the caller's stores (see mci_arr_add_point), the others in
+     * `own`. 8 bytes a point instead of a 176-byte copy in every face that has it. */
+    const mci_point **points;
+    mci_point_pool *own;
     mci_point_lines *lines; /* per point */
     uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge */
     mci_arr_segment *segments;
@@ -77,12 +85,15 @@ typedef struct mci_face_arr {
 } mci_face_arr;
 
 /* Start the arrangement of face `face` with corners a, b, c (non-degenerate).
- * `max_coplanar` bounds the number of mci_arr_add_coplanar calls (it sizes the
- * auxiliary vertex store, whose addresses must not move); `points` is the number of
- * points expected in all, corners included (room is made for them; more may come). */
+ * `corners` gives explicit points at a, b, c that outlive the arrangement (NULL: the
+ * arrangement makes its own). `max_coplanar` bounds the number of mci_arr_add_coplanar
+ * calls (it sizes the auxiliary vertex store, whose addresses must not move); `points`
+ * is the number of points expected in all, corners included (room is made for them;
+ * more may come). */
 mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const double *a, const double *b, const double *c,
-                         size_t max_coplanar, size_t points, mcsg_error *err);
+                         const mci_point *const corners[3], size_t max_coplanar,
+                         size_t points, mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Room for `points` points and `segments` segments in all (when more than now), so that
@@ -90,7 +101,14 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
  * a third of the arrangements' memory unused). False when out of memory. */
 bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_t segments);
 
-/* Inputs. Points must lie on the face (closed triangle). */
+/* p made stable, for a point built on the stack that is to be added: the stored corner
+ * when p is an explicit point at that corner's vertex, else a copy kept by the
+ * arrangement until mci_arr_free. NULL when out of memory. */
+const mci_point *mci_arr_keep(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
+
+/* Inputs. Points must lie on the face (closed triangle). The arrangement refers to the
+ * points given (mci_arr_add_point, mci_arr_add_crossing): they must stay valid and
+ * unchanged until mci_arr_free. */
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
 /* The segment a-b where face `other` crosses. `plane_id` names other's plane: faces of
  * one flat region of a leaf may share it (their segments then lie on one line, which

@@ -356,7 +356,7 @@ static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
             if (!s->explicit_slot[slot] || (seen[g / 8] >> (g % 8)) & 1)
                 continue;
             seen[g / 8] |= (uint8_t)(1u << (g % 8));
-            coord_lookup(&t, s->arrs[k].points[p].v[0], g);
+            coord_lookup(&t, s->arrs[k].points[p]->v[0], g);
         }
     mci_free(ctx, seen);
     for (size_t l = 0, at = 0; ok && l < o->leaf_count; l++) {
@@ -540,7 +540,7 @@ static void piece_point(const leaf_work *w, size_t p, int i, mci_point *out)
 {
     const mci_face_arr *arr = arr_of_face(w->s, w->pface[p]);
     if (arr) {
-        *out = arr->points[w->plocal[3 * p + i]];
+        *out = *arr->points[w->plocal[3 * p + i]];
     } else {
         const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
         mci_point_explicit(out, m->vertices + 3 * (size_t)w->plocal[3 * p + i]);
@@ -603,7 +603,7 @@ static void add_edge_sides(const mci_face_arr *arr, const uint32_t *gid, int e, 
                            size_t *n)
 {
     int a = e, b = (e + 1) % 3;
-    bool ascending = mci_compare_lex(&arr->points[a], &arr->points[b]) < 0;
+    bool ascending = mci_compare_lex(arr->points[a], arr->points[b]) < 0;
     uint32_t prev = (uint32_t)a;
     for (size_t k = 3; k < arr->point_count; k++) {
         size_t i = ascending ? k : arr->point_count + 2 - k;

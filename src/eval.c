@@ -145,7 +145,7 @@ static void vertex_coordinates(const eval_state *e, const uint64_t *rep, uint32_
         memcpy(out, e->cl.new_vertex[id - s->point_count], 3 * sizeof *out);
         return;
     }
-    mci_point_round(&s->arrs[rep[id] >> 32].points[(uint32_t)rep[id]], out);
+    mci_point_round(s->arrs[rep[id] >> 32].points[(uint32_t)rep[id]], out);
 }
 
 static uint64_t *point_representatives(const eval_state *e)

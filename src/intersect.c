@@ -31,14 +31,6 @@ typedef struct hit_list {
     size_t point_count, point_capacity;
 } hit_list;
 
-/* End k of hit h as a point (built into *scratch when it is a vertex). */
-static const mci_point *hit_end(const hit_list *l, const pair_hit *h, int k, mci_point *scratch)
-{
-    if ((h->stored >> k) & 1)
-        return &l->points[h->point[k]];
-    mci_point_explicit(scratch, h->vertex[k]);
-    return scratch;
-}
 
 const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
 {
@@ -527,51 +519,160 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const hit
     return true;
 }
 
-static bool add_hit(const mci_ctx *ctx, const mci_scene *s, mci_face_arr *arr,
-                    const hit_list *hits, const pair_hit *h, const face_facts *ff,
-                    const plane_cache *planes)
+/* One explicit point per vertex of an arranged face, which every arrangement with that
+ * vertex refers to (a vertex is a corner of six faces and an end of many hits: copies
+ * took a sixth of ring-800's arrangement memory). `slot` maps global vertex ids (leaf
+ * by leaf, from `first`) to points; it lives while arranging, the points as long as the
+ * arrangements (mci_scene.vertex_points). */
+typedef struct vertex_table {
+    size_t *first;  /* per leaf, its vertex 0's global id */
+    uint32_t *slot; /* per global vertex: index in points, or MCI_NONE */
+    mci_point *points;
+} vertex_table;
+
+static size_t corner_vertex_id(const mci_scene *s, const vertex_table *vt, uint32_t f, int k)
 {
+    uint32_t leaf = s->octree.face_leaf[f];
+    size_t local = f - s->octree.face_base[leaf];
+    return vt->first[leaf] + s->octree.leaves[leaf]->triangles[3 * local + (size_t)k];
+}
+
+static void free_vertex_map(const mci_ctx *ctx, vertex_table *vt)
+{
+    mci_free(ctx, vt->first);
+    mci_free(ctx, vt->slot);
+    vt->first = NULL;
+    vt->slot = NULL;
+}
+
+/* Slots for the corners of the arranged faces (in face order), and their points. */
+static bool build_vertex_table(const mci_ctx *ctx, const mci_scene *s, vertex_table *vt)
+{
+    size_t total = 0, n = 0;
+    vt->first = mci_malloc_array(ctx, s->octree.leaf_count + 1, sizeof *vt->first);
+    for (size_t l = 0; vt->first && l < s->octree.leaf_count; l++) {
+        vt->first[l] = total;
+        total += s->octree.leaves[l]->vertex_count;
+    }
+    vt->slot = mci_malloc_array(ctx, total + 1, sizeof *vt->slot);
+    if (!vt->first || !vt->slot)
+        return false;
+    for (size_t v = 0; v < total; v++)
+        vt->slot[v] = MCI_NONE;
+    for (uint32_t f = 0; f < s->face_count; f++)
+        for (int k = 0; s->arr_of[f] != MCI_NONE && k < 3; k++) {
+            size_t id = corner_vertex_id(s, vt, f, k);
+            if (vt->slot[id] == MCI_NONE)
+                vt->slot[id] = (uint32_t)n++;
+        }
+    if (!(vt->points = mci_malloc_array(ctx, n + 1, sizeof *vt->points)))
+        return false;
+    for (uint32_t f = 0; f < s->face_count; f++)
+        for (int k = 0; s->arr_of[f] != MCI_NONE && k < 3; k++)
+            mci_point_explicit(&vt->points[vt->slot[corner_vertex_id(s, vt, f, k)]],
+                               mci_scene_corner(s, f, k));
+    return true;
+}
+
+/* The table's point for corner k of face f, or NULL when it has none. */
+static const mci_point *corner_point(const mci_scene *s, const vertex_table *vt, uint32_t f,
+                                     int k)
+{
+    uint32_t slot = vt->slot ? vt->slot[corner_vertex_id(s, vt, f, k)] : MCI_NONE;
+    return slot == MCI_NONE ? NULL : &vt->points[slot];
+}
+
+/* The corner points of face f, or false if the table lacks one. */
+static bool corner_points(const mci_scene *s, const vertex_table *vt, uint32_t f,
+                          const mci_point *out[3])
+{
+    for (int k = 0; k < 3; k++)
+        if (!(out[k] = corner_point(s, vt, f, k)))
+            return false;
+    return true;
+}
+
+/* End k of hit h as a point that arr may refer to: a stored point, or a vertex (a
+ * corner of h's faces: the table's point; else kept by arr). NULL when out of memory. */
+static const mci_point *hit_end(const mci_ctx *ctx, const mci_scene *s, const vertex_table *vt,
+                                mci_face_arr *arr, const hit_list *l, const pair_hit *h, int k)
+{
+    mci_point vertex;
+    if ((h->stored >> k) & 1)
+        return &l->points[h->point[k]];
+    for (int c = 0; c < 6; c++) {
+        uint32_t face = c < 3 ? h->f : h->g;
+        const mci_point *p;
+        if (mci_scene_corner(s, face, c % 3) == h->vertex[k] &&
+            (p = corner_point(s, vt, face, c % 3)) != NULL)
+            return p;
+    }
+    mci_point_explicit(&vertex, h->vertex[k]);
+    return mci_arr_keep(ctx, arr, &vertex);
+}
+
+/* Faces are arranged independently (each writes only its own arrs[k]), in parallel. */
+typedef struct arrange_job {
+    const mci_ctx *ctx;
+    mci_scene *s;
+    const hit_list *hits;
+    const uint32_t *start, *list, *face_of;
+    const face_facts *ff;
+    const plane_cache *planes;
+    const vertex_table *vt;
+} arrange_job;
+
+static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
+{
+    const mci_scene *s = j->s;
     uint32_t other = h->f == arr->face ? h->g : h->f;
-    const mci_plane *plane = &planes->planes[planes->slot[other]];
+    const mci_plane *plane = &j->planes->planes[j->planes->slot[other]];
     bool crease[3];
-    mci_point a, b;
+    const mci_point *a, *b;
     switch (h->kind) {
     case MCI_TT_SEGMENT:
-        return mci_arr_add_crossing(ctx, arr, hit_end(hits, h, 0, &a), hit_end(hits, h, 1, &b),
-                                    other, plane, ff->plane_rep[other],
-                                    s->octree.face_leaf[other],
-                                    h->along_edge[h->f == arr->face ? 1 : 0]);
+        a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
+        b = a ? hit_end(j->ctx, s, j->vt, arr, j->hits, h, 1) : NULL;
+        return b && mci_arr_add_crossing(j->ctx, arr, a, b, other, plane,
+                                         j->ff->plane_rep[other], s->octree.face_leaf[other],
+                                         h->along_edge[h->f == arr->face ? 1 : 0]);
     case MCI_TT_POINT:
-        return mci_arr_add_point(ctx, arr, hit_end(hits, h, 0, &a));
+        a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
+        return a && mci_arr_add_point(j->ctx, arr, a);
     default:
         for (int i = 0; i < 3; i++)
-            crease[i] = (ff->crease[other] >> i) & 1;
-        return mci_arr_add_coplanar(ctx, arr, other, plane, crease, s->octree.face_leaf[other]);
+            crease[i] = (j->ff->crease[other] >> i) & 1;
+        return mci_arr_add_coplanar(j->ctx, arr, other, plane, crease,
+                                    s->octree.face_leaf[other]);
     }
 }
 
-static mcsg_status arrange_face(const mci_ctx *ctx, const mci_scene *s, uint32_t f,
-                                const hit_list *hits, const uint32_t *ids, size_t n,
-                                const face_facts *ff, const plane_cache *planes,
+/* The arrangement of face f with its n hits ids[]. */
+static mcsg_status arrange_face(const arrange_job *j, uint32_t f, const uint32_t *ids, size_t n,
                                 mci_face_arr *arr, mcsg_error *err)
 {
+    const mci_scene *s = j->s;
+    const pair_hit *hits = j->hits->v;
+    const mci_point *corners[3];
     size_t coplanar = 0, crossing = 0;
     mcsg_status st;
     for (size_t i = 0; i < n; i++) {
-        coplanar += hits->v[ids[i]].kind == MCI_TT_COPLANAR;
-        crossing += hits->v[ids[i]].kind == MCI_TT_SEGMENT;
+        coplanar += hits[ids[i]].kind == MCI_TT_COPLANAR;
+        crossing += hits[ids[i]].kind == MCI_TT_SEGMENT;
     }
     /* A crossing adds two points and a segment, a contact one point, a coplanar face up
      * to three segments (its points are counted as they come: corner copies, the most
      * common, are not appended). */
-    st = mci_arr_init(ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
-                      mci_scene_corner(s, f, 2), coplanar, 3 + n - coplanar + crossing, err);
-    if (st == MCSG_OK && !mci_arr_reserve(ctx, arr, 0, crossing + 3 * coplanar))
+    st = mci_arr_init(j->ctx, arr, f, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
+                      mci_scene_corner(s, f, 2), corner_points(s, j->vt, f, corners) ? corners
+                                                                                     : NULL,
+                      coplanar, 3 + n - coplanar + crossing, err);
+    if (st == MCSG_OK && !mci_arr_reserve(j->ctx, arr, 0, crossing + 3 * coplanar))
         st = mci_fail_nomem(err, "arranging faces");
     for (size_t i = 0; st == MCSG_OK && i < n; i++)
-        if (!add_hit(ctx, s, arr, hits, &hits->v[ids[i]], ff, planes))
+        if (!add_hit(j, arr, &hits[ids[i]]))
             st = mci_fail_nomem(err, "arranging faces");
-    return st == MCSG_OK ? mci_arr_merge(ctx, arr, err) : st;
+    return st == MCSG_OK ? mci_arr_merge(j->ctx, arr, err) : st;
 }
 
 /* Faces that are untouched themselves but receive a point on an edge. */
@@ -591,8 +692,8 @@ static void mark_receivers(const mci_scene *s, bool *needs)
 }
 
 /* Rebuild arrs in face order with new (empty) arrangements for the marked faces. */
-static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *needs,
-                                 mcsg_error *err)
+static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const vertex_table *vt,
+                                 const bool *needs, mcsg_error *err)
 {
     size_t extra = 0, k = 0, out = 0;
     mci_face_arr *all;
@@ -608,8 +709,10 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const bool *n
         if (s->arr_of[f] != MCI_NONE) {
             all[out] = s->arrs[k++];
         } else if (needs[f] && st == MCSG_OK) {
+            const mci_point *corners[3];
             st = mci_arr_init(ctx, &all[out], f, mci_scene_corner(s, f, 0),
-                              mci_scene_corner(s, f, 1), mci_scene_corner(s, f, 2), 0, 3, err);
+                              mci_scene_corner(s, f, 1), mci_scene_corner(s, f, 2),
+                              corner_points(s, vt, f, corners) ? corners : NULL, 0, 3, err);
         } else {
             continue;
         }
@@ -630,7 +733,7 @@ static bool has_edge_point(const mci_face_arr *t, const mci_point *p)
 {
     for (size_t q = 3; q < t->where_count; q++)
         if (t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE &&
-            mci_points_same_definition(&t->points[q], p))
+            mci_points_same_definition(t->points[q], p))
             return true;
     return false;
 }
@@ -647,7 +750,7 @@ static mci_face_arr *share_target(const mci_scene *s, const mci_face_arr *arr, s
     if (nb == MCI_NONE)
         return NULL;
     t = &s->arrs[s->arr_of[nb]];
-    return has_edge_point(t, &arr->points[p]) ? NULL : t;
+    return has_edge_point(t, arr->points[p]) ? NULL : t;
 }
 
 /* Which arrangements have an edge point their neighbour lacks: a read-only pass over
@@ -703,7 +806,8 @@ static mcsg_status reserve_shared(const mci_ctx *ctx, mci_scene *s, const uint8_
 /* Points on a face's edge go to the arrangement across that edge where it lacks them
  * (in arrangement order; an arrangement that received points shares none itself, its
  * new points are not located yet). */
-static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, const vertex_table *vt,
+                                     mcsg_error *err)
 {
     bool *needs = mci_calloc_array(ctx, s->face_count + 1, sizeof *needs);
     lack_job job = {s, NULL};
@@ -711,7 +815,7 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
     if (!needs)
         return mci_fail_nomem(err, "arranging faces");
     mark_receivers(s, needs);
-    st = add_receivers(ctx, s, needs, err);
+    st = add_receivers(ctx, s, vt, needs, err);
     mci_free(ctx, needs);
     if (st == MCSG_OK && !(job.lacking = mci_calloc_array(ctx, s->arr_count + 1, 1)))
         st = mci_fail_nomem(err, "arranging faces");
@@ -724,7 +828,7 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
         const mci_face_arr *arr = &s->arrs[k];
         for (size_t p = 3; job.lacking[k] && p < arr->point_count && !arr->dirty; p++) {
             mci_face_arr *t = share_target(s, arr, p);
-            if (t && !mci_arr_add_point(ctx, t, &arr->points[p]))
+            if (t && !mci_arr_add_point(ctx, t, arr->points[p]))
                 st = mci_fail_nomem(err, "arranging faces");
         }
     }
@@ -732,22 +836,12 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, mcsg_erro
     return st;
 }
 
-/* Faces are arranged independently (each writes only its own arrs[k]), in parallel. */
-typedef struct arrange_job {
-    const mci_ctx *ctx;
-    mci_scene *s;
-    const hit_list *hits;
-    const uint32_t *start, *list, *face_of;
-    const face_facts *ff;
-    const plane_cache *planes;
-} arrange_job;
-
 static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
 {
     const arrange_job *j = user;
     uint32_t f = j->face_of[k];
-    return arrange_face(j->ctx, j->s, f, j->hits, j->list + j->start[f],
-                        j->start[f + 1] - j->start[f], j->ff, j->planes, &j->s->arrs[k], err);
+    return arrange_face(j, f, j->list + j->start[f], j->start[f + 1] - j->start[f],
+                        &j->s->arrs[k], err);
 }
 
 /* Faces with the most hits first: a face cut by hundreds of others (a cylinder's cap)
@@ -849,18 +943,23 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
 {
     uint32_t *start = NULL, *list = NULL, *face_of = NULL;
     face_facts ff = {NULL, NULL};
-    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes};
+    vertex_table vt = {NULL, NULL, NULL};
+    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes, &vt};
     mcsg_status st = MCSG_OK;
-    if (!compute_face_facts(ctx, s, hits, planes, &ff) || !index_hits(ctx, s, hits, &start, &list) ||
+    if (!compute_face_facts(ctx, s, hits, planes, &ff) ||
+        !index_hits(ctx, s, hits, &start, &list) ||
         !number_arranged_faces(ctx, s, start, &face_of) ||
-        !record_touches(ctx, s, hits, start, list))
+        !record_touches(ctx, s, hits, start, list) || !build_vertex_table(ctx, s, &vt))
         st = mci_fail_nomem(err, "arranging faces");
+    s->vertex_points = vt.points; /* the arrangements refer to them */
     job.start = start;
     job.list = list;
     job.face_of = face_of;
     if (st == MCSG_OK)
         st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one, &job,
                                              err);
+    s->hit_points = hits->points; /* the arrangements refer to them */
+    hits->points = NULL;
     free_hits(ctx, hits);
     free_plane_cache(ctx, planes);
     free_face_facts(ctx, &ff);
@@ -868,7 +967,8 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
     mci_free(ctx, list);
     mci_free(ctx, face_of);
     if (st == MCSG_OK)
-        st = share_edge_points(ctx, s, err);
+        st = share_edge_points(ctx, s, &vt, err);
+    free_vertex_map(ctx, &vt);
     return st;
 }
 
@@ -980,6 +1080,9 @@ void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);
+    mci_free(ctx, scene->hit_points);
+    mci_free(ctx, scene->vertex_points);
+    scene->hit_points = scene->vertex_points = NULL;
     scene->arrs = NULL;
     scene->arr_of = scene->neighbour = scene->gid_start = scene->gid = NULL;
     scene->explicit_slot = scene->arr_dropped = NULL;
@@ -1199,7 +1302,7 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     for (size_t k = 0, slot = 0; ok && k < s->arr_count; k++) {
         s->gid_start[k] = (uint32_t)slot;
         for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {
-            nb.table[slot] = &s->arrs[k].points[p];
+            nb.table[slot] = s->arrs[k].points[p];
             nb.parent[slot] = (uint32_t)slot;
         }
     }
@@ -1291,7 +1394,7 @@ static mcsg_status export_curves(const mci_ctx *ctx, const mci_scene *s, mcsg_cu
         for (size_t p = 0; p < s->arrs[k].point_count; p++) {
             uint32_t id = new_id[s->gid[s->gid_start[k] + p]];
             if (id != MCI_NONE)
-                mci_point_round(&s->arrs[k].points[p], out->points + 3 * (size_t)id);
+                mci_point_round(s->arrs[k].points[p], out->points + 3 * (size_t)id);
         }
     for (size_t i = 0; i < count; i++) {
         out->segments[2 * i] = new_id[keys[i] >> 32];

@@ -18,6 +18,9 @@ typedef struct mci_scene {
     uint32_t *neighbour;      /* 3 per face: the face across edge i (corner i to i + 1) */
     uint32_t *arr_of;         /* per face: index in arrs, or MCI_NONE if untouched */
     mci_face_arr *arrs;       /* in increasing face order */
+    /* The points the arrangements refer to: the pair tests' (crossing ends) and one per
+     * vertex of an arranged face (see intersect.c). */
+    mci_point *hit_points, *vertex_points;
     size_t arr_count;
     /* Global identity (mci_scene_number_points): gid[gid_start[k] + i] numbers point
      * i of arrs[k]; equal points have equal numbers, across all faces. */

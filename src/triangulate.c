@@ -66,13 +66,13 @@ static int prev3(int i)
  * to be collinear (it does not return 0). */
 static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
-    const mci_point *pts = c->in->points;
-    int s = mci_orient2d_projected_quick(&pts[a], &pts[b], &pts[p], c->in->axis);
+    const mci_point *const *pts = c->in->points;
+    int s = mci_orient2d_projected_quick(pts[a], pts[b], pts[p], c->in->axis);
     if (s != MCI_UNCERTAIN)
         return c->in->sign * s;
     if (c->in->known_collinear && c->in->known_collinear(c->in->user, a, b, p))
         return 0;
-    return c->in->sign * mci_orient2d_projected_rest(&pts[a], &pts[b], &pts[p], c->in->axis);
+    return c->in->sign * mci_orient2d_projected_rest(pts[a], pts[b], pts[p], c->in->axis);
 }
 
 static int vertex_index(const tri *t, uint32_t v)
@@ -245,7 +245,7 @@ static uint32_t insertion_key(const mci_cdt_input *in, const double lo[2],
 {
     double x[3], q[2];
     uint32_t cell[2];
-    mci_point_approx(&in->points[p], x);
+    mci_point_approx(in->points[p], x);
     q[0] = x[(in->axis + 1) % 3];
     q[1] = x[(in->axis + 2) % 3];
     for (int k = 0; k < 2; k++) {
@@ -262,7 +262,7 @@ static void insertion_order(const mci_cdt_input *in, uint64_t *order)
     double lo[2] = {0, 0}, hi[2] = {0, 0}, span[2];
     for (int i = 0; i < 3; i++) {
         double x[3];
-        mci_point_approx(&in->points[i], x);
+        mci_point_approx(in->points[i], x);
         for (int k = 0; k < 2; k++) {
             double q = x[(in->axis + 1 + k) % 3];
             lo[k] = i == 0 || q < lo[k] ? q : lo[k];

@@ -18,7 +18,7 @@
  * share end points but must not cross, and no point may lie in a constraint's
  * interior. Constraints along the face's boundary are allowed and ignored. */
 typedef struct mci_cdt_input {
-    const mci_point *points;
+    const mci_point *const *points; /* by id */
     size_t point_count;
     int axis, sign;
     const uint32_t *insert;

@@ -58,8 +58,8 @@ static void add_box(scene_case *c, double x0, double y0, double z0, double x1, d
 
 static int orient_in_face(const mci_face_arr *arr, uint32_t a, uint32_t b, uint32_t c)
 {
-    return arr->sign * mci_orient2d_projected(&arr->points[a], &arr->points[b],
-                                              &arr->points[c], arr->axis);
+    return arr->sign * mci_orient2d_projected(arr->points[a], arr->points[b],
+                                              arr->points[c], arr->axis);
 }
 
 static bool tri_has_edge(const mci_face_arr *arr, uint32_t a, uint32_t b)

@@ -20,6 +20,7 @@ typedef struct face_case {
     double (*aux)[3]; /* end points of the lines that define LPI points */
     mci_plane plane;
     mci_point points[MAX_POINTS];
+    const mci_point *refs[MAX_POINTS]; /* the triangulation's input: points by id */
     size_t count;
     int axis, sign;
     uint32_t *edges;
@@ -45,6 +46,13 @@ static bool is_new_point(const face_case *f, const mci_point *p)
         if (mci_points_equal(&f->points[i], p))
             return false;
     return true;
+}
+
+static const mci_point *const *point_refs(face_case *f)
+{
+    for (size_t i = 0; i < f->count; i++)
+        f->refs[i] = &f->points[i];
+    return f->refs;
 }
 
 static void setup_face(face_case *f)
@@ -250,7 +258,7 @@ static void run_case(face_case *f)
     mcsg_error err;
     mci_cdt_output out;
     uint32_t *insert = malloc(f->count * sizeof *insert);
-    mci_cdt_input in = {f->points, f->count, f->axis, f->sign, insert, f->count - 3,
+    mci_cdt_input in = {point_refs(f), f->count, f->axis, f->sign, insert, f->count - 3,
                         f->edges, f->edge_count, NULL, NULL};
     mci_ctx_init(&ctx, NULL);
     for (size_t i = 3; i < f->count; i++)
@@ -325,7 +333,7 @@ TEST(contract_violations_are_reported)
     mci_cdt_input in;
     lattice_face(&f, 3);
     mci_ctx_init(&ctx, NULL);
-    in = (mci_cdt_input){f.points, f.count, f.axis, f.sign, insert, 2, NULL, 0, NULL, NULL};
+    in = (mci_cdt_input){point_refs(&f), f.count, f.axis, f.sign, insert, 2, NULL, 0, NULL, NULL};
     CHECK(mci_triangulate(&ctx, &in, &out, &err) == MCSG_ERR_INTERNAL);
     CHECK(out.tris == NULL && out.adj == NULL);
 }
@@ -337,7 +345,7 @@ TEST(allocation_failures)
     random_constraints(&f, 30);
     {
         uint32_t insert[MAX_POINTS];
-        mci_cdt_input in = {f.points, f.count, f.axis, f.sign, insert, f.count - 3,
+        mci_cdt_input in = {point_refs(&f), f.count, f.axis, f.sign, insert, f.count - 3,
                             f.edges, f.edge_count, NULL, NULL};
         for (size_t i = 3; i < f.count; i++)
             insert[i - 3] = (uint32_t)i;
