@@ -67,7 +67,8 @@ typedef struct mci_face_arr {
     uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge */
     mci_arr_segment *segments;
     mci_arr_edge *edges; /* after mci_arr_split: sorted by (a, b, other) */
-    double (*aux)[3];    /* auxiliary vertices (stable: points refer to them) */
+    double (*aux)[3];    /* auxiliary vertices (stable: points refer to them); NULL
+                            when no coplanar face is expected (mci_arr_init) */
     uint32_t *tris;      /* after mci_arr_triangulate: 3 point ids per triangle */
     uint32_t *adj;       /* ... and the side across each side (mci_cdt_output.adj) */
     uint32_t face;       /* global face id */
