@@ -132,6 +132,13 @@ void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr)
     memset(arr, 0, sizeof *arr);
 }
 
+void mci_arr_free_segments(const mci_ctx *ctx, mci_face_arr *arr)
+{
+    mci_free(ctx, arr->segments);
+    arr->segments = NULL;
+    arr->segment_count = arr->segment_capacity = 0;
+}
+
 /* A block for `capacity` points followed by their line lists and their locations (one
  * allocation where there were three: arrangements are many and small). */
 static const mci_point **point_block(const mci_ctx *ctx, size_t capacity,

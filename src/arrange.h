@@ -96,6 +96,9 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const mci_point *const corners[3], size_t max_coplanar,
                          size_t points, mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
+/* Free the segments (after mci_arr_split, which no longer needs them for the edges;
+ * adding or splitting again is then not allowed). */
+void mci_arr_free_segments(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Room for `points` points and `segments` segments in all (when more than now), so that
  * adding a counted number of them does not grow the arrays step by step (doubling left

@@ -50,7 +50,8 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
 /* mci_scene_build in two steps: everything but the splitting, then the splitting of
  * the arrangements k without skip[k] (skip may be NULL); skipped ones are only merged,
  * so that their points and locations are final (their faces will not be tessellated
- * with their constraints: see mci_decide_whole_faces). */
+ * with their constraints: see mci_decide_whole_faces). Splitting frees every
+ * arrangement's segments (only the elementary edges are used after it). */
 mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
                                     mci_scene *scene, mcsg_error *err);
