@@ -161,6 +161,57 @@ static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
     return MCSG_OK;
 }
 
+static uint64_t definition_hash(const mci_point *p)
+{
+    uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)p->kind;
+    for (int i = 0; i < mci_point_vertex_count(p); i++) {
+        h ^= (uint64_t)(uintptr_t)p->v[i];
+        h *= 0xff51afd7ed558ccdu;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
+/* Pair tests of the two faces along an edge with a third face build the same
+ * edge-plane point (one definition, so one value): the first copy is kept, since the
+ * arrangements refer to these points until the result is assembled. False when out of
+ * memory. */
+static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits)
+{
+    size_t n = hits->point_count, size = 16, kept = 0;
+    uint32_t *bucket, *remap;
+    mci_point *fit;
+    while (size < 2 * n)
+        size *= 2;
+    bucket = mci_malloc_array(ctx, size + n, sizeof *bucket);
+    if (!bucket)
+        return false;
+    remap = bucket + size;
+    for (size_t i = 0; i < size; i++)
+        bucket[i] = MCI_NONE;
+    for (size_t i = 0; i < n; i++) {
+        size_t at = definition_hash(&hits->points[i]) & (size - 1);
+        while (bucket[at] != MCI_NONE &&
+               !mci_points_same_definition(&hits->points[bucket[at]], &hits->points[i]))
+            at = (at + 1) & (size - 1);
+        if (bucket[at] == MCI_NONE) {
+            bucket[at] = (uint32_t)kept;
+            hits->points[kept++] = hits->points[i]; /* kept <= i: not read again */
+        }
+        remap[i] = bucket[at];
+    }
+    for (size_t h = 0; h < hits->count; h++)
+        for (int k = 0; k < 2; k++)
+            if ((hits->v[h].stored >> k) & 1)
+                hits->v[h].point[k] = remap[hits->v[h].point[k]];
+    mci_free(ctx, bucket);
+    hits->point_count = hits->point_capacity = kept;
+    if (!(fit = mci_realloc_array(ctx, hits->points, kept + 1, sizeof *fit)))
+        return false; /* every failure is reported, as the allocation tests demand */
+    hits->points = fit;
+    return true;
+}
+
 /* Moves the chunks' hits into *hits (in chunk order) and frees the chunks' lists: the
  * offsets serially, the copies (~180 bytes per stored point) on the threads. */
 typedef struct join_job {
@@ -217,6 +268,8 @@ static mcsg_status join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chu
         hits->point_capacity = hits->point_count = total_points;
         st = mci_parallel_for(ctx, n, join_chunk, &j, err);
     }
+    if (st == MCSG_OK && !merge_hit_copies(ctx, hits))
+        st = mci_fail_nomem(err, "intersecting faces");
     for (size_t c = 0; c < n; c++) {
         mci_free(ctx, chunks[c].hits.v);
         mci_free(ctx, chunks[c].hits.points);
@@ -1120,17 +1173,6 @@ typedef struct numbering {
     uint32_t *parent;        /* union-find over slots */
     size_t total;
 } numbering;
-
-static uint64_t definition_hash(const mci_point *p)
-{
-    uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)p->kind;
-    for (int i = 0; i < mci_point_vertex_count(p); i++) {
-        h ^= (uint64_t)(uintptr_t)p->v[i];
-        h *= 0xff51afd7ed558ccdu;
-        h ^= h >> 32;
-    }
-    return h;
-}
 
 /* Join with the smaller slot as root, so that roots are first occurrences. */
 static void join(uint32_t *parent, uint32_t a, uint32_t b)
