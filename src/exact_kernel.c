@@ -668,8 +668,9 @@ int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
 
 bool mci_points_same_definition(const mci_point *a, const mci_point *b)
 {
-    return a->kind == b->kind &&
-           memcmp(a->v, b->v, (size_t)mci_point_vertex_count(a) * sizeof a->v[0]) == 0;
+    /* Arrangements refer to shared points: one point is often compared with itself. */
+    return a == b || (a->kind == b->kind &&
+           memcmp(a->v, b->v, (size_t)mci_point_vertex_count(a) * sizeof a->v[0]) == 0);
 }
 
 /* The box test first: it decides most comparisons of distinct points and never returns 0
@@ -690,6 +691,8 @@ int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
 
 int mci_compare_lex(const mci_point *a, const mci_point *b)
 {
+    if (a == b)
+        return 0;
     for (int axis = 0; axis < 3; axis++) {
         int s = mci_compare_coord(a, b, axis);
         if (s != 0)
