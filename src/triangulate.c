@@ -482,7 +482,10 @@ static mcsg_status insert_constraint(cdt *c, uint32_t a, uint32_t b, mcsg_error 
     if (a == b || a >= c->in->point_count || b >= c->in->point_count || c->vt[a] == NONE ||
         c->vt[b] == NONE)
         return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: bad constraint %u-%u", a, b);
-    t = find_around(c, a, b, FAN_SEES);
+    /* The edge is often there already: looked for first without predicates. */
+    t = find_around(c, a, b, FAN_HAS_EDGE);
+    if (t == NONE)
+        t = find_around(c, a, b, FAN_SEES);
     if (t == NONE)
         return mci_fail(err, MCSG_ERR_INTERNAL, "triangulation: constraint %u-%u not found",
                         a, b);
