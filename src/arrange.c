@@ -137,6 +137,7 @@ void mci_arr_free_segments(const mci_ctx *ctx, mci_face_arr *arr)
     mci_free(ctx, arr->segments);
     arr->segments = NULL;
     arr->segment_count = arr->segment_capacity = 0;
+    arr->segments_freed = true;
 }
 
 /* A block for `capacity` points followed by their line lists and their locations (one
@@ -163,8 +164,8 @@ static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity
         memcpy(points, arr->points, arr->point_count * sizeof *points);
         memcpy(lines, arr->lines, arr->point_count * sizeof *lines);
     }
-    if (arr->where_count)
-        memcpy(where, arr->where, arr->where_count * sizeof *where);
+    if (arr->point_count) /* locations, and the appended points' known ones */
+        memcpy(where, arr->where, arr->point_count * sizeof *where);
     mci_free(ctx, arr->points);
     arr->points = points;
     arr->lines = lines;
@@ -213,14 +214,17 @@ static void add_line(mci_point_lines *l, uint64_t line)
     }
 }
 
-/* Add a point known to lie on `line` (0: none known). */
+/* Add a point known to lie on `line` (0: none known), at `where` (MCI_AT_*, or
+ * MCI_AT_UNKNOWN): until the next merge, where[] holds the appended points' known
+ * locations, which merging keeps instead of locating them again. */
 static bool add_point_on(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
-                         uint64_t line)
+                         uint64_t line, uint8_t where)
 {
     if (!grow_points(ctx, arr))
         return false;
     arr->lines[arr->point_count].count = 0;
     add_line(&arr->lines[arr->point_count], line);
+    arr->where[arr->point_count] = where;
     arr->points[arr->point_count++] = p;
     arr->dirty = true;
     return true;
@@ -246,11 +250,12 @@ static int coinciding_corner(const mci_face_arr *arr, const mci_point *p)
  * coplanar twin and touching neighbours receives each corner a dozen times).
  * Returns the point's index, or UINT32_MAX when out of memory. */
 static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p,
-                               uint64_t line)
+                               uint64_t line, uint8_t where)
 {
     int k = coinciding_corner(arr, p);
     if (k < 0)
-        return add_point_on(ctx, arr, p, line) ? (uint32_t)arr->point_count - 1 : UINT32_MAX;
+        return add_point_on(ctx, arr, p, line, where) ? (uint32_t)arr->point_count - 1
+                                                      : UINT32_MAX;
     arr->points[k] = p;
     add_line(&arr->lines[k], line);
     arr->dirty = true;
@@ -259,7 +264,7 @@ static uint32_t add_point_once(const mci_ctx *ctx, mci_face_arr *arr, const mci_
 
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p)
 {
-    return add_point_once(ctx, arr, p, 0) != UINT32_MAX;
+    return add_point_once(ctx, arr, p, 0, MCI_AT_UNKNOWN) != UINT32_MAX;
 }
 
 /* The stored corner when p is an explicit point at the same vertex (p's very
@@ -279,12 +284,17 @@ static bool add_point_copy(const mci_ctx *ctx, mci_face_arr *arr, const mci_poin
     return kept && mci_arr_add_point(ctx, arr, kept);
 }
 
+/* where: the ends' known locations (NULL: unknown). */
 static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
-                        const mci_point *b, const mci_arr_segment *s)
+                        const mci_point *b, const mci_arr_segment *s, const uint8_t *where)
 {
-    uint32_t ia = add_point_once(ctx, arr, a, s->line);
-    uint32_t ib = ia == UINT32_MAX ? UINT32_MAX : add_point_once(ctx, arr, b, s->line);
+    uint32_t ia, ib;
     size_t capacity = arr->segment_capacity;
+    if (arr->segments_freed)
+        return false;
+    ia = add_point_once(ctx, arr, a, s->line, where ? where[0] : MCI_AT_UNKNOWN);
+    ib = ia == UINT32_MAX ? UINT32_MAX
+         : add_point_once(ctx, arr, b, s->line, where ? where[1] : MCI_AT_UNKNOWN);
     if (ib == UINT32_MAX || arr->segment_count == UINT32_MAX ||
         !mci_grow_array(ctx, (void **)&arr->segments, &capacity, arr->segment_count + 1,
                         sizeof *arr->segments, 8) || capacity > UINT32_MAX)
@@ -303,11 +313,12 @@ static bool add_segment(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *
 
 bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
                           const mci_point *b, uint32_t other, const mci_plane *other_plane,
-                          uint32_t plane_id, uint32_t group, bool on_edge)
+                          uint32_t plane_id, uint32_t group, bool on_edge,
+                          const uint8_t where[2])
 {
     mci_arr_segment s = {0, 0, other, 0, {other_plane->a, other_plane->b, other_plane->c},
                          (uint64_t)plane_id + 1, group, on_edge, 0};
-    return add_segment(ctx, arr, a, b, &s);
+    return add_segment(ctx, arr, a, b, &s, where);
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -398,7 +409,7 @@ static bool clip_coplanar_edge(const mci_ctx *ctx, mci_face_arr *arr, uint32_t o
         mci_arr_segment s = {0, 0, other, 1, {u, v, aux},
                              COPLANAR_LINE + 3 * (uint64_t)other + (uint64_t)edge, group, 1,
                              !crease};
-        return aux && end && add_segment(ctx, arr, start, end, &s);
+        return aux && end && add_segment(ctx, arr, start, end, &s, NULL);
     }
 }
 
@@ -421,6 +432,8 @@ bool mci_arr_add_coplanar(const mci_ctx *ctx, mci_face_arr *arr, uint32_t other,
                           const mci_plane *other_plane, const bool crease[3], uint32_t group)
 {
     const double *v[3] = {other_plane->a, other_plane->b, other_plane->c};
+    if (!arr->aux || arr->segments_freed) /* not announced to mci_arr_init, or too late */
+        return false;
     arr->coplanar = true;
     /* An identical face (identical operands): every edge lies along an edge of this face,
      * so clipping would only add its two ends; the same points, without the tests. */
@@ -554,8 +567,6 @@ static uint8_t locate_in_face(const mci_face_arr *arr, const mci_point *p)
     return UINT8_MAX;
 }
 
-#define WHERE_UNKNOWN UINT8_C(0xfe)
-
 /* MCI_AT_* of the points whose location is not known yet (after a merge: the points
  * added since the previous one; a location depends on the point alone, not on which of
  * its copies is stored, so the others kept theirs). */
@@ -563,7 +574,7 @@ static mcsg_status locate_new_points(mci_face_arr *arr, mcsg_error *err)
 {
     uint8_t *where = arr->where;
     for (size_t i = 0; i < arr->point_count; i++) {
-        if (where[i] != WHERE_UNKNOWN)
+        if (where[i] != MCI_AT_UNKNOWN)
             continue;
         where[i] = i < 3 ? (uint8_t)(MCI_AT_CORNER + i) : locate_in_face(arr, arr->points[i]);
         if (i >= 3 && where[i] < MCI_AT_EDGE)
@@ -652,9 +663,12 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         arr->segment_count = out;
         for (size_t k = 0; k < cut_count; k++)
             cuts[k][1] = remap[cuts[k][1]];
-        memset(merged_where, WHERE_UNKNOWN, kept);
+        memset(merged_where, MCI_AT_UNKNOWN, kept);
         for (size_t i = 0; i < before; i++)
             merged_where[remap[i]] = arr->where[i];
+        for (size_t i = before; i < n; i++) /* known locations of appended points */
+            if (merged_where[remap[i]] == MCI_AT_UNKNOWN)
+                merged_where[remap[i]] = arr->where[i];
         mci_free(ctx, arr->points);
         arr->points = merged;
         arr->lines = merged_lines;
@@ -813,7 +827,7 @@ static void relate_segments(splitter *sp, uint32_t s, uint32_t t)
         const mci_point *kept;
         uint32_t id = (uint32_t)arr->point_count;
         if (!crossing_point(arr, &S, &T, &x) || !(kept = pool_copy(sp->ctx, arr, &x)) ||
-            !add_point_on(sp->ctx, arr, kept, S.line)) {
+            !add_point_on(sp->ctx, arr, kept, S.line, MCI_AT_UNKNOWN)) {
             sp->ok = false;
             return;
         }
@@ -1016,6 +1030,9 @@ mcsg_status mci_arr_split(const mci_ctx *ctx, mci_face_arr *arr, mcsg_error *err
     splitter sp = {ctx, arr, NULL, 0, 0, true};
     mcsg_status st = MCSG_OK;
     size_t before;
+    if (arr->segments_freed)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "face %u split after its segments were freed",
+                        arr->face);
     if (arr->dirty && (st = merge_points(ctx, arr, NULL, 0, err)) != MCSG_OK)
         return st;
     before = arr->point_count;

@@ -14,7 +14,8 @@
 enum {
     MCI_AT_CORNER = 0, /* + corner index 0..2 */
     MCI_AT_EDGE = 3,   /* + edge index 0..2 (edge i from corner i to corner i + 1) */
-    MCI_AT_INSIDE = 6
+    MCI_AT_INSIDE = 6,
+    MCI_AT_UNKNOWN = 0xfe /* not located yet */
 };
 
 /* A piece of constraint between two points of the face, with its source: the segment
@@ -60,7 +61,9 @@ typedef struct mci_face_arr {
     mci_plane plane;     /* the face's plane; corners plane.a, .b, .c */
     /* [0..2] are the corners. The points are referred to, not copied: those given by
      * the caller live in the caller's stores (see mci_arr_add_point), the others in
-     * `own`. 8 bytes a point instead of a 176-byte copy in every face that has it. */
+     * `own`. 8 bytes a point instead of a 176-byte copy in every face that has it. A
+     * point may be given to another arrangement (a scene shares edge points with the
+     * neighbour across), so arrangements that share points are freed together. */
     const mci_point **points;
     mci_point_pool *own;
     mci_point_lines *lines; /* per point */
@@ -83,6 +86,7 @@ typedef struct mci_face_arr {
     uint32_t tri_count;
     bool dirty;          /* points were added since the last merge */
     bool coplanar;       /* a coplanar face of another leaf was added */
+    bool segments_freed; /* mci_arr_free_segments was called */
 } mci_face_arr;
 
 /* Start the arrangement of face `face` with corners a, b, c (non-degenerate).
@@ -96,8 +100,10 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const mci_point *const corners[3], size_t max_coplanar,
                          size_t points, mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
-/* Free the segments (after mci_arr_split, which no longer needs them for the edges;
- * adding or splitting again is then not allowed). */
+/* Free the segments once they are no longer needed: after mci_arr_split (the edges
+ * are built), or after the last merge of an arrangement that will not be split.
+ * Adding segments or coplanar faces, or splitting, afterwards fails (mci_arr_split with
+ * MCSG_ERR_INTERNAL). */
 void mci_arr_free_segments(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Room for `points` points and `segments` segments in all (when more than now), so that
@@ -112,17 +118,20 @@ const mci_point *mci_arr_keep(const mci_ctx *ctx, mci_face_arr *arr, const mci_p
 
 /* Inputs. Points must lie on the face (closed triangle). The arrangement refers to the
  * points given (mci_arr_add_point, mci_arr_add_crossing): they must stay valid and
- * unchanged until mci_arr_free. */
+ * unchanged as long as the arrangement is used. */
 bool mci_arr_add_point(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *p);
 /* The segment a-b where face `other` crosses. `plane_id` names other's plane: faces of
  * one flat region of a leaf may share it (their segments then lie on one line, which
  * spares exact zero tests); distinct planes must have distinct ids below 2^32.
  * `group` is other's leaf and `on_edge` says whether the segment lies along an edge of
  * other: two segments of one leaf that do not lie along edges cannot cross or overlap
- * (a leaf does not intersect itself), so they are not compared at all. */
+ * (a leaf does not intersect itself), so they are not compared at all. `where` (may be
+ * NULL) gives the ends' locations MCI_AT_* when the caller knows them exactly (merging
+ * then does not locate them again), or MCI_AT_UNKNOWN. */
 bool mci_arr_add_crossing(const mci_ctx *ctx, mci_face_arr *arr, const mci_point *a,
                           const mci_point *b, uint32_t other, const mci_plane *other_plane,
-                          uint32_t plane_id, uint32_t group, bool on_edge);
+                          uint32_t plane_id, uint32_t group, bool on_edge,
+                          const uint8_t where[2]);
 /* The coplanar face `other` (corners of other_plane): its edges are clipped to this
  * face. The part inside of a crease edge (crease[i] for the edge from corner i to
  * corner i + 1: the other surface bends there) becomes a coplanar segment; other edges

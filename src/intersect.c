@@ -19,6 +19,7 @@ typedef struct pair_hit {
     uint32_t f, g;
     uint8_t kind; /* mci_tt_kind */
     bool along_edge[2]; /* of f, of g */
+    uint8_t strict_ends; /* mci_tt_result.strict_ends */
     uint8_t stored;     /* bit k: end k is points[point[k]], else the vertex vertex[k] */
     const double *vertex[2];
     uint32_t point[2];
@@ -57,6 +58,7 @@ static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
     hit->kind = (uint8_t)r->kind;
     hit->along_edge[0] = r->along_edge[0];
     hit->along_edge[1] = r->along_edge[1];
+    hit->strict_ends = r->strict_ends;
     for (int k = 0; k < ends; k++) {
         if (r->end[k].kind == MCI_POINT_EXPLICIT) {
             hit->vertex[k] = r->end[k].v[0];
@@ -213,7 +215,8 @@ static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits)
 }
 
 /* Moves the chunks' hits into *hits (in chunk order) and frees the chunks' lists: the
- * offsets serially, the copies (~180 bytes per stored point) on the threads. */
+ * offsets serially, the copies (~180 bytes per stored point) on the threads; then
+ * merges the stored points' copies (merge_hit_copies). */
 typedef struct join_job {
     pair_chunk *chunks;
     hit_list *hits;
@@ -268,14 +271,14 @@ static mcsg_status join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chu
         hits->point_capacity = hits->point_count = total_points;
         st = mci_parallel_for(ctx, n, join_chunk, &j, err);
     }
-    if (st == MCSG_OK && !merge_hit_copies(ctx, hits))
-        st = mci_fail_nomem(err, "intersecting faces");
     for (size_t c = 0; c < n; c++) {
         mci_free(ctx, chunks[c].hits.v);
         mci_free(ctx, chunks[c].hits.points);
         chunks[c].hits.v = NULL;
         chunks[c].hits.points = NULL;
     }
+    if (st == MCSG_OK && !merge_hit_copies(ctx, hits)) /* with the chunks' lists freed */
+        st = mci_fail_nomem(err, "intersecting faces");
     mci_free(ctx, j.first_hit);
     mci_free(ctx, j.first_point);
     return st;
@@ -675,20 +678,37 @@ typedef struct arrange_job {
     const vertex_table *vt;
 } arrange_job;
 
+/* Where an end of a crossing flagged in mci_tt_result.strict_ends lies in face f: an
+ * edge line of f lies strictly inside that edge, any other strictly inside f. */
+static uint8_t strict_end_location(const mci_scene *s, uint32_t f, const mci_point *p)
+{
+    for (int e = 0; e < 3; e++) {
+        const double *u = mci_scene_corner(s, f, e), *w = mci_scene_corner(s, f, (e + 1) % 3);
+        if ((p->v[0] == u && p->v[1] == w) || (p->v[0] == w && p->v[1] == u))
+            return (uint8_t)(MCI_AT_EDGE + e);
+    }
+    return MCI_AT_INSIDE;
+}
+
 static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
 {
     const mci_scene *s = j->s;
     uint32_t other = h->f == arr->face ? h->g : h->f;
     const mci_plane *plane = &j->planes->planes[j->planes->slot[other]];
     bool crease[3];
+    uint8_t where[2];
     const mci_point *a, *b;
     switch (h->kind) {
     case MCI_TT_SEGMENT:
         a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
         b = a ? hit_end(j->ctx, s, j->vt, arr, j->hits, h, 1) : NULL;
-        return b && mci_arr_add_crossing(j->ctx, arr, a, b, other, plane,
-                                         j->ff->plane_rep[other], s->octree.face_leaf[other],
-                                         h->along_edge[h->f == arr->face ? 1 : 0]);
+        if (!b)
+            return false;
+        where[0] = h->strict_ends & 1 ? strict_end_location(s, arr->face, a) : MCI_AT_UNKNOWN;
+        where[1] = h->strict_ends & 2 ? strict_end_location(s, arr->face, b) : MCI_AT_UNKNOWN;
+        return mci_arr_add_crossing(j->ctx, arr, a, b, other, plane, j->ff->plane_rep[other],
+                                    s->octree.face_leaf[other],
+                                    h->along_edge[h->f == arr->face ? 1 : 0], where);
     case MCI_TT_POINT:
         a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
         return a && mci_arr_add_point(j->ctx, arr, a);
@@ -997,7 +1017,8 @@ static void free_hits(const mci_ctx *ctx, hit_list *hits)
 }
 
 /* Consumes the hits and the plane cache: both are freed as soon as the faces have taken
- * their records, before the arrangements grow (splitting, edge points). */
+ * their records, before the arrangements grow (splitting, edge points), except the
+ * hits' point store, which moves to the scene (the arrangements refer to it). */
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list *hits,
                                       plane_cache *planes, mcsg_error *err)
 {

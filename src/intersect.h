@@ -21,6 +21,10 @@ typedef struct mci_tt_result {
     /* SEGMENT: whether it lies along an edge of t1 (two of t1's corners are on t2's
      * plane), and of t2. */
     bool along_edge[2];
+    /* SEGMENT with every corner of both triangles strictly off the other's plane: each
+     * end is where an edge of one triangle crosses the other's plane, strictly inside
+     * that edge; bit k says that end k is also strictly inside the other triangle. */
+    uint8_t strict_ends;
     mci_point end[2];
 } mci_tt_result;
 

@@ -139,8 +139,9 @@ static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const stric
 {
     const double *p1 = c->v1[0], *q1 = c->v1[1], *r1 = c->v1[2];
     const double *p2 = c->v2[0], *q2 = c->v2[1], *r2 = c->v2[2];
-    bool start_k = mci_orient3d_vertices(p1, r1, p2, q2) > 0;
-    bool end_l = mci_orient3d_vertices(p1, q1, p2, r2) < 0;
+    int start_side = mci_orient3d_vertices(p1, r1, p2, q2);
+    int end_side = mci_orient3d_vertices(p1, q1, p2, r2);
+    bool start_k = start_side > 0, end_l = end_side < 0;
     bool single = start_k && !end_l ? mci_orient3d_vertices(p1, q1, p2, q2) == 0
                   : !start_k && end_l ? mci_orient3d_vertices(p1, r1, p2, r2) == 0
                                       : false;
@@ -150,6 +151,11 @@ static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const stric
      * which is the section's end when the section runs against it. */
     if (single)
         start = end = &out->end[0];
+    /* A segment's end lies strictly inside the other triangle unless the two sections
+     * end there together (a tie: it is on an edge of each). */
+    else
+        out->strict_ends = (uint8_t)((start_side != 0) << c->reversed |
+                                     (end_side != 0) << !c->reversed);
     if (!single || !c->reversed) {
         if (start_k)
             edge_crossing(start, p2, q2, t1);

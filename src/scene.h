@@ -18,8 +18,10 @@ typedef struct mci_scene {
     uint32_t *neighbour;      /* 3 per face: the face across edge i (corner i to i + 1) */
     uint32_t *arr_of;         /* per face: index in arrs, or MCI_NONE if untouched */
     mci_face_arr *arrs;       /* in increasing face order */
-    /* The points the arrangements refer to: the pair tests' (crossing ends) and one per
-     * vertex of an arranged face (see intersect.c). */
+    /* The points the arrangements refer to, besides their own pools: the pair tests'
+     * (segment ends and contact points not at a vertex) and one per vertex of an
+     * arranged face (see intersect.c). Arrangements refer to each other's pools too
+     * (shared edge points): a scene's arrangements are freed together. */
     mci_point *hit_points, *vertex_points;
     size_t arr_count;
     /* Global identity (mci_scene_number_points): gid[gid_start[k] + i] numbers point

@@ -286,6 +286,39 @@ static bool nondegenerate(const double *v[3])
 
 static long kind_counts[4];
 static long coplanar_overlaps;
+static long strict_inside_ends, strict_tied_ends;
+
+/* Every corner of t strictly off the plane. */
+static bool strictly_off(const double *t[3], const mci_plane *plane)
+{
+    return mci_orient3d_vertex(t[0], plane) != 0 && mci_orient3d_vertex(t[1], plane) != 0 &&
+           mci_orient3d_vertex(t[2], plane) != 0;
+}
+
+/* strict_ends (the arrangements skip locating such ends): in a segment between
+ * triangles whose corners are all strictly off the other's plane, end e is an edge
+ * line of one triangle, strictly inside that edge; it is strictly inside the other
+ * triangle exactly when its bit is set. */
+static void check_strict_ends(const mci_plane *p1, const mci_plane *p2, const double *t1[3],
+                              const double *t2[3], const mci_tt_result *got, const char *what)
+{
+    bool strict = got->kind == MCI_TT_SEGMENT && strictly_off(t1, p2) && strictly_off(t2, p1);
+    CHECK_MSG(strict || got->strict_ends == 0, "%s: strict_ends set on a non-strict pair", what);
+    for (int e = 0; strict && e < 2; e++) {
+        const mci_point *x = &got->end[e];
+        bool of_t1 = (x->v[0] == t1[0] || x->v[0] == t1[1] || x->v[0] == t1[2]) &&
+                     (x->v[1] == t1[0] || x->v[1] == t1[1] || x->v[1] == t1[2]);
+        const mci_plane *own = of_t1 ? p1 : p2, *other = of_t1 ? p2 : p1;
+        int which;
+        bool inside = mci_point_in_triangle(x, other, &which) == MCI_INSIDE;
+        CHECK_MSG(x->kind == MCI_POINT_LPI && mci_point_in_triangle(x, own, &which) == MCI_ON_EDGE,
+                  "%s: strict end %d is not inside an edge of its triangle", what, e);
+        CHECK_MSG(inside == ((got->strict_ends >> e) & 1), "%s: strict end %d: inside %d, bit %d",
+                  what, e, inside, (got->strict_ends >> e) & 1);
+        strict_inside_ends += inside;
+        strict_tied_ends += !inside;
+    }
+}
 
 static void check_pair(const double *t1[3], const double *t2[3], const char *what)
 {
@@ -305,6 +338,7 @@ static void check_pair(const double *t1[3], const double *t2[3], const char *wha
     CHECK_MSG(got.kind == want.kind, "%s: kind %d, want %d", what, got.kind, want.kind);
     if (got.kind == want.kind && want.kind == MCI_TT_COPLANAR)
         CHECK_MSG(got.overlap == want.overlap, "%s: coplanar overlap %d", what, got.overlap);
+    check_strict_ends(&p1, &p2, t1, t2, &got, what);
     for (int e = 0; got.kind == want.kind && e < (int)want.kind && e < 2; e++) {
         if (want.kind == MCI_TT_COPLANAR)
             break;
@@ -344,8 +378,11 @@ TEST(random_and_degenerate_pairs_match_the_reference)
     }
     printf("kinds: disjoint %ld, point %ld, segment %ld, coplanar %ld (%ld overlapping)\n",
            kind_counts[0], kind_counts[1], kind_counts[2], kind_counts[3], coplanar_overlaps);
+    printf("strict segment ends: %ld inside the other triangle, %ld on its boundary\n",
+           strict_inside_ends, strict_tied_ends);
     CHECK(kind_counts[1] > 100 && kind_counts[2] > 100 && kind_counts[3] > 100);
     CHECK(coplanar_overlaps > 50);
+    CHECK(strict_inside_ends > 1000 && strict_tied_ends > 100);
 }
 
 TEST(shared_edge_crossing_is_defined_identically)
