@@ -20,16 +20,25 @@ typedef struct pair_hit {
     uint8_t kind; /* mci_tt_kind */
     bool along_edge[2]; /* of f, of g */
     uint8_t strict_ends; /* mci_tt_result.strict_ends */
-    uint8_t stored;     /* bit k: end k is points[point[k]], else the vertex vertex[k] */
+    uint8_t stored;     /* bit k: end k is a stored point, else the vertex vertex[k] */
     const double *vertex[2];
-    uint32_t point[2];
+    /* Stored end k: its index in the chunk's store, numbered across the chunks once
+     * they are joined, and finally the point itself (join_chunks). */
+    union {
+        uint32_t index;
+        const mci_point *at;
+    } point[2];
 } pair_hit;
 
+/* A chunk's hits and stored points; joined, the hits of all chunks and the chunks'
+ * point stores as blocks (kept where they are: the arrangements refer to them). */
 typedef struct hit_list {
     pair_hit *v;
     size_t count, capacity;
     mci_point *points;
     size_t point_count, point_capacity;
+    mci_point **blocks;
+    size_t block_count;
 } hit_list;
 
 
@@ -68,7 +77,7 @@ static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
                             sizeof *h->points, 64))
             return false;
         hit->stored |= (uint8_t)(1u << k);
-        hit->point[k] = (uint32_t)h->point_count;
+        hit->point[k].index = (uint32_t)h->point_count;
         h->points[h->point_count++] = r->end[k];
     }
     h->count++;
@@ -202,47 +211,85 @@ static uint64_t definition_hash(const mci_point *p)
 
 /* Pair tests of the two faces along an edge with a third face build the same
  * edge-plane point (one definition, so one value): the first copy is kept, since the
- * arrangements refer to these points until the result is assembled. False when out of
+ * arrangements refer to these points until the result is assembled. On entry the hits'
+ * stored ends are numbered across the blocks (block c from first[c]); on return they
+ * point to their points, each block cut to the points it keeps. False when out of
  * memory. */
-static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits)
+typedef struct hit_copies {
+    mci_point **at;     /* by number: the point */
+    uint32_t *rep;      /* by number: the number of the first copy */
+    uint32_t *bucket;   /* hash table of first copies */
+    size_t size;
+} hit_copies;
+
+static void find_first_copies(hit_copies *c, size_t n)
 {
-    size_t n = hits->point_count, size = 16, kept = 0;
-    uint32_t *bucket, *remap;
-    mci_point *fit;
-    while (size < 2 * n)
-        size *= 2;
-    bucket = mci_malloc_array(ctx, size + n, sizeof *bucket);
-    if (!bucket)
-        return false;
-    remap = bucket + size;
-    for (size_t i = 0; i < size; i++)
-        bucket[i] = MCI_NONE;
+    for (size_t i = 0; i < c->size; i++)
+        c->bucket[i] = MCI_NONE;
     for (size_t i = 0; i < n; i++) {
-        size_t at = definition_hash(&hits->points[i]) & (size - 1);
-        while (bucket[at] != MCI_NONE &&
-               !mci_points_same_definition(&hits->points[bucket[at]], &hits->points[i]))
-            at = (at + 1) & (size - 1);
-        if (bucket[at] == MCI_NONE) {
-            bucket[at] = (uint32_t)kept;
-            hits->points[kept++] = hits->points[i]; /* kept <= i: not read again */
-        }
-        remap[i] = bucket[at];
+        size_t at = definition_hash(c->at[i]) & (c->size - 1);
+        while (c->bucket[at] != MCI_NONE &&
+               !mci_points_same_definition(c->at[c->bucket[at]], c->at[i]))
+            at = (at + 1) & (c->size - 1);
+        if (c->bucket[at] == MCI_NONE)
+            c->bucket[at] = (uint32_t)i;
+        c->rep[i] = c->bucket[at];
     }
-    for (size_t h = 0; h < hits->count; h++)
-        for (int k = 0; k < 2; k++)
-            if ((hits->v[h].stored >> k) & 1)
-                hits->v[h].point[k] = remap[hits->v[h].point[k]];
-    mci_free(ctx, bucket);
-    hits->point_count = hits->point_capacity = kept;
-    if (!(fit = mci_realloc_array(ctx, hits->points, kept + 1, sizeof *fit)))
-        return false; /* every failure is reported, as the allocation tests demand */
-    hits->points = fit;
+}
+
+/* Each block keeps its first copies, in order, and is cut to them; at[] then gives
+ * every first copy's final place. */
+static bool compact_blocks(const mci_ctx *ctx, hit_list *hits, const size_t *first,
+                           hit_copies *c)
+{
+    for (size_t b = 0; b < hits->block_count; b++) {
+        size_t end = b + 1 < hits->block_count ? first[b + 1] : hits->point_count, kept = 0;
+        mci_point *fit;
+        for (size_t i = first[b]; i < end; i++)
+            if (c->rep[i] == i)
+                hits->blocks[b][kept++] = *c->at[i]; /* kept <= its index: not read again */
+        if (!(fit = mci_realloc_array(ctx, hits->blocks[b], kept + 1, sizeof *fit)))
+            return false;
+        hits->blocks[b] = fit;
+        kept = 0;
+        for (size_t i = first[b]; i < end; i++)
+            if (c->rep[i] == i)
+                c->at[i] = &fit[kept++];
+    }
     return true;
 }
 
-/* Moves the chunks' hits into *hits (in chunk order) and frees the chunks' lists: the
- * offsets serially, the copies (~180 bytes per stored point) on the threads; then
- * merges the stored points' copies (merge_hit_copies). */
+static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits, const size_t *first)
+{
+    size_t n = hits->point_count;
+    hit_copies c = {mci_malloc_array(ctx, n + 1, sizeof *c.at), NULL, NULL, 16};
+    bool ok;
+    while (c.size < 2 * n)
+        c.size *= 2;
+    c.rep = mci_malloc_array(ctx, n + c.size, sizeof *c.rep);
+    c.bucket = c.rep ? c.rep + n : NULL;
+    ok = c.at && c.rep;
+    for (size_t b = 0; ok && b < hits->block_count; b++) {
+        size_t end = b + 1 < hits->block_count ? first[b + 1] : n;
+        for (size_t i = first[b]; i < end; i++)
+            c.at[i] = &hits->blocks[b][i - first[b]];
+    }
+    if (ok) {
+        find_first_copies(&c, n);
+        ok = compact_blocks(ctx, hits, first, &c);
+    }
+    for (size_t h = 0; ok && h < hits->count; h++)
+        for (int k = 0; k < 2; k++)
+            if ((hits->v[h].stored >> k) & 1)
+                hits->v[h].point[k].at = c.at[c.rep[hits->v[h].point[k].index]];
+    mci_free(ctx, c.at);
+    mci_free(ctx, c.rep);
+    return ok;
+}
+
+/* Moves the chunks' hits into *hits (in chunk order; the offsets serially, the copies on
+ * the threads) and their point stores into its blocks, as they are (a joined copy cost
+ * ring-800 58 MB of copying and page faults); then merges the stored points' copies. */
 typedef struct join_job {
     pair_chunk *chunks;
     hit_list *hits;
@@ -259,11 +306,9 @@ static mcsg_status join_chunk(void *user, size_t c, mcsg_error *err)
         pair_hit h = from->v[i];
         for (int k = 0; k < 2; k++)
             if ((h.stored >> k) & 1)
-                h.point[k] += base;
+                h.point[k].index += base;
         j->hits->v[j->first_hit[c] + i] = h;
     }
-    if (from->point_count)
-        memcpy(j->hits->points + base, from->points, from->point_count * sizeof *from->points);
     return MCSG_OK;
 }
 
@@ -288,22 +333,26 @@ static mcsg_status join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chu
         st = mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total_points);
     if (st == MCSG_OK) {
         hits->v = mci_malloc_array(ctx, total + 1, sizeof *hits->v);
-        hits->points = mci_malloc_array(ctx, total_points + 1, sizeof *hits->points);
-        if (!hits->v || !hits->points)
+        hits->blocks = mci_calloc_array(ctx, n + 1, sizeof *hits->blocks);
+        if (!hits->v || !hits->blocks)
             st = mci_fail_nomem(err, "intersecting faces");
     }
     if (st == MCSG_OK) {
         hits->capacity = hits->count = total;
-        hits->point_capacity = hits->point_count = total_points;
+        hits->point_count = total_points;
         st = mci_parallel_for(ctx, n, join_chunk, &j, err);
     }
     for (size_t c = 0; c < n; c++) {
+        if (hits->blocks && st == MCSG_OK) { /* the block takes the store */
+            hits->blocks[hits->block_count++] = chunks[c].hits.points;
+            chunks[c].hits.points = NULL;
+        }
         mci_free(ctx, chunks[c].hits.v);
         mci_free(ctx, chunks[c].hits.points);
         chunks[c].hits.v = NULL;
         chunks[c].hits.points = NULL;
     }
-    if (st == MCSG_OK && !merge_hit_copies(ctx, hits)) /* with the chunks' lists freed */
+    if (st == MCSG_OK && !merge_hit_copies(ctx, hits, j.first_point))
         st = mci_fail_nomem(err, "intersecting faces");
     mci_free(ctx, j.first_hit);
     mci_free(ctx, j.first_point);
@@ -677,11 +726,11 @@ static bool corner_points(const mci_scene *s, const vertex_table *vt, uint32_t f
 /* End k of hit h as a point that arr may refer to: a stored point, or a vertex (a
  * corner of h's faces: the table's point; else kept by arr). NULL when out of memory. */
 static const mci_point *hit_end(const mci_ctx *ctx, const mci_scene *s, const vertex_table *vt,
-                                mci_face_arr *arr, const hit_list *l, const pair_hit *h, int k)
+                                mci_face_arr *arr, const pair_hit *h, int k)
 {
     mci_point vertex;
     if ((h->stored >> k) & 1)
-        return &l->points[h->point[k]];
+        return h->point[k].at;
     for (int c = 0; c < 6; c++) {
         uint32_t face = c < 3 ? h->f : h->g;
         const mci_point *p;
@@ -726,8 +775,8 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
     const mci_point *a, *b;
     switch (h->kind) {
     case MCI_TT_SEGMENT:
-        a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
-        b = a ? hit_end(j->ctx, s, j->vt, arr, j->hits, h, 1) : NULL;
+        a = hit_end(j->ctx, s, j->vt, arr, h, 0);
+        b = a ? hit_end(j->ctx, s, j->vt, arr, h, 1) : NULL;
         if (!b)
             return false;
         where[0] = h->strict_ends & 1 ? strict_end_location(s, arr->face, a) : MCI_AT_UNKNOWN;
@@ -736,7 +785,7 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
                                     s->octree.face_leaf[other],
                                     h->along_edge[h->f == arr->face ? 1 : 0], where);
     case MCI_TT_POINT:
-        a = hit_end(j->ctx, s, j->vt, arr, j->hits, h, 0);
+        a = hit_end(j->ctx, s, j->vt, arr, h, 0);
         return a && mci_arr_add_point(j->ctx, arr, a);
     default:
         for (int i = 0; i < 3; i++)
@@ -1035,10 +1084,18 @@ static bool number_arranged_faces(const mci_ctx *ctx, mci_scene *s, const uint32
     return true;
 }
 
+static void free_point_blocks(const mci_ctx *ctx, mci_point **blocks, size_t count)
+{
+    for (size_t b = 0; blocks && b < count; b++)
+        mci_free(ctx, blocks[b]);
+    mci_free(ctx, blocks);
+}
+
 static void free_hits(const mci_ctx *ctx, hit_list *hits)
 {
     mci_free(ctx, hits->v);
     mci_free(ctx, hits->points);
+    free_point_blocks(ctx, hits->blocks, hits->block_count);
     memset(hits, 0, sizeof *hits);
 }
 
@@ -1065,8 +1122,10 @@ static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list
     if (st == MCSG_OK)
         st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one, &job,
                                              err);
-    s->hit_points = hits->points; /* the arrangements refer to them */
-    hits->points = NULL;
+    s->hit_blocks = hits->blocks; /* the arrangements refer to them */
+    s->hit_block_count = hits->block_count;
+    hits->blocks = NULL;
+    hits->block_count = 0;
     free_hits(ctx, hits);
     free_plane_cache(ctx, planes);
     free_face_facts(ctx, &ff);
@@ -1103,7 +1162,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 {
     uint64_t *pairs = NULL;
     size_t count = 0;
-    hit_list hits = {NULL, 0, 0, NULL, 0, 0};
+    hit_list hits = {NULL, 0, 0, NULL, 0, 0, NULL, 0};
     plane_cache planes = {NULL, NULL};
     double t0 = mci_seconds_now(), t1, t2;
     mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);
@@ -1187,9 +1246,11 @@ void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);
-    mci_free(ctx, scene->hit_points);
+    free_point_blocks(ctx, scene->hit_blocks, scene->hit_block_count);
     mci_free(ctx, scene->vertex_points);
-    scene->hit_points = scene->vertex_points = NULL;
+    scene->hit_blocks = NULL;
+    scene->hit_block_count = 0;
+    scene->vertex_points = NULL;
     scene->arrs = NULL;
     scene->arr_of = scene->neighbour = scene->gid_start = scene->gid = NULL;
     scene->explicit_slot = scene->arr_dropped = NULL;
