@@ -163,9 +163,9 @@ static bool resize_points(const mci_ctx *ctx, mci_face_arr *arr, size_t capacity
     if (arr->point_count) { /* the first block has nothing to copy (and memcpy no NULL) */
         memcpy(points, arr->points, arr->point_count * sizeof *points);
         memcpy(lines, arr->lines, arr->point_count * sizeof *lines);
-    }
-    if (arr->point_count) /* locations, and the appended points' known ones */
+        /* locations, and the appended points' known ones */
         memcpy(where, arr->where, arr->point_count * sizeof *where);
+    }
     mci_free(ctx, arr->points);
     arr->points = points;
     arr->lines = lines;
@@ -568,8 +568,9 @@ static uint8_t locate_in_face(const mci_face_arr *arr, const mci_point *p)
 }
 
 /* MCI_AT_* of the points whose location is not known yet (after a merge: the points
- * added since the previous one; a location depends on the point alone, not on which of
- * its copies is stored, so the others kept theirs). */
+ * added since the previous one and not given with their location; a location depends
+ * on the point alone, not on which of its copies is stored, so the others kept theirs).
+ * Debug builds check the given locations too. */
 static mcsg_status locate_new_points(mci_face_arr *arr, mcsg_error *err)
 {
     uint8_t *where = arr->where;
@@ -584,6 +585,12 @@ static mcsg_status locate_new_points(mci_face_arr *arr, mcsg_error *err)
             return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: a point is off "
                             "the face", arr->face);
     }
+#ifndef NDEBUG
+    for (size_t i = 3; i < arr->point_count; i++)
+        if (where[i] != locate_in_face(arr, arr->points[i]))
+            return mci_fail(err, MCSG_ERR_INTERNAL, "arrangement of face %u: point %zu was "
+                            "given at the wrong place", arr->face, i);
+#endif
     return MCSG_OK;
 }
 

@@ -67,7 +67,8 @@ typedef struct mci_face_arr {
     const mci_point **points;
     mci_point_pool *own;
     mci_point_lines *lines; /* per point */
-    uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge */
+    uint8_t *where;      /* MCI_AT_* per point, after mci_arr_merge; between merges,
+                            appended points' known locations or MCI_AT_UNKNOWN */
     mci_arr_segment *segments;
     mci_arr_edge *edges; /* after mci_arr_split: sorted by (a, b, other) */
     double (*aux)[3];    /* auxiliary vertices (stable: points refer to them); NULL

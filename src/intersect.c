@@ -13,7 +13,7 @@
 #include <string.h>
 
 /* A hit keeps its end points compactly: an input vertex (most contacts of meshes that
- * share vertices or faces) as its address, other points in the list's point store. A
+ * share vertices or faces) as its address, other points in the point stores. A
  * full point is ~190 bytes; bunny ∩ bunny has 375K hits, nearly all at vertices. */
 typedef struct pair_hit {
     uint32_t f, g;
@@ -151,8 +151,6 @@ typedef struct pair_job {
     pair_chunk *chunks;
 } pair_job;
 
-/* Every coplanar pair is kept, touching or not: faces that only share an edge still
- * exchange the points on it. */
 /* The lists cut to their contents. */
 static bool trim_hits(const mci_ctx *ctx, hit_list *h)
 {
@@ -170,6 +168,8 @@ static bool trim_hits(const mci_ctx *ctx, hit_list *h)
     return points != NULL;
 }
 
+/* Every coplanar pair is kept, touching or not: faces that only share an edge still
+ * exchange the points on it. */
 static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     pair_job *j = user;
@@ -179,7 +179,8 @@ static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
     hit_list *h = &c->hits;
     /* Room for a hit per pair and two ends each, trimmed after: growing by doubling
      * copied every chunk's points about twice (1% of ring-800's instructions), and
-     * room never written takes no memory. */
+     * room never written takes no memory from the system allocator (an allocator
+     * that counts bytes sees up to 1.4 MB more per thread until the trim). */
     if (!mci_grow_array(j->ctx, (void **)&h->v, &h->capacity, pairs, sizeof *h->v, 1) ||
         !mci_grow_array(j->ctx, (void **)&h->points, &h->point_capacity, 2 * pairs,
                         sizeof *h->points, 1))
@@ -209,12 +210,8 @@ static uint64_t definition_hash(const mci_point *p)
     return h;
 }
 
-/* Pair tests of the two faces along an edge with a third face build the same
- * edge-plane point (one definition, so one value): the first copy is kept, since the
- * arrangements refer to these points until the result is assembled. On entry the hits'
- * stored ends are numbered across the blocks (block c from first[c]); on return they
- * point to their points, each block cut to the points it keeps. False when out of
- * memory. */
+/* Copies of the pair tests' points (merge_hit_copies), by their number across the
+ * blocks. */
 typedef struct hit_copies {
     mci_point **at;     /* by number: the point */
     uint32_t *rep;      /* by number: the number of the first copy */
@@ -259,6 +256,12 @@ static bool compact_blocks(const mci_ctx *ctx, hit_list *hits, const size_t *fir
     return true;
 }
 
+/* Pair tests of the two faces along an edge with a third face build the same
+ * edge-plane point (one definition, so one value): the first copy is kept, since the
+ * arrangements refer to these points until the result is assembled. On entry the hits'
+ * stored ends are numbered across the blocks (block b from first[b]); on return they
+ * point to their points, each block cut to the points it keeps. False when out of
+ * memory. */
 static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits, const size_t *first)
 {
     size_t n = hits->point_count;
@@ -1101,7 +1104,7 @@ static void free_hits(const mci_ctx *ctx, hit_list *hits)
 
 /* Consumes the hits and the plane cache: both are freed as soon as the faces have taken
  * their records, before the arrangements grow (splitting, edge points), except the
- * hits' point store, which moves to the scene (the arrangements refer to it). */
+ * hits' point blocks, which move to the scene (the arrangements refer to them). */
 static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list *hits,
                                       plane_cache *planes, mcsg_error *err)
 {

@@ -20,10 +20,12 @@ typedef struct mci_scene {
     mci_face_arr *arrs;       /* in increasing face order */
     /* The points the arrangements refer to, besides their own pools: the pair tests'
      * (segment ends and contact points not at a vertex; a block per chunk of pairs)
-     * and one per vertex of an arranged face (see intersect.c). Arrangements refer to each other's pools too
-     * (shared edge points): a scene's arrangements are freed together. */
-    mci_point **hit_blocks, *vertex_points;
+     * and one per vertex of an arranged face (see intersect.c). Arrangements refer to
+     * each other's pools too (shared edge points): a scene's arrangements are freed
+     * together. */
+    mci_point **hit_blocks;
     size_t hit_block_count;
+    mci_point *vertex_points;
     size_t arr_count;
     /* Global identity (mci_scene_number_points): gid[gid_start[k] + i] numbers point
      * i of arrs[k]; equal points have equal numbers, across all faces. */
