@@ -756,16 +756,19 @@ typedef struct arrange_job {
     const vertex_table *vt;
 } arrange_job;
 
-/* Where an end of a crossing flagged in mci_tt_result.strict_ends lies in face f: an
- * edge line of f lies strictly inside that edge, any other strictly inside f. */
-static uint8_t strict_end_location(const mci_scene *s, uint32_t f, const mci_point *p)
+/* Where an end of a crossing lies in face f, when the pair test knows: an edge line of f
+ * meets the other plane strictly inside that edge (the pair test builds such points
+ * only for edges whose ends lie strictly on both sides), and an end flagged in
+ * mci_tt_result.strict_ends lies strictly inside f. */
+static uint8_t end_location(const mci_scene *s, uint32_t f, const mci_point *p,
+                            bool strictly_inside)
 {
-    for (int e = 0; e < 3; e++) {
+    for (int e = 0; p->kind == MCI_POINT_LPI && e < 3; e++) {
         const double *u = mci_scene_corner(s, f, e), *w = mci_scene_corner(s, f, (e + 1) % 3);
         if ((p->v[0] == u && p->v[1] == w) || (p->v[0] == w && p->v[1] == u))
             return (uint8_t)(MCI_AT_EDGE + e);
     }
-    return MCI_AT_INSIDE;
+    return strictly_inside ? MCI_AT_INSIDE : MCI_AT_UNKNOWN;
 }
 
 static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
@@ -782,8 +785,8 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
         b = a ? hit_end(j->ctx, s, j->vt, arr, h, 1) : NULL;
         if (!b)
             return false;
-        where[0] = h->strict_ends & 1 ? strict_end_location(s, arr->face, a) : MCI_AT_UNKNOWN;
-        where[1] = h->strict_ends & 2 ? strict_end_location(s, arr->face, b) : MCI_AT_UNKNOWN;
+        where[0] = end_location(s, arr->face, a, h->strict_ends & 1);
+        where[1] = end_location(s, arr->face, b, h->strict_ends & 2);
         return mci_arr_add_crossing(j->ctx, arr, a, b, other, plane, j->ff->plane_rep[other],
                                     s->octree.face_leaf[other],
                                     h->along_edge[h->f == arr->face ? 1 : 0], where);
