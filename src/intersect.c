@@ -234,13 +234,19 @@ static void find_first_copies(hit_copies *c, size_t n)
     }
 }
 
+/* The end of block b's numbers (block b holds first[b] ..). */
+static size_t block_end(const hit_list *hits, const size_t *first, size_t b)
+{
+    return b + 1 < hits->block_count ? first[b + 1] : hits->point_count;
+}
+
 /* Each block keeps its first copies, in order, and is cut to them; at[] then gives
  * every first copy's final place. */
 static bool compact_blocks(const mci_ctx *ctx, hit_list *hits, const size_t *first,
                            hit_copies *c)
 {
     for (size_t b = 0; b < hits->block_count; b++) {
-        size_t end = b + 1 < hits->block_count ? first[b + 1] : hits->point_count, kept = 0;
+        size_t end = block_end(hits, first, b), kept = 0;
         mci_point *fit;
         for (size_t i = first[b]; i < end; i++)
             if (c->rep[i] == i)
@@ -272,11 +278,9 @@ static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits, const size_t *f
     c.rep = mci_malloc_array(ctx, n + c.size, sizeof *c.rep);
     c.bucket = c.rep ? c.rep + n : NULL;
     ok = c.at && c.rep;
-    for (size_t b = 0; ok && b < hits->block_count; b++) {
-        size_t end = b + 1 < hits->block_count ? first[b + 1] : n;
-        for (size_t i = first[b]; i < end; i++)
+    for (size_t b = 0; ok && b < hits->block_count; b++)
+        for (size_t i = first[b]; i < block_end(hits, first, b); i++)
             c.at[i] = &hits->blocks[b][i - first[b]];
-    }
     if (ok) {
         find_first_copies(&c, n);
         ok = compact_blocks(ctx, hits, first, &c);
@@ -702,10 +706,12 @@ static bool build_vertex_table(const mci_ctx *ctx, const mci_scene *s, const uin
         }
     if (!(vt->points = mci_malloc_array(ctx, n + 1, sizeof *vt->points)))
         return false;
+    /* The same walk meets each vertex first in slot order: each point is built once. */
+    n = 0;
     for (size_t a = 0; a < s->arr_count; a++)
         for (int k = 0; k < 3; k++)
-            mci_point_explicit(&vt->points[vt->slot[corner_vertex_id(s, vt, face_of[a], k)] - 1],
-                               mci_scene_corner(s, face_of[a], k));
+            if (vt->slot[corner_vertex_id(s, vt, face_of[a], k)] == n + 1)
+                mci_point_explicit(&vt->points[n++], mci_scene_corner(s, face_of[a], k));
     return true;
 }
 
