@@ -86,11 +86,42 @@ static inline dd dd_sub(dd x, dd y)
     return dd_add(x, dd_neg(y));
 }
 
+#ifndef FP_FAST_FMA
+/* a = hi + lo with halves of at most 26 significant bits (Veltkamp's split); an
+ * overflow of the scaled value makes both parts NaN. */
+static inline double split(double a, double *lo)
+{
+    double scaled = 134217729.0 * a, hi = scaled - (scaled - a);
+    *lo = a - hi;
+    return hi;
+}
+
+/* a b = p + *err exactly, barring underflow and overflow (Dekker's product). */
+static inline double two_prod(double a, double b, double *err)
+{
+    double p = a * b, al, bl, ah = split(a, &al), bh = split(b, &bl);
+    *err = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    return p;
+}
+#endif
+
+/* Where fma is a call rather than an instruction (x86-64 without -mfma), the exact
+ * product comes from Dekker's algorithm and the cross terms are rounded separately:
+ * the error is then at most u^2 (x.lo y.lo, dropped) + 2u^2 (the two cross products) +
+ * u^2 (their sum added to the exact product's tail) + O(u^3), below 5u^2 of the result,
+ * where DD_REL_MUL charges 32u^2; under underflow each of the two dozen operations
+ * loses at most 2^-1074 (Dekker's product at most 3.5 times that), within
+ * DD_UNDERFLOW. Either way the signs and roundings decided are the exact ones. */
 static inline dd dd_mul(dd x, dd y)
 {
+    dd r;
+#ifdef FP_FAST_FMA
     double ch = x.hi * y.hi, cl1 = fma(x.hi, y.hi, -ch);
     double tl1 = fma(x.hi, y.lo, x.lo * y.lo), cl2 = fma(x.lo, y.hi, tl1);
-    dd r;
+#else
+    double cl1, ch = two_prod(x.hi, y.hi, &cl1);
+    double cl2 = x.hi * y.lo + x.lo * y.hi;
+#endif
     r.hi = fast_two_sum(ch, cl1 + cl2, &r.lo);
     r.e = magnitude(x) * y.e + magnitude(y) * x.e + x.e * y.e + DD_REL_MUL * magnitude(r) +
           DD_UNDERFLOW;
