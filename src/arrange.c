@@ -868,7 +868,7 @@ static void item_bounds(const mci_face_arr *arr, const double face_lo[2],
     mci_point_bounds(p, lo, hi);
     for (int k = 0; k < 2; k++) {
         int axis = (arr->axis + 1 + k) % 3;
-        double l = fmax(lo[axis], face_lo[k]), h = fmin(hi[axis], face_hi[k]);
+        double l = mci_max(lo[axis], face_lo[k]), h = mci_min(hi[axis], face_hi[k]);
         it->lo[k] = first || l < it->lo[k] ? l : it->lo[k];
         it->hi[k] = first || h > it->hi[k] ? h : it->hi[k];
     }
@@ -907,8 +907,8 @@ static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size
     memset(is_end, 0, arr->point_count * sizeof *is_end);
     for (int k = 0; k < 2; k++) {
         int axis = (arr->axis + 1 + k) % 3;
-        face_lo[k] = fmin(fmin(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
-        face_hi[k] = fmax(fmax(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
+        face_lo[k] = mci_min(mci_min(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
+        face_hi[k] = mci_max(mci_max(arr->plane.a[axis], arr->plane.b[axis]), arr->plane.c[axis]);
     }
     for (size_t s = 0; s < arr->segment_count; s++, n++) {
         const mci_arr_segment *seg = &arr->segments[s];

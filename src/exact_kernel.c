@@ -272,7 +272,7 @@ static void compute_bounds(const mci_point *p, double lo[3], double hi[3])
          * operations (relative) and underflow (absolute). */
         ql = yl >= 0 ? yl * inv_wh : yl * inv_wl;
         qh = yh >= 0 ? yh * inv_wl : yh * inv_wh;
-        slack = 0x1p-48 * (fabs(base) + fmax(fabs(ql), fabs(qh))) + 0x1p-1060;
+        slack = 0x1p-48 * (fabs(base) + mci_max(fabs(ql), fabs(qh))) + 0x1p-1060;
         lo[k] = base + ql - slack;
         hi[k] = base + qh + slack;
         if (!(wl > 0) || !(lo[k] <= hi[k])) {
@@ -293,9 +293,9 @@ static void set_box(mci_point *p, const double exact[3], unsigned exact_axes)
     for (int k = 0; k < 3; k++) {
         double c = lo[k] / 2 + hi[k] / 2;
         /* |c - lo|, |hi - c| <= (hi - lo) / 2 up to the rounding of c and the halving */
-        double r = fmax(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070;
+        double r = mci_max(hi[k] - c, c - lo[k]) * (1 + 0x1p-50) + 0x1p-1070;
         p->c[k] = isfinite(c) ? c : 0;
-        p->r = fmax(p->r, isfinite(c) && isfinite(r) ? r : INFINITY);
+        p->r = mci_max(p->r, isfinite(c) && isfinite(r) ? r : INFINITY);
     }
     p->exact_axes = (uint8_t)exact_axes;
     for (int k = 0; k < 3; k++)
@@ -458,7 +458,8 @@ static bool round_filtered(const mci_point *p, int k, double *out, double *guess
     *guess = hi;
     bv = hi - base;
     lo = (base - (hi - bv)) + (q - bv);
-    gap = fmin(mci_next_up(hi) - hi, hi - mci_next_down(hi)) / 2;
+    /* NaN only when hi is not finite, which the test below rejects first. */
+    gap = mci_min(mci_next_up(hi) - hi, hi - mci_next_down(hi)) / 2;
     if (!isfinite(hi) || !(fabs(hi) >= 0x1p-900) || !((fabs(lo) + err) * (1 + 0x1p-50) < gap))
         return false;
     *out = hi;

@@ -51,6 +51,19 @@ static inline double mci_next_down(double x)
     return -mci_next_up(-x);
 }
 
+/* The larger and the smaller of two doubles, inline: fmax and fmin are library calls,
+ * and each spilled the live doubles. Unlike those they return y when either is NaN;
+ * callers use them where no operand can be NaN, or where a NaN result is as safe. */
+static inline double mci_max(double x, double y)
+{
+    return x > y ? x : y;
+}
+
+static inline double mci_min(double x, double y)
+{
+    return x < y ? x : y;
+}
+
 /* A value known to within an error bound: |exact - v| <= e. After an overflow e (and
  * v) may be +inf or NaN, which carries no information: every sign test fails on it and
  * the exact stage decides. */

@@ -193,20 +193,11 @@ static bool split_points(const mci_cell *cell, double mid[3])
     return true;
 }
 
-/* Inline maximum and minimum (fmax and fmin are library calls). They differ from those
- * only on NaN, which overflow on extreme coordinates can produce; a NaN bound or value
- * makes a "misses" test below false, which keeps the face: still conservative. */
-static double max_of(double x, double y)
-{
-    return x > y ? x : y;
-}
-
-static double min_of(double x, double y)
-{
-    return x < y ? x : y;
-}
-
-/* Whether the triangle's plane provably misses the box: the box corners extreme along
+/* mci_max and mci_min differ from fmax and fmin only on NaN, which overflow on extreme
+ * coordinates can produce; a NaN bound or value makes a "misses" test below false, which
+ * keeps the face: still conservative.
+ *
+ * Whether the triangle's plane provably misses the box: the box corners extreme along
  * the normal, evaluated in doubles, are both strictly on one side by more than a bound
  * on the rounding error (differences, the cross product and the dot product each add at
  * most a few units of 2^-53 relative to the sums of absolute terms; 1e-14 covers them
@@ -226,7 +217,7 @@ static bool plane_misses_box(const double *a, const double *b, const double *c,
         double to_lo = lo[k] - a[k], to_hi = hi[k] - a[k];
         lowest += n * (n > 0 ? to_lo : to_hi);
         highest += n * (n > 0 ? to_hi : to_lo);
-        bound += n_abs * max_of(fabs(to_lo), fabs(to_hi));
+        bound += n_abs * mci_max(fabs(to_lo), fabs(to_hi));
     }
     bound = bound * 1e-14 + 1e-300;
     return lowest > bound || highest < -bound;
@@ -244,10 +235,10 @@ static bool edge_axis_misses_box(const double *p, const double *q, const double 
     double lo_j = lo[j] - p[j], hi_j = hi[j] - p[j], lo_i = lo[i] - p[i], hi_i = hi[i] - p[i];
     double f_lo = ei * (ei > 0 ? lo_j : hi_j) - ej * (ej > 0 ? hi_i : lo_i);
     double f_hi = ei * (ei > 0 ? hi_j : lo_j) - ej * (ej > 0 ? lo_i : hi_i);
-    double bound = fabs(ei) * (max_of(fabs(lo_j), fabs(hi_j)) + fabs(r[j] - p[j])) +
-                   fabs(ej) * (max_of(fabs(lo_i), fabs(hi_i)) + fabs(r[i] - p[i]));
+    double bound = fabs(ei) * (mci_max(fabs(lo_j), fabs(hi_j)) + fabs(r[j] - p[j])) +
+                   fabs(ej) * (mci_max(fabs(lo_i), fabs(hi_i)) + fabs(r[i] - p[i]));
     bound = bound * 1e-14 + 1e-300;
-    return f_lo > max_of(0, fr) + bound || f_hi < min_of(0, fr) - bound;
+    return f_lo > mci_max(0, fr) + bound || f_hi < mci_min(0, fr) - bound;
 }
 
 static bool triangle_misses_box(const double *const v[3], const double lo[3],
@@ -301,20 +292,20 @@ typedef struct box_job {
  * random, and mispredicted branches made this pass cost more than it saved. */
 static float float_below(double x)
 {
-    return (float)min_of(x - fabs(x) * 0x1p-23 - 0x1p-149, FLT_MAX);
+    return (float)mci_min(x - fabs(x) * 0x1p-23 - 0x1p-149, FLT_MAX);
 }
 
 static float float_above(double x)
 {
-    return (float)max_of(x + fabs(x) * 0x1p-23 + 0x1p-149, -FLT_MAX);
+    return (float)mci_max(x + fabs(x) * 0x1p-23 + 0x1p-149, -FLT_MAX);
 }
 
 /* The face's box in doubles, from its corners. */
 static void exact_box(const double *const v[3], double box[6])
 {
     for (int k = 0; k < 3; k++) {
-        box[k] = min_of(min_of(v[0][k], v[1][k]), v[2][k]);
-        box[3 + k] = max_of(max_of(v[0][k], v[1][k]), v[2][k]);
+        box[k] = mci_min(mci_min(v[0][k], v[1][k]), v[2][k]);
+        box[3 + k] = mci_max(mci_max(v[0][k], v[1][k]), v[2][k]);
     }
 }
 
