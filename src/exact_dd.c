@@ -178,6 +178,19 @@ static void dd_cross(const dd a[3], const dd b[3], dd out[3])
     }
 }
 
+int mci_orient3d_vertices_dd(const double *a, const double *b, const double *c,
+                             const double *d)
+{
+    dd d1[3], d2[3], to_d[3], n[3];
+    for (int k = 0; k < 3; k++) {
+        d1[k] = dd_diff(b[k], a[k]);
+        d2[k] = dd_diff(c[k], a[k]);
+        to_d[k] = dd_diff(d[k], a[k]);
+    }
+    dd_cross(d1, d2, n);
+    return dd_sign(dd_dot(n, to_d));
+}
+
 /* TPI of planes (v[0], v[1], v[2]), (v[3], v[4], v[5]), (v[6], v[7], v[8]): with normals
  * n_i and s_i = n_i.(a_i - origin) (a_i the plane's first vertex), the offset from the
  * origin is (s_0 n_1 x n_2 + s_1 n_2 x n_0 + s_2 n_0 x n_1) / W, W = n_0.(n_1 x n_2)

@@ -599,6 +599,8 @@ int mci_orient3d_vertex(const double *x, const mci_plane *plane)
         same_coordinates(x, plane->c))
         return 0;
     s = mci_orient3d_vertex_filtered(x, plane);
+    if (s == MCI_UNCERTAIN)
+        s = mci_orient3d_vertices_dd(plane->a, plane->b, plane->c, x);
     if (s == MCI_UNCERTAIN) {
         mci_point p;
         mci_point_explicit(&p, x);
@@ -637,6 +639,8 @@ int mci_orient3d_vertices_filtered(const double *a, const double *b, const doubl
 int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d)
 {
     int s = mci_orient3d_vertices_filtered(a, b, c, d);
+    if (s == MCI_UNCERTAIN)
+        s = mci_orient3d_vertices_dd(a, b, c, d);
     if (s == MCI_UNCERTAIN) {
         mci_plane plane;
         mci_point p;

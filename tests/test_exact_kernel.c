@@ -1163,7 +1163,20 @@ static void check_orient2d_dd(const scenario *s, const query *q, int filtered, i
 
 /* The vertex forms of orient3d (an input vertex against a plane, and against the plane
  * of three input vertices): full predicate equal to the reference, filter never wrong. */
-static long vertex_filter_cases, vertex_filter_decided;
+static long vertex_filter_cases, vertex_filter_decided, vertex_dd_cases, vertex_dd_decided;
+
+/* The double-double stage between them: a sign it gives must be the reference's. */
+static void check_orient3d_vertex_dd(const scenario *s, const mci_plane *p, const double *x,
+                                     int filtered, int ref)
+{
+    int got = mci_orient3d_vertices_dd(p->a, p->b, p->c, x);
+    CHECK_MSG(got == MCI_UNCERTAIN || got == ref, "mci_orient3d_vertices_dd (%s): %d, "
+              "reference %d", class_names[s->cls], got, ref);
+    if (filtered == MCI_UNCERTAIN) {
+        vertex_dd_cases++;
+        vertex_dd_decided += got != MCI_UNCERTAIN;
+    }
+}
 
 static void check_orient3d_vertex(const scenario *s, const query *q, int ref)
 {
@@ -1183,6 +1196,7 @@ static void check_orient3d_vertex(const scenario *s, const query *q, int ref)
               "reference %d", class_names[s->cls], f1, ref);
     CHECK_MSG(f2 == MCI_UNCERTAIN || f2 == ref, "mci_orient3d_vertices_filtered (%s): %d, "
               "reference %d", class_names[s->cls], f2, ref);
+    check_orient3d_vertex_dd(s, p, x, f2, ref);
     vertex_filter_cases += 2;
     vertex_filter_decided += (f1 != MCI_UNCERTAIN) + (f2 != MCI_UNCERTAIN);
 }
@@ -1857,6 +1871,8 @@ static void print_predicate_table(void)
            dd_after_filter, dd_decided);
     printf("orient3d of input vertices: %ld filter cases, %ld decided by the filter\n",
            vertex_filter_cases, vertex_filter_decided);
+    printf("orient3d of input vertices the filter left: %ld, double-double stage decided %ld\n",
+           vertex_dd_cases, vertex_dd_decided);
     printf("implicit point boxes: %ld, infinite %ld, tight (1e-10) %ld\n\n", box_points,
            box_infinite, box_tight);
 }
