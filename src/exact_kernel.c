@@ -589,6 +589,40 @@ int mci_orient3d_vertex_filtered(const double *x, const mci_plane *plane)
     return filter_sign(value, bound);
 }
 
+static bool same_projection(const double *p, const double *q, int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    return p[i] == q[i] && p[j] == q[j];
+}
+
+/* Whether four input vertices are coplanar by their coordinates alone: they share a
+ * coordinate (a cap, a box's face), or along some axis they project to at most two
+ * points (they lie on at most two lines parallel to the axis: a cylinder's side, an
+ * extrusion's wall). The filters cannot decide these zeros, and the exact stage costs
+ * thousands of instructions each (cylinder_28_holes: 9,596 crease tests). */
+static bool coplanar_by_coordinates(const double *a, const double *b, const double *c,
+                                    const double *d)
+{
+    const double *v[4] = {a, b, c, d};
+    for (int k = 0; k < 3; k++) {
+        const double *second = NULL;
+        bool two = true;
+        if (a[k] == b[k] && a[k] == c[k] && a[k] == d[k])
+            return true;
+        for (int i = 1; i < 4 && two; i++) {
+            if (same_projection(v[i], a, k))
+                continue;
+            if (!second)
+                second = v[i];
+            else
+                two = same_projection(v[i], second, k);
+        }
+        if (two)
+            return true;
+    }
+    return false;
+}
+
 /* The same predicate for an input vertex, without building a point. A vertex equal to
  * one that defines the plane lies on it: the common case of shared and duplicated
  * vertices (identical operands), which the filter cannot decide (the value is 0). */
@@ -599,6 +633,8 @@ int mci_orient3d_vertex(const double *x, const mci_plane *plane)
         same_coordinates(x, plane->c))
         return 0;
     s = mci_orient3d_vertex_filtered(x, plane);
+    if (s == MCI_UNCERTAIN && coplanar_by_coordinates(plane->a, plane->b, plane->c, x))
+        return 0;
     if (s == MCI_UNCERTAIN)
         s = mci_orient3d_vertices_dd(plane->a, plane->b, plane->c, x);
     if (s == MCI_UNCERTAIN) {
@@ -639,6 +675,8 @@ int mci_orient3d_vertices_filtered(const double *a, const double *b, const doubl
 int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d)
 {
     int s = mci_orient3d_vertices_filtered(a, b, c, d);
+    if (s == MCI_UNCERTAIN && coplanar_by_coordinates(a, b, c, d))
+        return 0;
     if (s == MCI_UNCERTAIN)
         s = mci_orient3d_vertices_dd(a, b, c, d);
     if (s == MCI_UNCERTAIN) {

@@ -1932,6 +1932,89 @@ TEST(bit_range)
     }
 }
 
+/* Exact det[b - a, c - a, d - a] of four doubles, by rationals. */
+static int ref_orient3d_doubles(const double *a, const double *b, const double *c,
+                                const double *d)
+{
+    const double *v[3] = {b, c, d};
+    mpq_t r[3][3], t, u, det;
+    int sign;
+    mpq_inits(t, u, det, NULL);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            mpq_init(r[i][k]);
+            mpq_set_d(r[i][k], v[i][k]);
+            mpq_set_d(t, a[k]);
+            mpq_sub(r[i][k], r[i][k], t);
+        }
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        mpq_mul(t, r[1][i], r[2][j]);
+        mpq_mul(u, r[1][j], r[2][i]);
+        mpq_sub(t, t, u);
+        mpq_mul(t, t, r[0][k]);
+        mpq_add(det, det, t);
+    }
+    sign = mpq_sgn(det);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            mpq_clear(r[i][k]);
+    mpq_clears(t, u, det, NULL);
+    return sign;
+}
+
+/* Four vertices in every order, against the reference, through both vertex forms. */
+static void check_four_vertices(const double *const q[4], long *zeros)
+{
+    for (int r = 0; r < 4; r++) {
+        const double *a = q[r], *b = q[(r + 1) % 4], *c = q[(r + 2) % 4], *d = q[(r + 3) % 4];
+        int ref = ref_orient3d_doubles(a, b, c, d);
+        mci_plane plane;
+        mci_plane_init(&plane, a, b, c);
+        CHECK_MSG(mci_orient3d_vertices(a, b, c, d) == ref, "mci_orient3d_vertices: ref %d",
+                  ref);
+        CHECK_MSG(mci_orient3d_vertex(d, &plane) == ref, "mci_orient3d_vertex: ref %d", ref);
+        *zeros += ref == 0;
+    }
+}
+
+/* The shapes the coordinate rule and the double-word stage of orient3d of vertices are
+ * for: a cylinder's side rectangle and cap (coplanar by their coordinates, which no
+ * filter decides), a UV sphere's quad (nearly coplanar after rounding), and each with one
+ * coordinate moved by an ulp (then the answer is not 0 for the rule's shapes). */
+TEST(vertex_orient3d_shapes)
+{
+    long zeros = 0, cases = 0;
+    for (int i = 0; i < 20000; i++) {
+        double t1 = rng_unit() * 6.283185307179586, t2 = t1 + 0.01 + rng_unit() * 0.5;
+        double p1 = rng_unit() * 3.14159, p2 = p1 + 0.01 + rng_unit() * 0.3;
+        double rad = ldexp(0.5 + rng_unit(), rng_int(-30, 30)), z0 = rng_unit() * rad,
+               z1 = z0 + rad * (0.1 + rng_unit());
+        double side[4][3] = {{rad * cos(t1), rad * sin(t1), z0}, {rad * cos(t2), rad * sin(t2), z0},
+                             {rad * cos(t2), rad * sin(t2), z1}, {rad * cos(t1), rad * sin(t1), z1}};
+        double cap[4][3] = {{0, 0, z0}, {rad * cos(t1), rad * sin(t1), z0},
+                            {rad * cos(t2), rad * sin(t2), z0}, {rad * cos(p2), rad * sin(p1), z0}};
+        double quad[4][3];
+        double (*shapes[3])[3] = {side, cap, quad};
+        for (int k = 0; k < 4; k++) {
+            double t = k == 0 || k == 3 ? t1 : t2, p = k < 2 ? p1 : p2;
+            quad[k][0] = rad * cos(t) * sin(p);
+            quad[k][1] = rad * sin(t) * sin(p);
+            quad[k][2] = rad * cos(p);
+        }
+        for (int sh = 0; sh < 3; sh++) {
+            const double *q[4] = {shapes[sh][0], shapes[sh][1], shapes[sh][2], shapes[sh][3]};
+            int v = rng_int(0, 3), axis = rng_int(0, 2);
+            check_four_vertices(q, &zeros);
+            shapes[sh][v][axis] = mci_next_up(shapes[sh][v][axis]);
+            check_four_vertices(q, &zeros);
+            cases += 8;
+        }
+    }
+    printf("vertex orient3d shapes: %ld cases, %ld coplanar\n", cases, zeros);
+    CHECK(zeros > cases / 4); /* the rule's shapes were there */
+}
+
 int main(void)
 {
     const char *seed = getenv("MCSG_TEST_SEED");
@@ -1941,6 +2024,7 @@ int main(void)
     ws_init();
     RUN(next_double);
     RUN(bit_range);
+    RUN(vertex_orient3d_shapes);
     RUN(reference_sanity);
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);
