@@ -623,6 +623,21 @@ static bool coplanar_by_coordinates(const double *a, const double *b, const doub
     return false;
 }
 
+/* The stages after the double filter for an input vertex against the plane of three:
+ * the coordinate rule, the double-word stage, then exact. */
+static int orient3d_vertex_beyond_filter(const double *x, const mci_plane *plane)
+{
+    int s;
+    mci_point p;
+    if (coplanar_by_coordinates(plane->a, plane->b, plane->c, x))
+        return 0;
+    s = mci_orient3d_vertices_dd(plane->a, plane->b, plane->c, x);
+    if (s != MCI_UNCERTAIN)
+        return s;
+    mci_point_explicit(&p, x);
+    return mci_orient3d_exact(&p, plane);
+}
+
 /* The same predicate for an input vertex, without building a point. A vertex equal to
  * one that defines the plane lies on it: the common case of shared and duplicated
  * vertices (identical operands), which the filter cannot decide (the value is 0). */
@@ -633,16 +648,7 @@ int mci_orient3d_vertex(const double *x, const mci_plane *plane)
         same_coordinates(x, plane->c))
         return 0;
     s = mci_orient3d_vertex_filtered(x, plane);
-    if (s == MCI_UNCERTAIN && coplanar_by_coordinates(plane->a, plane->b, plane->c, x))
-        return 0;
-    if (s == MCI_UNCERTAIN)
-        s = mci_orient3d_vertices_dd(plane->a, plane->b, plane->c, x);
-    if (s == MCI_UNCERTAIN) {
-        mci_point p;
-        mci_point_explicit(&p, x);
-        s = mci_orient3d_exact(&p, plane);
-    }
-    return s;
+    return s != MCI_UNCERTAIN ? s : orient3d_vertex_beyond_filter(x, plane);
 }
 
 /* det[b - a, c - a, d - a] in doubles with Shewchuk's bound for orient3d (errboundA =
@@ -675,18 +681,11 @@ int mci_orient3d_vertices_filtered(const double *a, const double *b, const doubl
 int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d)
 {
     int s = mci_orient3d_vertices_filtered(a, b, c, d);
-    if (s == MCI_UNCERTAIN && coplanar_by_coordinates(a, b, c, d))
-        return 0;
-    if (s == MCI_UNCERTAIN)
-        s = mci_orient3d_vertices_dd(a, b, c, d);
-    if (s == MCI_UNCERTAIN) {
-        mci_plane plane;
-        mci_point p;
-        mci_plane_init(&plane, a, b, c);
-        mci_point_explicit(&p, d);
-        s = mci_orient3d_exact(&p, &plane);
-    }
-    return s;
+    mci_plane plane;
+    if (s != MCI_UNCERTAIN)
+        return s;
+    mci_plane_init(&plane, a, b, c);
+    return orient3d_vertex_beyond_filter(d, &plane);
 }
 
 /* ---------------------------------------------------------------------------------- */

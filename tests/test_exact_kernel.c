@@ -1990,8 +1990,10 @@ TEST(vertex_orient3d_shapes)
         double p1 = rng_unit() * 3.14159, p2 = p1 + 0.01 + rng_unit() * 0.3;
         double rad = ldexp(0.5 + rng_unit(), rng_int(-30, 30)), z0 = rng_unit() * rad,
                z1 = z0 + rad * (0.1 + rng_unit());
-        double side[4][3] = {{rad * cos(t1), rad * sin(t1), z0}, {rad * cos(t2), rad * sin(t2), z0},
-                             {rad * cos(t2), rad * sin(t2), z1}, {rad * cos(t1), rad * sin(t1), z1}};
+        double side[4][3] = {{rad * cos(t1), rad * sin(t1), z0},
+                             {rad * cos(t2), rad * sin(t2), z0},
+                             {rad * cos(t2), rad * sin(t2), z1},
+                             {rad * cos(t1), rad * sin(t1), z1}};
         double cap[4][3] = {{0, 0, z0}, {rad * cos(t1), rad * sin(t1), z0},
                             {rad * cos(t2), rad * sin(t2), z0}, {rad * cos(p2), rad * sin(p1), z0}};
         double quad[4][3];
