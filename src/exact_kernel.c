@@ -777,16 +777,11 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
 /* First filter, on the cached boxes: for points close together but defined far away
  * (consecutive points of a curve, say) the homogeneous determinant's bound grows with
  * the distances to the defining vertices, while differences of the boxes stay small;
- * and it is a few operations instead of a 3x3 determinant. */
+ * and it is a few operations instead of a 3x3 determinant. Inline in exact_kernel.h
+ * (mci_orient2d_projected_quick), with its error bound. */
 static int orient2d_boxes(const mci_point *p, const mci_point *q, const mci_point *r, int axis)
 {
-    int i = (axis + 1) % 3, j = (axis + 2) % 3;
-    mci_fv d[2][2];
-    d[0][0] = fv_sub((mci_fv){q->c[i], q->r}, (mci_fv){p->c[i], p->r});
-    d[0][1] = fv_sub((mci_fv){q->c[j], q->r}, (mci_fv){p->c[j], p->r});
-    d[1][0] = fv_sub((mci_fv){r->c[i], r->r}, (mci_fv){p->c[i], p->r});
-    d[1][1] = fv_sub((mci_fv){r->c[j], r->r}, (mci_fv){p->c[j], p->r});
-    return fv_sign(fv_sub(fv_mul(d[0][0], d[1][1]), fv_mul(d[0][1], d[1][0])));
+    return mci_orient2d_projected_quick(p, q, r, axis);
 }
 
 /* Whether the projected coordinates of p are exact in the box (axes other than axis). */
@@ -821,12 +816,6 @@ static bool lpi_on_line(const mci_point *x, const mci_point *a, const mci_point 
            b->kind == MCI_POINT_EXPLICIT &&
            ((same_coordinates(x->v[0], a->v[0]) && same_coordinates(x->v[1], b->v[0])) ||
             (same_coordinates(x->v[0], b->v[0]) && same_coordinates(x->v[1], a->v[0])));
-}
-
-int mci_orient2d_projected_quick(const mci_point *p, const mci_point *q, const mci_point *r,
-                                 int axis)
-{
-    return orient2d_boxes(p, q, r, axis);
 }
 
 /* Collinear by definition: an exact zero, which only the slow exact stage could confirm

@@ -30,6 +30,9 @@
 #include <stdint.h>
 #include <string.h>
 
+/* What a filter stage returns when it cannot decide a sign. */
+#define MCI_UNCERTAIN 2
+
 /* nextafter(x, +INFINITY) and nextafter(x, -INFINITY), inline: certified boxes step
  * outward millions of times per evaluation and the library call dominated. Same results
  * for every input (NaN stays NaN, +-0 steps to +-2^-1074, -inf up to -DBL_MAX). */
@@ -159,9 +162,33 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
                            int axis);
 /* mci_orient2d_projected in two halves, for callers that know collinear cases of their
  * own (a face's lines): the first, a few operations on the cached boxes, decides most
- * calls (+1 or -1) and returns MCI_UNCERTAIN otherwise; the second decides the rest. */
-int mci_orient2d_projected_quick(const mci_point *p, const mci_point *q, const mci_point *r,
-                                 int axis);
+ * calls (+1 or -1) and returns MCI_UNCERTAIN otherwise; the second decides the rest.
+ * The first is inline: triangulation calls it millions of times.
+ *
+ * Its bound: each difference of centres is within e1 (q - p) or e2 (r - p) of the true
+ * difference, e = the two radii + u times the larger difference of its pair (the
+ * rounding of a subtraction is at most u times its result, and exact when subnormal).
+ * Then |AD - ad| <= m1 e2 + m2 e1 + e1 e2 for each product of the determinant, with m
+ * the larger difference of each pair; the products' rounding adds u m1 m2 + eta each,
+ * the final subtraction u |det|. The factor and the extra eta absorb the rounding of the
+ * bound's own few operations (all on nonnegative values; see exact_kernel.c). Overflow
+ * or NaN fails the comparison: uncertain. It never returns 0. */
+static inline int mci_orient2d_projected_quick(const mci_point *p, const mci_point *q,
+                                               const mci_point *r, int axis)
+{
+    const double u = 0x1p-53, eta = 0x1p-1074, safety = 1.0 + 0x1p-30;
+    int i = axis == 2 ? 0 : axis + 1, j = axis == 0 ? 2 : axis - 1;
+    double a = q->c[i] - p->c[i], b = q->c[j] - p->c[j];
+    double c = r->c[i] - p->c[i], d = r->c[j] - p->c[j];
+    double m1 = mci_max(fabs(a), fabs(b)), m2 = mci_max(fabs(c), fabs(d));
+    double e1 = p->r + q->r + u * m1, e2 = p->r + r->r + u * m2;
+    double det = a * d - b * c;
+    double bound = 2 * (m1 * e2 + m2 * e1 + e1 * e2) + 2 * u * (m1 * m2) + u * fabs(det) +
+                   8 * eta;
+    if (fabs(det) > bound * safety)
+        return det > 0 ? 1 : -1;
+    return MCI_UNCERTAIN;
+}
 int mci_orient2d_projected_rest(const mci_point *p, const mci_point *q, const mci_point *r,
                                 int axis);
 
@@ -220,8 +247,8 @@ void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);
  * the exact stage on every case, not only where the filter gives up) and benchmarks
  * (which measure how often the filter decides):
  *   *_filtered: the floating-point stage; returns the sign, or MCI_UNCERTAIN;
- *   *_exact:    the exact integer stage; always returns the sign. */
-#define MCI_UNCERTAIN 2
+ *   *_exact:    the exact integer stage; always returns the sign.
+ * (MCI_UNCERTAIN is defined above.) */
 
 int mci_orient3d_filtered(const mci_point *p, const mci_plane *plane);
 int mci_orient3d_vertex_filtered(const double *x, const mci_plane *plane);
