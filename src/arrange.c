@@ -24,6 +24,7 @@
  * unless their boxes overlap.
  */
 #include "arrange.h"
+#include "sort_template.h"
 #include "triangulate.h"
 
 #include <math.h>
@@ -614,8 +615,13 @@ static void sort_after_merge(const point_key *table, size_t merged, size_t n,
     memcpy(idx, tmp, n * sizeof *idx);
 }
 
+/* A point where a segment is cut (found by the splitter, consumed by build_edges). */
+typedef struct arr_cut {
+    uint32_t segment, point;
+} arr_cut;
+
 /* Merge; the `cut_count` cuts (segment, point) given get their point ids renumbered. */
-static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[2],
+static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, arr_cut *cuts,
                                 size_t cut_count, mcsg_error *err)
 {
     size_t n = arr->point_count, kept = 0;
@@ -669,7 +675,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, uint32_t 
         }
         arr->segment_count = out;
         for (size_t k = 0; k < cut_count; k++)
-            cuts[k][1] = remap[cuts[k][1]];
+            cuts[k].point = remap[cuts[k].point];
         memset(merged_where, MCI_AT_UNKNOWN, kept);
         for (size_t i = 0; i < before; i++)
             merged_where[remap[i]] = arr->where[i];
@@ -754,7 +760,7 @@ typedef struct sweep_item {
 typedef struct splitter {
     const mci_ctx *ctx;
     mci_face_arr *arr;
-    uint32_t (*cuts)[2]; /* (segment, point) */
+    arr_cut *cuts;
     size_t cut_count, cut_capacity;
     bool ok;
 } splitter;
@@ -766,8 +772,7 @@ static void cut(splitter *sp, uint32_t s, uint32_t p)
         sp->ok = false;
         return;
     }
-    sp->cuts[sp->cut_count][0] = s;
-    sp->cuts[sp->cut_count++][1] = p;
+    sp->cuts[sp->cut_count++] = (arr_cut){s, p};
 }
 
 /* Cut segment s at p if p, known to lie on its line, is strictly between its ends. */
@@ -882,16 +887,18 @@ static bool one_surface(const mci_face_arr *arr, uint32_t s, uint32_t t)
     return S->group == T->group && !S->on_edge && !T->on_edge;
 }
 
-static int compare_items(const void *x, const void *y)
+/* (lo[0], segments before points, id): a total order (ids are unique within each
+ * kind), so the unstable sort's result is unique. */
+static inline bool item_less(const sweep_item *a, const sweep_item *b)
 {
-    const sweep_item *a = x, *b = y;
     if (a->lo[0] != b->lo[0])
-        return a->lo[0] < b->lo[0] ? -1 : 1;
-    /* Deterministic order for equal keys. */
+        return a->lo[0] < b->lo[0];
     if (a->is_point != b->is_point)
-        return a->is_point ? 1 : -1;
-    return (a->id > b->id) - (a->id < b->id);
+        return b->is_point;
+    return a->id < b->id;
 }
+
+MCI_DEFINE_SORT(sort_items, sweep_item, item_less)
 
 /* Segments, and the points that are no segment's end (those are seen through their
  * segments). */
@@ -926,8 +933,7 @@ static sweep_item *sweep_items(const mci_ctx *ctx, const mci_face_arr *arr, size
         item_bounds(arr, face_lo, face_hi, arr->points[p], &items[n], true);
         n++;
     }
-    if (n > 0)
-        qsort(items, n, sizeof *items, compare_items);
+    sort_items(items, n);
     *count = n;
     return items;
 }
@@ -957,22 +963,30 @@ static bool sweep(splitter *sp)
     return sp->ok;
 }
 
-static int compare_cuts(const void *x, const void *y)
+static inline bool cut_less(const arr_cut *a, const arr_cut *b)
 {
-    const uint32_t *a = x, *b = y;
-    return a[0] != b[0] ? (a[0] > b[0]) - (a[0] < b[0]) : (a[1] > b[1]) - (a[1] < b[1]);
+    return a->segment != b->segment ? a->segment < b->segment : a->point < b->point;
 }
 
-static int compare_edges(const void *x, const void *y)
+MCI_DEFINE_SORT(sort_cuts, arr_cut, cut_less)
+
+static inline bool edge_less(const mci_arr_edge *a, const mci_arr_edge *b)
 {
-    const mci_arr_edge *a = x, *b = y;
     if (a->a != b->a)
-        return (a->a > b->a) - (a->a < b->a);
+        return a->a < b->a;
     if (a->b != b->b)
-        return (a->b > b->b) - (a->b < b->b);
+        return a->b < b->b;
     if (a->other != b->other)
-        return (a->other > b->other) - (a->other < b->other);
-    return (a->coplanar > b->coplanar) - (a->coplanar < b->coplanar);
+        return a->other < b->other;
+    return a->coplanar < b->coplanar;
+}
+
+/* Equal edges are equal in every field, so the unstable sort's order is unique. */
+MCI_DEFINE_SORT(sort_edges, mci_arr_edge, edge_less)
+
+static bool same_edge(const mci_arr_edge *a, const mci_arr_edge *b)
+{
+    return a->a == b->a && a->b == b->b && a->other == b->other && a->coplanar == b->coplanar;
 }
 
 /* The elementary edges of segment s: its ends and cuts (ids[0..n)) in order along it. */
@@ -993,7 +1007,7 @@ static void emit_pieces(mci_face_arr *arr, const point_key *table,
     }
 }
 
-static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[2],
+static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, arr_cut *cuts,
                         size_t cut_count)
 {
     size_t max_pieces = arr->segment_count + cut_count, c = 0, out = 0;
@@ -1011,21 +1025,19 @@ static bool build_edges(const mci_ctx *ctx, mci_face_arr *arr, uint32_t (*cuts)[
         mci_free(ctx, table);
         return false;
     }
-    if (cut_count > 0)
-        qsort(cuts, cut_count, sizeof *cuts, compare_cuts);
+    sort_cuts(cuts, cut_count);
     for (uint32_t s = 0; s < arr->segment_count; s++) {
         size_t n = 0;
         ids[n++] = arr->segments[s].a;
         ids[n++] = arr->segments[s].b;
-        for (; c < cut_count && cuts[c][0] == s; c++)
-            ids[n++] = cuts[c][1];
+        for (; c < cut_count && cuts[c].segment == s; c++)
+            ids[n++] = cuts[c].point;
         if (!arr->segments[s].phantom)
             emit_pieces(arr, table, &arr->segments[s], ids, tmp, n);
     }
-    if (arr->edge_count > 0)
-        qsort(arr->edges, arr->edge_count, sizeof *arr->edges, compare_edges);
+    sort_edges(arr->edges, arr->edge_count);
     for (size_t e = 0; e < arr->edge_count; e++)
-        if (out == 0 || compare_edges(&arr->edges[e], &arr->edges[out - 1]) != 0)
+        if (out == 0 || !same_edge(&arr->edges[e], &arr->edges[out - 1]))
             arr->edges[out++] = arr->edges[e];
     arr->edge_count = out;
     mci_free(ctx, table);

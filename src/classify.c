@@ -22,6 +22,7 @@
  * Only leaves whose bounding box meets this leaf's can have another label than OUT.
  */
 #include "classify.h"
+#include "sort_template.h"
 #include "triangulate.h"
 
 #include <math.h>
@@ -128,11 +129,12 @@ static bool cell_meets_ray(const mci_cell *c, const double lo[3], const double h
            c->hi[2] >= lo[2];
 }
 
-static int compare_u32(const void *x, const void *y)
+static inline bool u32_less(const uint32_t *a, const uint32_t *b)
 {
-    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
-    return (a > b) - (a < b);
+    return *a < *b;
 }
+
+MCI_DEFINE_SORT(sort_u32, uint32_t, u32_less)
 
 /* Faces of leaf m in the leaf cells the ray meets, sorted and unique in s->faces. Every
  * face the (perturbed) ray crosses, or that holds p, touches the closed ray, so it is
@@ -167,8 +169,7 @@ static bool collect_ray_faces(const mci_ctx *ctx, const mci_octree *o, uint32_t 
             s->faces[n++] = f;
         }
     }
-    if (n > 1)
-        qsort(s->faces, n, sizeof *s->faces, compare_u32);
+    sort_u32(s->faces, n);
     s->face_count = 0;
     for (size_t i = 0; i < n; i++)
         if (i == 0 || s->faces[i] != s->faces[i - 1])

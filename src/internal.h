@@ -120,6 +120,8 @@ typedef struct mci_keyed {
 uint64_t mci_edge_key(uint32_t u, uint32_t v);
 /* Sort by key, then ref. */
 void mci_sort_keyed(mci_keyed *items, size_t n);
+/* Sort 64-bit integers ascending (an introsort without qsort's callback). */
+void mci_sort_u64(uint64_t *items, size_t n);
 /* Index of the first item with this key in sorted items[0 .. n), or n. */
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key);
 

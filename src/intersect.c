@@ -1501,12 +1501,6 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
 /* ---------------------------------------------------------------------------------- */
 /* Public entry: the curves                                                            */
 
-static int compare_u64(const void *x, const void *y)
-{
-    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
-    return (a > b) - (a < b);
-}
-
 /* Every elementary edge of every arrangement, once (both faces along a curve have it). */
 static uint64_t *curve_edges(const mci_ctx *ctx, const mci_scene *s, size_t *count)
 {
@@ -1524,8 +1518,7 @@ static uint64_t *curve_edges(const mci_ctx *ctx, const mci_scene *s, size_t *cou
             keys[i++] = a < b ? a << 32 | b : b << 32 | a;
         }
     }
-    if (n > 0)
-        qsort(keys, n, sizeof *keys, compare_u64);
+    mci_sort_u64(keys, n);
     for (size_t i = 0; i < n; i++)
         if (out == 0 || keys[i] != keys[out - 1])
             keys[out++] = keys[i];

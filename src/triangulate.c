@@ -232,12 +232,6 @@ static uint32_t morton(uint32_t x, uint32_t y)
     return spread_bits(x) | spread_bits(y) << 1;
 }
 
-static int compare_u64(const void *a, const void *b)
-{
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
 /* Quantised position of a point in the face's bounding box (only orders the insertion:
  * any order gives a valid triangulation). */
 static uint32_t insertion_key(const mci_cdt_input *in, const double lo[2],
@@ -273,8 +267,7 @@ static void insertion_order(const mci_cdt_input *in, uint64_t *order)
     span[1] = hi[1] - lo[1];
     for (size_t i = 0; i < in->insert_count; i++)
         order[i] = (uint64_t)insertion_key(in, lo, span, in->insert[i]) << 32 | i;
-    if (in->insert_count > 0)
-        qsort(order, in->insert_count, sizeof *order, compare_u64);
+    mci_sort_u64(order, in->insert_count);
 }
 
 static mcsg_status insert_points(cdt *c, mcsg_error *err)

@@ -1,13 +1,15 @@
 /*
  * Core helpers: the keyed sort (introsort, and an in-place radix sort for long arrays)
- * against a qsort reference on random, sorted, reversed, constant, organ-pipe, edge-key
- * and equal-rank inputs of many sizes, and the key lookup on the sorted result; the
+ * and the 64-bit integer sort (sort_template.h, its heap sort too) against a qsort
+ * reference on random, sorted, reversed, constant, organ-pipe, edge-key and equal-rank
+ * inputs of many sizes, and the key lookup on the sorted result; the
  * parallel loop (every task once, the first failing position reported whatever the
  * thread count, with threads per loop or a pool), the pool's short and nested loops and
  * the heaviest-first order.
  */
 #include "testlib.h"
 #include "internal.h"
+#include "sort_template.h"
 
 #include <stdatomic.h>
 #include <stdio.h>
@@ -65,7 +67,7 @@ static bool same_order(const mci_keyed *a, const mci_keyed *b, size_t n)
     return true;
 }
 
-/* Arrays over 4,096 items take the in-place radix sort (digits skipped or not, deep
+/* Arrays over 1,024 items take the in-place radix sort (digits skipped or not, deep
  * buckets handed back to the introsort), shorter ones the introsort: both must give
  * qsort's order. */
 TEST(keyed_sort_matches_qsort)
@@ -91,6 +93,60 @@ TEST(keyed_sort_matches_qsort)
         }
         free(a);
         free(b);
+    }
+}
+
+static int compare_u64_reference(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return (a > b) - (a < b);
+}
+
+static inline bool u64_before(const uint64_t *a, const uint64_t *b)
+{
+    return *a < *b;
+}
+
+/* The template instantiated here too, so that its heap sort (taken when the recursion
+ * budget runs out, which median-of-three pivots make rare) is tested directly. */
+MCI_DEFINE_SORT(test_sort_u64, uint64_t, u64_before)
+
+/* mci_sort_u64 (sort_template.h's introsort), and the template's heap sort and
+ * introsort with a small recursion budget, against qsort on the same patterns. */
+TEST(u64_sorts_match_qsort)
+{
+    static const size_t sizes[] = {0, 1, 2, 3, 15, 16, 17, 18, 100, 1000, 50000};
+    uint64_t rng = 777;
+    for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
+        size_t n = sizes[s];
+        mci_keyed *items = malloc((n + 1) * sizeof *items);
+        uint64_t *ref = malloc((n + 1) * sizeof *ref), *got = malloc((n + 1) * sizeof *got);
+        CHECK(items && ref && got);
+        for (int pattern = 0; items && ref && got && pattern < 8; pattern++) {
+            fill(items, n, pattern, &rng);
+            for (size_t i = 0; i < n; i++)
+                ref[i] = items[i].key;
+            if (n)
+                qsort(ref, n, sizeof *ref, compare_u64_reference);
+            for (int variant = 0; variant < 4; variant++) {
+                for (size_t i = 0; i < n; i++)
+                    got[i] = items[i].key;
+                if (variant == 0)
+                    mci_sort_u64(got, n);
+                else if (variant == 1)
+                    test_sort_u64(got, n);
+                else if (variant == 2)
+                    test_sort_u64_heap(got, n);
+                else
+                    test_sort_u64_intro(got, n, 2);
+                CHECK_MSG(n == 0 || memcmp(got, ref, n * sizeof *got) == 0,
+                          "size %zu pattern %d variant %d: order differs from qsort", n,
+                          pattern, variant);
+            }
+        }
+        free(items);
+        free(ref);
+        free(got);
     }
 }
 
@@ -260,6 +316,7 @@ TEST(heaviest_first_moves_only_heavy_tasks)
 int main(void)
 {
     RUN(keyed_sort_matches_qsort);
+    RUN(u64_sorts_match_qsort);
     RUN(find_key_reports_missing_keys);
     RUN(parallel_loop_runs_every_task_once_and_reports_the_first_failure);
     RUN(pool_runs_short_and_nested_loops);
