@@ -509,6 +509,43 @@ void mci_sort_keyed(mci_keyed *items, size_t n)
         keyed_sort(items, n);
 }
 
+/* Least-significant-digit radix sort, 16 bits per pass; passes over digits that are
+ * the same in every key are skipped (face ids rarely use all 32 bits). */
+bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
+{
+    uint64_t *tmp, *src = keys, *dst;
+    size_t *count;
+    bool ok;
+    if (n < 2)
+        return true;
+    tmp = mci_malloc_array(ctx, n, sizeof *tmp);
+    count = mci_malloc_array(ctx, 65536, sizeof *count);
+    ok = tmp && count;
+    dst = tmp;
+    for (int shift = 0; ok && shift < 64; shift += 16) {
+        size_t sum = 0;
+        memset(count, 0, 65536 * sizeof *count);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift) & 0xffff]++;
+        if (count[(src[0] >> shift) & 0xffff] == n)
+            continue; /* one digit value: the pass would not move anything */
+        for (size_t d = 0; d < 65536; d++) {
+            size_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            dst[count[(src[i] >> shift) & 0xffff]++] = src[i];
+        src = dst;
+        dst = src == keys ? tmp : keys;
+    }
+    if (ok && src != keys)
+        memcpy(keys, src, n * sizeof *keys);
+    mci_free(ctx, tmp);
+    mci_free(ctx, count);
+    return ok;
+}
+
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key)
 {
     size_t lo = 0, hi = n;

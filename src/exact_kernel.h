@@ -25,6 +25,7 @@
 #ifndef MESHCSG_EXACT_KERNEL_H
 #define MESHCSG_EXACT_KERNEL_H
 
+#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -65,6 +66,24 @@ static inline double mci_max(double x, double y)
 static inline double mci_min(double x, double y)
 {
     return x < y ? x : y;
+}
+
+/* A float at or below x (mci_float_above: at or above), for boxes that only cull (half
+ * the bytes of doubles): x is moved down by at least a float unit in its last place
+ * (2^-23 relative, 2^-149 absolute) before rounding to nearest, which moves it back by
+ * at most half of one; beyond the float range the bound is the largest float, or an
+ * infinity on the safe side. A NaN gives the largest float (below) or its negative
+ * (above): callers that may have NaN must map it themselves. No branch: the rounding
+ * direction is random, and mispredicted branches made the octree's pass over the faces
+ * cost more than it saved. */
+static inline float mci_float_below(double x)
+{
+    return (float)mci_min(x - fabs(x) * 0x1p-23 - 0x1p-149, FLT_MAX);
+}
+
+static inline float mci_float_above(double x)
+{
+    return (float)mci_max(x + fabs(x) * 0x1p-23 + 0x1p-149, -FLT_MAX);
 }
 
 /* A value known to within an error bound: |exact - v| <= e. After an overflow e (and

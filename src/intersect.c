@@ -1383,24 +1383,26 @@ static mcsg_status join_same_definitions(const mci_ctx *ctx, numbering *nb, mcsg
     return st;
 }
 
+/* The certified box rounded outward to floats: the table of these is the peak of the
+ * dense scenes' runs (ring-800: 238K roots), and a larger box only adds pairs to test. */
 typedef struct boxed_slot {
-    double lo[3], hi[3];
+    float lo[3], hi[3];
     uint32_t slot;
 } boxed_slot;
 
 /* A key whose unsigned order is the numeric order of x (not NaN; -0 counts as +0). */
-static uint64_t orderable(double x)
+static uint32_t orderable_float(float x)
 {
-    uint64_t bits;
-    x += 0.0; /* -0 -> +0 */
+    uint32_t bits;
+    x += 0.0f; /* -0 -> +0 */
     memcpy(&bits, &x, sizeof bits);
-    return bits >> 63 ? ~bits : bits | (UINT64_C(1) << 63);
+    return bits >> 31 ? ~bits : bits | (UINT32_C(1) << 31);
 }
 
 typedef struct bounds_job {
     const numbering *nb;
     boxed_slot *items;
-    mci_keyed *order;
+    uint64_t *order; /* per item: its low x (orderable_float) << 32 | its index */
     size_t n;
 } bounds_job;
 
@@ -1412,22 +1414,26 @@ static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
     (void)err;
     for (size_t i = chunk * HASH_CHUNK; i < end; i++) {
         boxed_slot *item = &j->items[i];
-        mci_point_bounds(j->nb->table[item->slot], item->lo, item->hi);
-        j->order[i].key = orderable(item->lo[0]);
-        j->order[i].ref = (uint32_t)i;
+        double lo[3], hi[3];
+        mci_point_bounds(j->nb->table[item->slot], lo, hi);
+        for (int k = 0; k < 3; k++) { /* a NaN bound (overflow) bounds nothing */
+            item->lo[k] = isnan(lo[k]) ? -INFINITY : mci_float_below(lo[k]);
+            item->hi[k] = isnan(hi[k]) ? INFINITY : mci_float_above(hi[k]);
+        }
+        j->order[i] = (uint64_t)orderable_float(item->lo[0]) << 32 | i;
     }
     return MCSG_OK;
 }
 
 /* Distinct definitions of one point: a sweep along x over the certified boxes (sorted by
- * their low x with the keyed radix sort; equal lows in slot order), each pair whose
- * boxes overlap tested exactly. The joins do not depend on the order, only on the pairs. */
+ * their low x; equal lows in slot order), each pair whose boxes overlap tested exactly.
+ * The joins do not depend on the order, only on the pairs. */
 static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
 {
     size_t roots = 0;
     bounds_job j = {nb, NULL, NULL, 0};
     const boxed_slot *items;
-    const mci_keyed *order;
+    const uint64_t *order;
     mcsg_status st;
     /* Sized for the roots only: most slots are copies (ring-800: 797K slots). */
     for (uint32_t slot = 0; slot < nb->total; slot++)
@@ -1440,12 +1446,12 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
-    if (st == MCSG_OK)
-        mci_sort_keyed(j.order, j.n);
+    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
+        st = mci_fail_nomem(err, "numbering points");
     for (size_t i = 0; st == MCSG_OK && i < j.n; i++) {
-        const boxed_slot *a = &items[order[i].ref];
-        for (size_t k = i + 1; k < j.n && items[order[k].ref].lo[0] <= a->hi[0]; k++) {
-            const boxed_slot *b = &items[order[k].ref];
+        const boxed_slot *a = &items[(uint32_t)order[i]];
+        for (size_t k = i + 1; k < j.n && items[(uint32_t)order[k]].lo[0] <= a->hi[0]; k++) {
+            const boxed_slot *b = &items[(uint32_t)order[k]];
             if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
                 b->lo[2] > a->hi[2])
                 continue;
@@ -1470,11 +1476,10 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     if (nb.total >= UINT32_MAX)
         return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", nb.total);
     s->gid_start = mci_malloc_array(ctx, s->arr_count + 1, sizeof *s->gid_start);
-    s->gid = mci_malloc_array(ctx, nb.total + 1, sizeof *s->gid);
     s->explicit_slot = nb.explicit_slot = mci_malloc_array(ctx, nb.total + 1, 1);
     nb.table = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.table);
     nb.parent = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.parent);
-    ok = s->gid_start && s->gid && s->explicit_slot && nb.table && nb.parent;
+    ok = s->gid_start && s->explicit_slot && nb.table && nb.parent;
     for (size_t k = 0, slot = 0; ok && k < s->arr_count; k++) {
         s->gid_start[k] = (uint32_t)slot;
         for (size_t p = 0; p < s->arrs[k].point_count; p++, slot++) {
@@ -1487,6 +1492,9 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     st = ok ? join_same_definitions(ctx, &nb, err) : mci_fail_nomem(err, "numbering points");
     if (st == MCSG_OK)
         st = join_equal_points(ctx, &nb, err);
+    /* Allocated last: the joins' tables were this step's peak. */
+    if (st == MCSG_OK && !(s->gid = mci_malloc_array(ctx, nb.total + 1, sizeof *s->gid)))
+        st = mci_fail_nomem(err, "numbering points");
     for (uint32_t slot = 0; st == MCSG_OK && slot < nb.total; slot++) {
         uint32_t root = find_root(nb.parent, slot);
         s->gid[slot] = root == slot ? (uint32_t)id++ : s->gid[root];

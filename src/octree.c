@@ -285,20 +285,6 @@ typedef struct box_job {
     float *box;
 } box_job;
 
-/* A float at or below x (float_above: at or above): x is moved down by at least a float
- * unit in its last place (2^-23 relative, 2^-149 absolute) before rounding to nearest,
- * which moves it back by at most half of one; beyond the float range the bound is the
- * largest float, or an infinity on the safe side. No branch: the rounding direction is
- * random, and mispredicted branches made this pass cost more than it saved. */
-static float float_below(double x)
-{
-    return (float)mci_min(x - fabs(x) * 0x1p-23 - 0x1p-149, FLT_MAX);
-}
-
-static float float_above(double x)
-{
-    return (float)mci_max(x + fabs(x) * 0x1p-23 + 0x1p-149, -FLT_MAX);
-}
 
 /* The face's box in doubles, from its corners. */
 static void exact_box(const double *const v[3], double box[6])
@@ -323,8 +309,8 @@ static mcsg_status box_chunk(void *user, size_t chunk, mcsg_error *err)
         float *out = j->box + 6 * (size_t)f;
         exact_box(v, box);
         for (int k = 0; k < 3; k++) {
-            out[k] = float_below(box[k]);
-            out[3 + k] = float_above(box[3 + k]);
+            out[k] = mci_float_below(box[k]);
+            out[3 + k] = mci_float_above(box[3 + k]);
         }
     }
     return MCSG_OK;
@@ -690,38 +676,6 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
 /* ---------------------------------------------------------------------------------- */
 /* Candidate pairs                                                                     */
 
-/* Least-significant-digit radix sort, 16 bits per pass; passes over digits that are
- * the same in every key are skipped (face ids rarely use all 32 bits). */
-static bool radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
-{
-    uint64_t *tmp = mci_malloc_array(ctx, n, sizeof *tmp), *src = keys, *dst = tmp;
-    size_t *count = mci_malloc_array(ctx, 65536, sizeof *count);
-    bool ok = tmp && count;
-    for (int shift = 0; ok && shift < 64; shift += 16) {
-        size_t sum = 0;
-        memset(count, 0, 65536 * sizeof *count);
-        for (size_t i = 0; i < n; i++)
-            count[(src[i] >> shift) & 0xffff]++;
-        if (count[(src[0] >> shift) & 0xffff] == n)
-            continue; /* one digit value: the pass would not move anything */
-        for (size_t d = 0; d < 65536; d++) {
-            size_t c = count[d];
-            count[d] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++)
-            dst[count[(src[i] >> shift) & 0xffff]++] = src[i];
-        src = dst;
-        dst = src == keys ? tmp : keys;
-    }
-    if (ok && src != keys)
-        memcpy(keys, src, n * sizeof *keys);
-    mci_free(ctx, tmp);
-    mci_free(ctx, count);
-    return ok;
-}
-
-
 /* A cell's face with what the pair loop reads, copied once per cell (the loop reads each
  * face's box and leaf once per other face of the cell). */
 typedef struct cell_face {
@@ -861,7 +815,7 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
     if (job.box != tree->face_box)
         mci_free(ctx, job.box);
     /* A pair sharing several cells was collected once per cell: keep one. */
-    if (st == MCSG_OK && *count && !radix_sort_u64(ctx, *pairs, *count))
+    if (st == MCSG_OK && *count && !mci_radix_sort_u64(ctx, *pairs, *count))
         st = mci_fail_nomem(err, "collecting candidate pairs");
     if (st != MCSG_OK) {
         mci_free(ctx, *pairs);

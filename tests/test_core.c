@@ -111,12 +111,16 @@ static inline bool u64_before(const uint64_t *a, const uint64_t *b)
  * budget runs out, which median-of-three pivots make rare) is tested directly. */
 MCI_DEFINE_SORT(test_sort_u64, uint64_t, u64_before)
 
-/* mci_sort_u64 (sort_template.h's introsort), and the template's heap sort and
- * introsort with a small recursion budget, against qsort on the same patterns. */
+/* mci_sort_u64 (sort_template.h's introsort), the template's heap sort and introsort
+ * with a small recursion budget, and mci_radix_sort_u64, against qsort on the same
+ * patterns. */
 TEST(u64_sorts_match_qsort)
 {
     static const size_t sizes[] = {0, 1, 2, 3, 15, 16, 17, 18, 100, 1000, 50000};
     uint64_t rng = 777;
+    mci_ctx ctx;
+    mcsg_options opts = {0};
+    mci_ctx_init(&ctx, &opts);
     for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
         size_t n = sizes[s];
         mci_keyed *items = malloc((n + 1) * sizeof *items);
@@ -128,7 +132,7 @@ TEST(u64_sorts_match_qsort)
                 ref[i] = items[i].key;
             if (n)
                 qsort(ref, n, sizeof *ref, compare_u64_reference);
-            for (int variant = 0; variant < 4; variant++) {
+            for (int variant = 0; variant < 5; variant++) {
                 for (size_t i = 0; i < n; i++)
                     got[i] = items[i].key;
                 if (variant == 0)
@@ -137,8 +141,10 @@ TEST(u64_sorts_match_qsort)
                     test_sort_u64(got, n);
                 else if (variant == 2)
                     test_sort_u64_heap(got, n);
-                else
+                else if (variant == 3)
                     test_sort_u64_intro(got, n, 2);
+                else
+                    CHECK(mci_radix_sort_u64(&ctx, got, n));
                 CHECK_MSG(n == 0 || memcmp(got, ref, n * sizeof *got) == 0,
                           "size %zu pattern %d variant %d: order differs from qsort", n,
                           pattern, variant);
