@@ -766,30 +766,146 @@ static uint32_t *critical_leaves(const mci_ctx *ctx, const mci_octree *tree, siz
     return cells;
 }
 
-/* The chunks' lists one after the other in *pairs (each freed once copied). */
-static bool join_pair_chunks(const mci_ctx *ctx, pair_chunk_list *chunks, size_t n,
-                             uint64_t **pairs, size_t *count)
+/* The chunks' pairs sorted and unique, without one sort over all of them: a pass puts
+ * each pair in the bucket of its first face's range (contiguous ranges, so bucket order
+ * is key order), then each bucket is sorted on its own, on the threads, and its repeats
+ * (a pair shared by several cells) dropped. One radix sort over all 1.5M pairs of
+ * ring-800 ran on one thread: 22 ms of the step's 47 on two threads (now 34). */
+enum { PAIRS_PER_BUCKET = 2048 };
+
+typedef struct bucket_job {
+    uint64_t *keys, *scratch; /* bucket b: [start[b], start[b + 1]) of each */
+    const size_t *start;
+    size_t *unique;           /* per bucket: its pairs once each, at its start in keys */
+} bucket_job;
+
+/* LSD radix sort of keys through tmp (11-bit digits: the counts stay in the first-level
+ * cache) over the bits that differ between keys only (a bucket's pairs share most of
+ * their first face's bits); the result is in keys. */
+static void sort_bucket(uint64_t *keys, uint64_t *tmp, size_t n)
 {
-    size_t total = 0;
-    for (size_t c = 0; c < n; c++)
-        total += chunks[c].count;
-    *pairs = mci_malloc_array(ctx, total + 1, sizeof **pairs);
-    if (!*pairs)
+    uint32_t count[2048];
+    uint64_t *src = keys, *dst = tmp, all = ~UINT64_C(0), any = 0, varying;
+    if (n <= 64) {
+        mci_sort_u64(keys, n);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        all &= keys[i];
+        any |= keys[i];
+    }
+    varying = all ^ any;
+    for (int shift = 0; shift < 64 && varying >> shift; shift += 11) {
+        uint32_t sum = 0;
+        if (!((varying >> shift) & 2047))
+            continue;
+        memset(count, 0, sizeof count);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift) & 2047]++;
+        for (size_t d = 0; d < 2048; d++) {
+            uint32_t c = count[d];
+            count[d] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            dst[count[(src[i] >> shift) & 2047]++] = src[i];
+        src = dst;
+        dst = src == keys ? tmp : keys;
+    }
+    if (src != keys)
+        memcpy(keys, src, n * sizeof *keys);
+}
+
+static mcsg_status bucket_task(void *user, size_t b, mcsg_error *err)
+{
+    const bucket_job *j = user;
+    uint64_t *keys = j->keys + j->start[b];
+    size_t n = j->start[b + 1] - j->start[b], out = 0;
+    (void)err;
+    sort_bucket(keys, j->scratch + j->start[b], n);
+    for (size_t i = 0; i < n; i++)
+        if (out == 0 || keys[i] != keys[out - 1])
+            keys[out++] = keys[i];
+    j->unique[b] = out;
+    return MCSG_OK;
+}
+
+/* The bucket of a pair: its first face's id >> shift. */
+static int bucket_shift(uint32_t faces, size_t pairs)
+{
+    size_t wanted = pairs / PAIRS_PER_BUCKET + 1;
+    int shift = 0;
+    while (((size_t)faces >> shift) > wanted)
+        shift++;
+    return shift;
+}
+
+/* Moves the chunks' pairs into their buckets (each chunk's list freed once moved);
+ * false when out of memory (the lists not moved stay with the chunks). */
+static bool fill_buckets(const mci_ctx *ctx, pair_chunk_list *chunks, size_t n, int shift,
+                         uint64_t *keys, size_t *start, size_t buckets)
+{
+    size_t *at = mci_malloc_array(ctx, buckets + 1, sizeof *at);
+    if (!at)
         return false;
+    for (size_t c = 0; c < n; c++)
+        for (size_t i = 0; i < chunks[c].count; i++)
+            start[(chunks[c].pairs[i] >> 32 >> shift) + 1]++;
+    for (size_t b = 0; b < buckets; b++) {
+        start[b + 1] += start[b];
+        at[b] = start[b];
+    }
     for (size_t c = 0; c < n; c++) {
-        if (chunks[c].count)
-            memcpy(*pairs + *count, chunks[c].pairs, chunks[c].count * sizeof **pairs);
-        *count += chunks[c].count;
+        for (size_t i = 0; i < chunks[c].count; i++)
+            keys[at[chunks[c].pairs[i] >> 32 >> shift]++] = chunks[c].pairs[i];
         mci_free(ctx, chunks[c].pairs);
         chunks[c].pairs = NULL;
     }
+    mci_free(ctx, at);
     return true;
+}
+
+static mcsg_status sorted_unique_pairs(const mci_ctx *ctx, const mci_octree *tree,
+                                       pair_chunk_list *chunks, size_t n, uint64_t **pairs,
+                                       size_t *count, mcsg_error *err)
+{
+    size_t total = 0, buckets;
+    uint32_t faces = tree->face_base[tree->leaf_count];
+    int shift;
+    bucket_job j = {NULL, NULL, NULL, NULL};
+    size_t *start = NULL;
+    mcsg_status st = MCSG_OK;
+    for (size_t c = 0; c < n; c++)
+        total += chunks[c].count;
+    shift = bucket_shift(faces, total);
+    buckets = ((size_t)faces >> shift) + 1;
+    j.keys = mci_malloc_array(ctx, total + 1, sizeof *j.keys);
+    j.start = start = mci_calloc_array(ctx, buckets + 1, sizeof *start);
+    j.unique = mci_malloc_array(ctx, buckets + 1, sizeof *j.unique);
+    if (!j.keys || !start || !j.unique ||
+        !fill_buckets(ctx, chunks, n, shift, j.keys, start, buckets) ||
+        !(j.scratch = mci_malloc_array(ctx, total + 1, sizeof *j.scratch)))
+        st = mci_fail_nomem(err, "collecting candidate pairs");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, buckets, bucket_task, &j, err);
+    for (size_t b = 0; st == MCSG_OK && b < buckets; b++) { /* the buckets' runs joined */
+        memmove(j.keys + *count, j.keys + start[b], j.unique[b] * sizeof *j.keys);
+        *count += j.unique[b];
+    }
+    mci_free(ctx, j.scratch);
+    mci_free(ctx, start);
+    mci_free(ctx, j.unique);
+    if (st == MCSG_OK)
+        *pairs = j.keys;
+    else
+        mci_free(ctx, j.keys);
+    return st;
 }
 
 mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tree,
                                        uint64_t **pairs, size_t *count, mcsg_error *err)
 {
-    size_t unique = 0, chunk_count = 0;
+    size_t chunk_count = 0;
     /* Contiguous boxes: a pair's test reads 48 bytes instead of 12 vertices. The build's
      * when the tree still has them, else computed again (a pass over the faces). */
     pair_job job = {ctx, tree, tree->face_box ? tree->face_box : face_boxes(ctx, tree), NULL,
@@ -806,27 +922,14 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
         st = mci_fail_nomem(err, "collecting candidate pairs");
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, chunk_count, collect_chunk, &job, err);
-    if (st == MCSG_OK && !join_pair_chunks(ctx, job.chunks, chunk_count, pairs, count))
-        st = mci_fail_nomem(err, "collecting candidate pairs");
-    for (size_t c = 0; job.chunks && c < chunk_count; c++)
-        mci_free(ctx, job.chunks[c].pairs);
-    mci_free(ctx, job.chunks);
     mci_free(ctx, job.cells);
     if (job.box != tree->face_box)
         mci_free(ctx, job.box);
     /* A pair sharing several cells was collected once per cell: keep one. */
-    if (st == MCSG_OK && *count && !mci_radix_sort_u64(ctx, *pairs, *count))
-        st = mci_fail_nomem(err, "collecting candidate pairs");
-    if (st != MCSG_OK) {
-        mci_free(ctx, *pairs);
-        *pairs = NULL;
-        *count = 0;
-        return st;
-    }
-    for (size_t i = 0; i < *count; i++) {
-        if (i == 0 || (*pairs)[i] != (*pairs)[i - 1])
-            (*pairs)[unique++] = (*pairs)[i];
-    }
-    *count = unique;
-    return MCSG_OK;
+    if (st == MCSG_OK)
+        st = sorted_unique_pairs(ctx, tree, job.chunks, chunk_count, pairs, count, err);
+    for (size_t c = 0; job.chunks && c < chunk_count; c++)
+        mci_free(ctx, job.chunks[c].pairs);
+    mci_free(ctx, job.chunks);
+    return st;
 }

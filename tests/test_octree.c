@@ -321,6 +321,24 @@ TEST(two_offset_spheres)
     mcsg_mesh_free(&b, NULL);
 }
 
+/* Face ids up to 2^15 and thousands of pairs: the pair sort's buckets then span many
+ * first faces and its radix passes run on every digit of both ids. */
+TEST(fine_spheres_large_face_ids)
+{
+    mcsg_mesh a, b;
+    mcsg_resolution res = {128, 0, 0};
+    mcsg_error err;
+    double shift[12] = {1, 0, 0, 0.3, 0, 1, 0, 0.2, 0, 0, 1, 0.1};
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &a, &err), &err);
+    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &b, &err), &err);
+    mcsg_mesh_transform(&b, shift);
+    CHECK(a.triangle_count + b.triangle_count > 30000);
+    const mcsg_mesh *leaves[2] = {&a, &b};
+    check_scene(leaves, 2, 48, 4000);
+    mcsg_mesh_free(&a, NULL);
+    mcsg_mesh_free(&b, NULL);
+}
+
 TEST(coplanar_cubes_and_identical_spheres)
 {
     mcsg_mesh c1, c2, s1;
@@ -396,6 +414,7 @@ int main(void)
 {
     RUN(triangle_box_matches_rational_clipping);
     RUN(two_offset_spheres);
+    RUN(fine_spheres_large_face_ids);
     RUN(coplanar_cubes_and_identical_spheres);
     RUN(scaled_beyond_float_range);
     RUN(build_survives_allocation_failure);
