@@ -45,6 +45,7 @@ typedef struct cdt {
     tri *t;
     size_t count;
     uint32_t *vt; /* a triangle incident to each inserted point */
+    double (*box)[3]; /* each point's projected box (mci_point_projected_box) */
     uint64_t *order; /* insertion order (see insertion_order) */
     void *block;  /* t, vt and order in one allocation */
     uint64_t rng;
@@ -67,7 +68,7 @@ static int prev3(int i)
 static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
     const mci_point *const *pts = c->in->points;
-    int s = mci_orient2d_projected_quick(pts[a], pts[b], pts[p], c->in->axis);
+    int s = mci_orient2d_boxes(c->box[a], c->box[b], c->box[p]);
     if (s != MCI_UNCERTAIN)
         return c->in->sign * s;
     if (c->in->known_collinear && c->in->known_collinear(c->in->user, a, b, p))
@@ -510,21 +511,26 @@ static mcsg_status setup(cdt *c, const mci_ctx *ctx, const mci_cdt_input *in, mc
     if (in->point_count > SIZE_MAX / 64)
         return mci_fail(err, MCSG_ERR_LIMIT, "too many points in one face (%zu)",
                         in->point_count);
-    /* One block: order (64-bit keys), the triangles, vt. */
+    /* One block: the boxes, order (64-bit keys), the triangles, vt. */
     {
         size_t tris = 1 + 2 * in->insert_count, words = in->insert_count + 1;
+        size_t box_words = 3 * in->point_count;
         size_t tri_words = (tris * sizeof *c->t + sizeof *c->order - 1) / sizeof *c->order;
         size_t vt_words = (in->point_count * sizeof *c->vt + sizeof *c->order - 1) /
                           sizeof *c->order;
-        c->block = mci_malloc_array(ctx, words + tri_words + vt_words, sizeof *c->order);
+        c->block = mci_malloc_array(ctx, box_words + words + tri_words + vt_words,
+                                    sizeof *c->order);
         if (!c->block)
             return mci_fail_nomem(err, "triangulating a face");
-        c->order = c->block;
+        c->box = c->block;
+        c->order = (uint64_t *)(void *)(c->box + in->point_count);
         c->t = (tri *)(void *)(c->order + words);
         c->vt = (uint32_t *)(void *)(c->order + words + tri_words);
     }
-    for (size_t i = 0; i < in->point_count; i++)
+    for (size_t i = 0; i < in->point_count; i++) {
         c->vt[i] = i < 3 ? 0 : NONE;
+        mci_point_projected_box(in->points[i], in->axis, c->box[i]);
+    }
     c->t[0] = (tri){{0, 1, 2}, {NONE, NONE, NONE}, 0};
     c->count = 1;
     return MCSG_OK;
