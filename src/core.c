@@ -509,41 +509,46 @@ void mci_sort_keyed(mci_keyed *items, size_t n)
         keyed_sort(items, n);
 }
 
-/* Least-significant-digit radix sort, 16 bits per pass; passes over digits that are
- * the same in every key are skipped (face ids rarely use all 32 bits). */
-bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
+void mci_radix_sort_u64_buffered(uint64_t *keys, uint64_t *tmp, size_t n)
 {
-    uint64_t *tmp, *src = keys, *dst;
-    size_t *count;
-    bool ok;
-    if (n < 2)
-        return true;
-    tmp = mci_malloc_array(ctx, n, sizeof *tmp);
-    count = mci_malloc_array(ctx, 65536, sizeof *count);
-    ok = tmp && count;
-    dst = tmp;
-    for (int shift = 0; ok && shift < 64; shift += 16) {
-        size_t sum = 0;
-        memset(count, 0, 65536 * sizeof *count);
-        for (size_t i = 0; i < n; i++)
-            count[(src[i] >> shift) & 0xffff]++;
-        if (count[(src[0] >> shift) & 0xffff] == n)
+    uint32_t count[2048];
+    uint64_t *src = keys, *dst = tmp, all = ~UINT64_C(0), any = 0, varying;
+    for (size_t i = 0; i < n; i++) {
+        all &= keys[i];
+        any |= keys[i];
+    }
+    varying = all ^ any;
+    for (int shift = 0; shift < 64 && varying >> shift; shift += 11) {
+        uint32_t sum = 0;
+        if (!((varying >> shift) & 2047))
             continue; /* one digit value: the pass would not move anything */
-        for (size_t d = 0; d < 65536; d++) {
-            size_t c = count[d];
+        memset(count, 0, sizeof count);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift) & 2047]++;
+        for (size_t d = 0; d < 2048; d++) {
+            uint32_t c = count[d];
             count[d] = sum;
             sum += c;
         }
         for (size_t i = 0; i < n; i++)
-            dst[count[(src[i] >> shift) & 0xffff]++] = src[i];
+            dst[count[(src[i] >> shift) & 2047]++] = src[i];
         src = dst;
         dst = src == keys ? tmp : keys;
     }
-    if (ok && src != keys)
+    if (src != keys)
         memcpy(keys, src, n * sizeof *keys);
+}
+
+bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)
+{
+    uint64_t *tmp;
+    if (n < 2)
+        return true;
+    if (!(tmp = mci_malloc_array(ctx, n, sizeof *tmp)))
+        return false;
+    mci_radix_sort_u64_buffered(keys, tmp, n);
     mci_free(ctx, tmp);
-    mci_free(ctx, count);
-    return ok;
+    return true;
 }
 
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key)

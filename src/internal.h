@@ -122,8 +122,11 @@ uint64_t mci_edge_key(uint32_t u, uint32_t v);
 void mci_sort_keyed(mci_keyed *items, size_t n);
 /* Sort 64-bit integers ascending (an introsort without qsort's callback). */
 void mci_sort_u64(uint64_t *items, size_t n);
-/* The same for long arrays: a radix sort through a buffer of n keys (and 512 KiB of
- * counts); false when those cannot be allocated (keys unchanged or sorted). */
+/* The same for long arrays: a least-significant-digit radix sort through tmp (n keys),
+ * 11-bit digits (the counts stay in the first-level cache), passes only over the digits
+ * where some keys differ (ids rarely use all their bits); n < 2^32. */
+void mci_radix_sort_u64_buffered(uint64_t *keys, uint64_t *tmp, size_t n);
+/* ... with the buffer allocated; false when it cannot be (keys unchanged). */
 bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n);
 /* Index of the first item with this key in sorted items[0 .. n), or n. */
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key);

@@ -1446,9 +1446,7 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
-    if (st == MCSG_OK && j.n <= 65536) /* the radix sort's counts alone take 512 KiB */
-        mci_sort_u64(j.order, j.n);
-    else if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
+    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
         st = mci_fail_nomem(err, "numbering points");
     for (size_t i = 0; st == MCSG_OK && i < j.n; i++) {
         const boxed_slot *a = &items[(uint32_t)order[i]];

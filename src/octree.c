@@ -779,50 +779,16 @@ typedef struct bucket_job {
     size_t *unique;           /* per bucket: its pairs once each, at its start in keys */
 } bucket_job;
 
-/* LSD radix sort of keys through tmp (11-bit digits: the counts stay in the first-level
- * cache) over the bits that differ between keys only (a bucket's pairs share most of
- * their first face's bits); the result is in keys. */
-static void sort_bucket(uint64_t *keys, uint64_t *tmp, size_t n)
-{
-    uint32_t count[2048];
-    uint64_t *src = keys, *dst = tmp, all = ~UINT64_C(0), any = 0, varying;
-    if (n <= 64) {
-        mci_sort_u64(keys, n);
-        return;
-    }
-    for (size_t i = 0; i < n; i++) {
-        all &= keys[i];
-        any |= keys[i];
-    }
-    varying = all ^ any;
-    for (int shift = 0; shift < 64 && varying >> shift; shift += 11) {
-        uint32_t sum = 0;
-        if (!((varying >> shift) & 2047))
-            continue;
-        memset(count, 0, sizeof count);
-        for (size_t i = 0; i < n; i++)
-            count[(src[i] >> shift) & 2047]++;
-        for (size_t d = 0; d < 2048; d++) {
-            uint32_t c = count[d];
-            count[d] = sum;
-            sum += c;
-        }
-        for (size_t i = 0; i < n; i++)
-            dst[count[(src[i] >> shift) & 2047]++] = src[i];
-        src = dst;
-        dst = src == keys ? tmp : keys;
-    }
-    if (src != keys)
-        memcpy(keys, src, n * sizeof *keys);
-}
-
 static mcsg_status bucket_task(void *user, size_t b, mcsg_error *err)
 {
     const bucket_job *j = user;
     uint64_t *keys = j->keys + j->start[b];
     size_t n = j->start[b + 1] - j->start[b], out = 0;
     (void)err;
-    sort_bucket(keys, j->scratch + j->start[b], n);
+    if (n <= 64)
+        mci_sort_u64(keys, n);
+    else
+        mci_radix_sort_u64_buffered(keys, j->scratch + j->start[b], n);
     for (size_t i = 0; i < n; i++)
         if (out == 0 || keys[i] != keys[out - 1])
             keys[out++] = keys[i];
