@@ -69,8 +69,8 @@ void mci_pool_stop(mci_ctx *ctx);
 
 /* Run fn(user, i, err) for i in 0 .. count-1 on up to mci_thread_count(ctx) threads
  * (the calling thread included). Tasks must be independent. Returns MCSG_OK, or the
- * status and message of the failing task with the smallest index (no task is started
- * after a failure). */
+ * status and message of the failing task with the smallest index (once a failure is
+ * known, no task after it starts; every task before it runs). */
 typedef mcsg_status (*mci_task_fn)(void *user, size_t index, mcsg_error *err);
 mcsg_status mci_parallel_for(const mci_ctx *ctx, size_t count, mci_task_fn fn, void *user,
                              mcsg_error *err);

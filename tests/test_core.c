@@ -217,7 +217,8 @@ static mci_ctx ctx_with_threads(int threads, bool pooled)
  * loop posted after the first and never run a task twice. */
 TEST(parallel_loop_runs_every_task_once_and_reports_the_first_failure)
 {
-    static const int none[] = {-1}, two[] = {800, 37, -1};
+    /* late: positions past the first 256, which are claimed in batches */
+    static const int none[] = {-1}, two[] = {800, 37, -1}, late[] = {700, 650, -1};
     static task_log log;
     uint32_t reversed[TASKS];
     mcsg_error err;
@@ -241,6 +242,10 @@ TEST(parallel_loop_runs_every_task_once_and_reports_the_first_failure)
             CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 37 failed") == 0);
             run_tasks(&ctx, reversed, two, &log, &st, &err);
             CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 800 failed") == 0);
+            run_tasks(&ctx, NULL, late, &log, &st, &err);
+            CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 650 failed") == 0);
+            run_tasks(&ctx, reversed, late, &log, &st, &err);
+            CHECK(st == MCSG_ERR_INTERNAL && strcmp(err.message, "task 700 failed") == 0);
             mci_pool_stop(&ctx);
             CHECK(ctx.pool == NULL);
         }
