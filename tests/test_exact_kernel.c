@@ -2036,6 +2036,54 @@ TEST(vertex_orient3d_shapes)
     CHECK(zeros > cases / 4); /* the rule's shapes were there */
 }
 
+/* The coordinates of x cyclically moved by `shift` axes (the shapes below along any axis). */
+static void rotate_axes(double x[3], int shift)
+{
+    double t[3] = {x[0], x[1], x[2]};
+    for (int k = 0; k < 3; k++)
+        x[(k + shift) % 3] = t[k];
+}
+
+/* Two crossings of one plane that contains an axis direction (a side of a cylindrical
+ * hole) with two lines whose ends project to the same points along that axis (a
+ * cylinder's top and bottom cap edges): equal on the two other axes by definition
+ * (mci_compare_coord's rule), and compared with the exact stage on every axis, also
+ * after an end is moved by one ulp (the rule must then not apply). */
+TEST(lpi_equal_by_projection)
+{
+    long cases = 0, equal = 0;
+    for (int i = 0; i < 20000; i++) {
+        double r = 0.2 + rng_unit(), big = 5 + 5 * rng_unit(), t1 = rng_unit() * 6.2831853;
+        double t2 = t1 + 0.05 + rng_unit() * 0.5, u = rng_unit() * 6.2831853;
+        double cx = (big - 2 * r) * cos(u + 0.01), cy = (big - 2 * r) * sin(u + 0.01);
+        double z0 = -1 - rng_unit(), z1 = 1 + rng_unit();
+        double v[7][3] = {{cx + r * cos(t1), cy + r * sin(t1), 2 * z0},
+                          {cx + r * cos(t2), cy + r * sin(t2), 2 * z0},
+                          {cx + r * cos(t1), cy + r * sin(t1), 2 * z1},
+                          {0, 0, z1}, {big * cos(u), big * sin(u), z1},
+                          {0, 0, z0}, {big * cos(u), big * sin(u), z0}};
+        int shift = rng_int(0, 2), moved = rng_int(0, 1);
+        mci_plane plane;
+        mci_point a, b;
+        for (int k = 0; k < 7; k++)
+            rotate_axes(v[k], shift);
+        if (moved) /* one end of the lower line moved across: no longer the same projection */
+            v[6][(shift + rng_int(0, 1)) % 3] = mci_next_up(v[6][(shift + rng_int(0, 1)) % 3]);
+        mci_plane_init(&plane, v[0], v[1], v[2]);
+        if (!mci_point_lpi(&a, v[3], v[4], &plane) || !mci_point_lpi(&b, v[5], v[6], &plane))
+            continue;
+        for (int axis = 0; axis < 3; axis++) {
+            int got = mci_compare_coord(&a, &b, axis), ref = mci_compare_coord_exact(&a, &b, axis);
+            CHECK_MSG(got == ref, "case %d axis %d (shift %d, moved %d): %d, exact %d", i, axis,
+                      shift, moved, got, ref);
+            equal += ref == 0;
+        }
+        cases++;
+    }
+    printf("lpi equal by projection: %ld pairs, %ld equal coordinates\n", cases, equal);
+    CHECK(cases > 10000 && equal > cases / 2); /* the rule's shapes were there */
+}
+
 int main(void)
 {
     const char *seed = getenv("MCSG_TEST_SEED");
@@ -2046,6 +2094,7 @@ int main(void)
     RUN(next_double);
     RUN(bit_range);
     RUN(vertex_orient3d_shapes);
+    RUN(lpi_equal_by_projection);
     RUN(reference_sanity);
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);
