@@ -513,6 +513,10 @@ void mci_radix_sort_u64_buffered(uint64_t *keys, uint64_t *tmp, size_t n)
 {
     uint32_t count[2048];
     uint64_t *src = keys, *dst = tmp, all = ~UINT64_C(0), any = 0, varying;
+    if (n <= 64) { /* clearing the counts alone would cost more */
+        mci_sort_u64(keys, n);
+        return;
+    }
     for (size_t i = 0; i < n; i++) {
         all &= keys[i];
         any |= keys[i];
@@ -537,6 +541,15 @@ void mci_radix_sort_u64_buffered(uint64_t *keys, uint64_t *tmp, size_t n)
     }
     if (src != keys)
         memcpy(keys, src, n * sizeof *keys);
+}
+
+size_t mci_unique_u64(uint64_t *keys, size_t n)
+{
+    size_t out = 0;
+    for (size_t i = 0; i < n; i++)
+        if (out == 0 || keys[i] != keys[out - 1])
+            keys[out++] = keys[i];
+    return out;
 }
 
 bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n)

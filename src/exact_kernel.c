@@ -805,16 +805,6 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
     return big_orient2d(points, axis, s.e0);
 }
 
-/* First filter, on the cached boxes: for points close together but defined far away
- * (consecutive points of a curve, say) the homogeneous determinant's bound grows with
- * the distances to the defining vertices, while differences of the boxes stay small;
- * and it is a few operations instead of a 3x3 determinant. Inline in exact_kernel.h
- * (mci_orient2d_projected_quick), with its error bound. */
-static int orient2d_boxes(const mci_point *p, const mci_point *q, const mci_point *r, int axis)
-{
-    return mci_orient2d_projected_quick(p, q, r, axis);
-}
-
 /* Whether the projected coordinates of p are exact in the box (axes other than axis). */
 static bool exact_in_projection(const mci_point *p, int axis)
 {
@@ -905,7 +895,7 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
     int s;
     if (collinear_by_definition(p, q, r))
         return 0;
-    s = orient2d_boxes(p, q, r, axis);
+    s = mci_orient2d_projected_quick(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : orient2d_beyond_boxes(p, q, r, axis);
 }
 

@@ -182,6 +182,9 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
 /* mci_orient2d_projected in two halves, for callers that know collinear cases of their
  * own (a face's lines): the first, a few operations on the cached boxes, decides most
  * calls (+1 or -1) and returns MCI_UNCERTAIN otherwise; the second decides the rest.
+ * The boxes come first because for points close together but defined far away
+ * (consecutive points of a curve) the homogeneous determinant's bound grows with the
+ * distances to the defining vertices, while differences of the boxes stay small.
  * The first is inline: triangulation calls it millions of times.
  *
  * Its bound: each difference of centres is within e1 (q - p) or e2 (r - p) of the true

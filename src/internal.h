@@ -128,6 +128,8 @@ void mci_sort_u64(uint64_t *items, size_t n);
 void mci_radix_sort_u64_buffered(uint64_t *keys, uint64_t *tmp, size_t n);
 /* ... with the buffer allocated; false when it cannot be (keys unchanged). */
 bool mci_radix_sort_u64(const mci_ctx *ctx, uint64_t *keys, size_t n);
+/* Drops repeats from sorted keys[0 .. n) in place; returns how many are left. */
+size_t mci_unique_u64(uint64_t *keys, size_t n);
 /* Index of the first item with this key in sorted items[0 .. n), or n. */
 size_t mci_find_key(const mci_keyed *items, size_t n, uint64_t key);
 

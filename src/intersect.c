@@ -1512,7 +1512,7 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
 /* Every elementary edge of every arrangement, once (both faces along a curve have it). */
 static uint64_t *curve_edges(const mci_ctx *ctx, const mci_scene *s, size_t *count)
 {
-    size_t n = 0, out = 0;
+    size_t n = 0;
     uint64_t *keys;
     for (size_t k = 0; k < s->arr_count; k++)
         n += s->arrs[k].edge_count;
@@ -1527,10 +1527,7 @@ static uint64_t *curve_edges(const mci_ctx *ctx, const mci_scene *s, size_t *cou
         }
     }
     mci_sort_u64(keys, n);
-    for (size_t i = 0; i < n; i++)
-        if (out == 0 || keys[i] != keys[out - 1])
-            keys[out++] = keys[i];
-    *count = out;
+    *count = mci_unique_u64(keys, n);
     return keys;
 }
 

@@ -11,7 +11,6 @@
 #include "exact.h"
 #include "exact_kernel.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -284,7 +283,6 @@ typedef struct box_job {
     const mci_octree *t;
     float *box;
 } box_job;
-
 
 /* The face's box in doubles, from its corners. */
 static void exact_box(const double *const v[3], double box[6])
@@ -783,16 +781,10 @@ static mcsg_status bucket_task(void *user, size_t b, mcsg_error *err)
 {
     const bucket_job *j = user;
     uint64_t *keys = j->keys + j->start[b];
-    size_t n = j->start[b + 1] - j->start[b], out = 0;
+    size_t n = j->start[b + 1] - j->start[b];
     (void)err;
-    if (n <= 64)
-        mci_sort_u64(keys, n);
-    else
-        mci_radix_sort_u64_buffered(keys, j->scratch + j->start[b], n);
-    for (size_t i = 0; i < n; i++)
-        if (out == 0 || keys[i] != keys[out - 1])
-            keys[out++] = keys[i];
-    j->unique[b] = out;
+    mci_radix_sort_u64_buffered(keys, j->scratch + j->start[b], n);
+    j->unique[b] = mci_unique_u64(keys, n);
     return MCSG_OK;
 }
 

@@ -47,7 +47,7 @@ typedef struct cdt {
     uint32_t *vt; /* a triangle incident to each inserted point */
     double (*box)[3]; /* each point's projected box (mci_point_projected_box) */
     uint64_t *order; /* insertion order (see insertion_order) */
-    void *block;  /* t, vt and order in one allocation */
+    void *block;  /* box, order, t and vt in one allocation */
     uint64_t rng;
     queued_edge *queue;
     size_t queue_head, queue_len, queue_cap;

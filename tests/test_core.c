@@ -113,7 +113,7 @@ MCI_DEFINE_SORT(test_sort_u64, uint64_t, u64_before)
 
 /* mci_sort_u64 (sort_template.h's introsort), the template's heap sort and introsort
  * with a small recursion budget, and mci_radix_sort_u64, against qsort on the same
- * patterns. */
+ * patterns; mci_unique_u64 on the sorted result. */
 TEST(u64_sorts_match_qsort)
 {
     static const size_t sizes[] = {0, 1, 2, 3, 15, 16, 17, 18, 100, 1000, 50000};
@@ -148,6 +148,14 @@ TEST(u64_sorts_match_qsort)
                 CHECK_MSG(n == 0 || memcmp(got, ref, n * sizeof *got) == 0,
                           "size %zu pattern %d variant %d: order differs from qsort", n,
                           pattern, variant);
+                if (variant == 0) { /* mci_unique_u64 against a plain count of changes */
+                    size_t expected = 0, kept = mci_unique_u64(got, n);
+                    for (size_t i = 0; i < n; i++)
+                        expected += i == 0 || ref[i] != ref[i - 1];
+                    CHECK_EQ_SIZE(kept, expected);
+                    for (size_t i = 1; i < kept; i++)
+                        CHECK(got[i - 1] < got[i]);
+                }
             }
         }
         free(items);
