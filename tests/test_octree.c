@@ -306,37 +306,37 @@ static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_f
     mci_octree_free(&ctx, &tree);
 }
 
-TEST(two_offset_spheres)
+/* Two unit spheres of `segments` segments, the second moved by (dx, dy, dz): the scene
+ * checks with cells of at most max_faces faces; returns the scene's face count. */
+static size_t check_two_spheres(int segments, double dx, double dy, double dz,
+                                uint32_t max_faces, size_t min_pairs)
 {
     mcsg_mesh a, b;
-    mcsg_resolution res = {24, 0, 0};
+    mcsg_resolution res = {segments, 0, 0};
     mcsg_error err;
-    double shift[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.25, 0, 0, 1, 0};
+    double shift[12] = {1, 0, 0, dx, 0, 1, 0, dy, 0, 0, 1, dz};
+    size_t faces;
     CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &a, &err), &err);
     CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &b, &err), &err);
     mcsg_mesh_transform(&b, shift);
+    faces = a.triangle_count + b.triangle_count;
     const mcsg_mesh *leaves[2] = {&a, &b};
-    check_scene(leaves, 2, 8, 100);
+    check_scene(leaves, 2, max_faces, min_pairs);
     mcsg_mesh_free(&a, NULL);
     mcsg_mesh_free(&b, NULL);
+    return faces;
+}
+
+TEST(two_offset_spheres)
+{
+    check_two_spheres(24, 0.5, 0.25, 0, 8, 100);
 }
 
 /* Face ids up to 2^15 and thousands of pairs: the pair sort's buckets then span many
  * first faces and its radix passes run on every digit of both ids. */
 TEST(fine_spheres_large_face_ids)
 {
-    mcsg_mesh a, b;
-    mcsg_resolution res = {128, 0, 0};
-    mcsg_error err;
-    double shift[12] = {1, 0, 0, 0.3, 0, 1, 0, 0.2, 0, 0, 1, 0.1};
-    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &a, &err), &err);
-    CHECK_OK(mcsg_make_sphere(1.0, res, NULL, &b, &err), &err);
-    mcsg_mesh_transform(&b, shift);
-    CHECK(a.triangle_count + b.triangle_count > 30000);
-    const mcsg_mesh *leaves[2] = {&a, &b};
-    check_scene(leaves, 2, 48, 4000);
-    mcsg_mesh_free(&a, NULL);
-    mcsg_mesh_free(&b, NULL);
+    CHECK(check_two_spheres(128, 0.3, 0.2, 0.1, 48, 4000) > 30000);
 }
 
 TEST(coplanar_cubes_and_identical_spheres)
