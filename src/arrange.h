@@ -100,6 +100,11 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                          const double *a, const double *b, const double *c,
                          const mci_point *const corners[3], size_t max_coplanar,
                          size_t points, mcsg_error *err);
+/* An arrangement of the corners alone, as merged (a face dropped whole: nothing is
+ * added to it, and it is never tessellated). */
+mcsg_status mci_arr_init_corners(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
+                                 const double *a, const double *b, const double *c,
+                                 const mci_point *const corners[3], mcsg_error *err);
 void mci_arr_free(const mci_ctx *ctx, mci_face_arr *arr);
 /* Free the segments once they are no longer needed: after mci_arr_split (the edges
  * are built), or after the last merge of an arrangement that will not be split.

@@ -616,26 +616,55 @@ static void add_edge_sides(const mci_face_arr *arr, const uint32_t *gid, int e, 
     out[(*n)++] = (mci_keyed){mci_edge_key(gid[prev], gid[b]), 0};
 }
 
+/* The global point ids of arrangement arr. */
+static const uint32_t *arr_gids(const mci_scene *s, const mci_face_arr *arr)
+{
+    return s->gid + s->gid_start[arr - s->arrs];
+}
+
+/* Where the sides along edge e of face f, dropped whole, are listed: the edge of the
+ * arranged neighbour across that has pieces (its points on the edge are the ones its
+ * pieces end at; the dropped face has its corners only), else f's own edge (one side:
+ * the neighbour is untouched, a whole triangle, or dropped too). */
+static const mci_face_arr *wall_edge(const mci_scene *s, uint32_t f, int e, int *edge)
+{
+    const mci_face_arr *arr = arr_of_face(s, f), *across;
+    const uint32_t *gid = arr_gids(s, arr);
+    uint32_t nb = s->neighbour[3 * (size_t)f + (size_t)e];
+    uint64_t key = mci_edge_key(gid[e], gid[(e + 1) % 3]);
+    *edge = e;
+    if (nb == MCI_NONE || !(across = arr_of_face(s, nb)) || dropped_whole(s, nb))
+        return arr;
+    for (int i = 0; i < 3; i++) {
+        const uint32_t *g = arr_gids(s, across);
+        if (mci_edge_key(g[i], g[(i + 1) % 3]) == key) {
+            *edge = i;
+            return across;
+        }
+    }
+    return arr;
+}
+
 /* Pieces next to a face dropped whole have no piece across their side there: those
  * sides are walls (no region crosses them), known by their keys. */
 static mcsg_status collect_walls(leaf_work *w)
 {
     const mci_scene *s = w->s;
     size_t n = 0;
+    int edge;
     for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++)
-        n += dropped_whole(s, f) ? arr_of_face(s, f)->point_count + 3 : 0;
+        for (int e = 0; dropped_whole(s, f) && e < 3; e++)
+            n += wall_edge(s, f, e, &edge)->point_count + 1;
     if (n == 0)
         return MCSG_OK;
     w->walls = mci_malloc_array(w->ctx, n, sizeof *w->walls);
     if (!w->walls)
         return mci_fail_nomem(w->err, "classifying faces");
-    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++) {
-        const mci_face_arr *arr = arr_of_face(s, f);
-        if (!dropped_whole(s, f))
-            continue;
-        for (int e = 0; e < 3; e++)
-            add_edge_sides(arr, s->gid + s->gid_start[s->arr_of[f]], e, w->walls, &w->nwalls);
-    }
+    for (uint32_t f = w->face_base; f < w->face_base + w->face_count; f++)
+        for (int e = 0; dropped_whole(s, f) && e < 3; e++) {
+            const mci_face_arr *arr = wall_edge(s, f, e, &edge);
+            add_edge_sides(arr, arr_gids(s, arr), edge, w->walls, &w->nwalls);
+        }
     mci_sort_keyed(w->walls, w->nwalls);
     return MCSG_OK;
 }

@@ -498,8 +498,9 @@ static mcsg_status copies_meet_coplanar_faces(eval_state *e, bool *meet, mcsg_er
         return mci_fail_nomem(err, "comparing the leaves");
     for (size_t l = 0; l < n; l++)
         has_copies[e->alias[l]] |= e->alias[l] != l;
-    for (size_t k = 0; k < s->arr_count && !*meet; k++)
-        *meet = s->arrs[k].coplanar && has_copies[s->octree.face_leaf[s->arrs[k].face]];
+    for (uint32_t f = 0; f < s->face_count && !*meet; f++)
+        *meet = s->arr_of[f] != MCI_NONE && (s->arr_contact[s->arr_of[f]] & MCI_CONTACT_COPLANAR) &&
+                has_copies[s->octree.face_leaf[f]];
     mci_free(&e->ctx, has_copies);
     return MCSG_OK;
 }
@@ -511,7 +512,7 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
     bool coplanar = false;
     mcsg_status st = find_copies(e, err);
     if (st == MCSG_OK)
-        st = mci_scene_build_unsplit(&e->ctx, leaves, e->tree.leaf_count, e->alias, &e->scene,
+        st = mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, e->alias, &e->scene,
                                      err);
     if (st == MCSG_OK && e->alias)
         st = copies_meet_coplanar_faces(e, &coplanar, err);
@@ -521,10 +522,11 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
     mci_free(&e->ctx, e->alias);
     e->alias = NULL;
     e->stats.copied_primitives = 0;
-    return mci_scene_build_unsplit(&e->ctx, leaves, e->tree.leaf_count, NULL, &e->scene, err);
+    return mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, NULL, &e->scene, err);
 }
 
-/* Faces that the result drops whole are found before splitting, which they then skip. */
+/* Faces that the result drops whole are found from the pair tests, before anything is
+ * built for them: their arrangements keep their corners only, and are not split. */
 static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
 {
     mcsg_status st = build_scene(e, err);
@@ -533,6 +535,8 @@ static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
         st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,
                                     err);
     e->stats.seconds_whole_faces = mci_seconds_now() - t0;
+    if (st == MCSG_OK)
+        st = mci_scene_arrange(&e->ctx, &e->scene, err);
     if (st == MCSG_OK)
         st = mci_scene_split(&e->ctx, &e->scene, e->scene.arr_dropped, err);
     if (st == MCSG_OK)

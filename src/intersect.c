@@ -767,11 +767,11 @@ typedef struct arrange_job {
  * meets the other plane strictly inside that edge (the pair test builds such points
  * only for edges whose ends lie strictly on both sides), and an end flagged in
  * mci_tt_result.strict_ends lies strictly inside f. */
-static uint8_t end_location(const mci_scene *s, uint32_t f, const mci_point *p,
+static uint8_t end_location(const double *const corner[3], const mci_point *p,
                             bool strictly_inside)
 {
     for (int e = 0; p->kind == MCI_POINT_LPI && e < 3; e++) {
-        const double *u = mci_scene_corner(s, f, e), *w = mci_scene_corner(s, f, (e + 1) % 3);
+        const double *u = corner[e], *w = corner[(e + 1) % 3];
         if ((p->v[0] == u && p->v[1] == w) || (p->v[0] == w && p->v[1] == u))
             return (uint8_t)(MCI_AT_EDGE + e);
     }
@@ -783,6 +783,7 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
     const mci_scene *s = j->s;
     uint32_t other = h->f == arr->face ? h->g : h->f;
     const mci_plane *plane = &j->planes->planes[j->planes->slot[other]];
+    const double *const corner[3] = {arr->plane.a, arr->plane.b, arr->plane.c};
     bool crease[3];
     uint8_t where[2];
     const mci_point *a, *b;
@@ -792,8 +793,8 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const pair_hit *h)
         b = a ? hit_end(j->ctx, s, j->vt, arr, h, 1) : NULL;
         if (!b)
             return false;
-        where[0] = end_location(s, arr->face, a, h->strict_ends & 1);
-        where[1] = end_location(s, arr->face, b, h->strict_ends & 2);
+        where[0] = end_location(corner, a, h->strict_ends & 1);
+        where[1] = end_location(corner, b, h->strict_ends & 2);
         return mci_arr_add_crossing(j->ctx, arr, a, b, other, plane, j->ff->plane_rep[other],
                                     s->octree.face_leaf[other],
                                     h->along_edge[h->f == arr->face ? 1 : 0], where);
@@ -836,6 +837,12 @@ static mcsg_status arrange_face(const arrange_job *j, uint32_t f, const uint32_t
     return st == MCSG_OK ? mci_arr_merge(j->ctx, arr, err) : st;
 }
 
+/* Whether arrangement k is a face dropped whole (corners only: see mci_scene_arrange). */
+static bool is_dropped(const mci_scene *s, size_t k)
+{
+    return s->arr_dropped && s->arr_dropped[k];
+}
+
 /* Faces that are untouched themselves but receive a point on an edge. */
 static void mark_receivers(const mci_scene *s, bool *needs)
 {
@@ -852,22 +859,47 @@ static void mark_receivers(const mci_scene *s, bool *needs)
     }
 }
 
+/* A per-arrangement flag array (NULL: none) renumbered with the arrangements: new
+ * index i was old_of[i], or is a receiver (MCI_NONE: flags 0). */
+static bool renumber_flags(const mci_ctx *ctx, uint8_t **flags, const uint32_t *old_of,
+                           size_t n)
+{
+    uint8_t *fresh;
+    if (!*flags)
+        return true;
+    if (!(fresh = mci_calloc_array(ctx, n + 1, 1)))
+        return false;
+    for (size_t i = 0; i < n; i++)
+        if (old_of[i] != MCI_NONE)
+            fresh[i] = (*flags)[old_of[i]];
+    mci_free(ctx, *flags);
+    *flags = fresh;
+    return true;
+}
+
 /* Rebuild arrs in face order with new (empty) arrangements for the marked faces. */
 static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const vertex_table *vt,
                                  const bool *needs, mcsg_error *err)
 {
     size_t extra = 0, k = 0, out = 0;
     mci_face_arr *all;
+    uint32_t *old_of;
     mcsg_status st = MCSG_OK;
     for (size_t f = 0; f < s->face_count; f++)
         extra += needs[f];
     if (extra == 0)
         return MCSG_OK;
     all = mci_calloc_array(ctx, s->arr_count + extra, sizeof *all);
-    if (!all)
+    old_of = mci_malloc_array(ctx, s->arr_count + extra, sizeof *old_of);
+    if (!all || !old_of) {
+        mci_free(ctx, all);
+        mci_free(ctx, old_of);
         return mci_fail_nomem(err, "arranging faces");
+    }
     for (uint32_t f = 0; f < s->face_count; f++) {
+        old_of[out] = MCI_NONE;
         if (s->arr_of[f] != MCI_NONE) {
+            old_of[out] = (uint32_t)k;
             all[out] = s->arrs[k++];
         } else if (needs[f] && st == MCSG_OK) {
             const mci_point *corners[3];
@@ -882,6 +914,10 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const vertex_
     mci_free(ctx, s->arrs);
     s->arrs = all;
     s->arr_count = out;
+    if (st == MCSG_OK && (!renumber_flags(ctx, &s->arr_dropped, old_of, out) ||
+                          !renumber_flags(ctx, &s->arr_contact, old_of, out)))
+        st = mci_fail_nomem(err, "arranging faces");
+    mci_free(ctx, old_of);
     return st;
 }
 
@@ -908,8 +944,8 @@ static mci_face_arr *share_target(const mci_scene *s, const mci_face_arr *arr, s
     if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
         return NULL;
     nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
-    if (nb == MCI_NONE)
-        return NULL;
+    if (nb == MCI_NONE || is_dropped(s, s->arr_of[nb]))
+        return NULL; /* a face dropped whole has no pieces to join (see collect_walls) */
     t = &s->arrs[s->arr_of[nb]];
     return has_edge_point(t, arr->points[p]) ? NULL : t;
 }
@@ -1001,6 +1037,12 @@ static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
 {
     const arrange_job *j = user;
     uint32_t f = j->face_of[k];
+    const mci_point *corners[3];
+    if (is_dropped(j->s, k))
+        return mci_arr_init_corners(j->ctx, &j->s->arrs[k], f, mci_scene_corner(j->s, f, 0),
+                                    mci_scene_corner(j->s, f, 1), mci_scene_corner(j->s, f, 2),
+                                    corner_points(j->s, j->vt, f, corners) ? corners : NULL,
+                                    err);
     return arrange_face(j, f, j->list + j->start[f], j->start[f + 1] - j->start[f],
                         &j->s->arrs[k], err);
 }
@@ -1010,6 +1052,8 @@ static mcsg_status arrange_one(void *user, size_t k, mcsg_error *err)
 static uint32_t arrange_cost(const void *user, size_t k)
 {
     const arrange_job *j = user;
+    if (is_dropped(j->s, k))
+        return 0;
     return j->start[j->face_of[k] + 1] - j->start[j->face_of[k]];
 }
 
@@ -1112,42 +1156,156 @@ static void free_hits(const mci_ctx *ctx, hit_list *hits)
     memset(hits, 0, sizeof *hits);
 }
 
-/* Consumes the hits and the plane cache: both are freed as soon as the faces have taken
- * their records, before the arrangements grow (splitting, edge points), except the
- * hits' point blocks, which move to the scene (the arrangements refer to them). */
-static mcsg_status build_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list *hits,
-                                      plane_cache *planes, mcsg_error *err)
+/* The pair tests' records from mci_scene_build_touched to mci_scene_arrange. */
+struct mci_scene_pending {
+    hit_list hits;
+    plane_cache planes;
+    face_facts ff;
+    uint32_t *start, *list; /* index_hits */
+    uint32_t *face_of;      /* arrangement -> face */
+    vertex_table vt;        /* its points belong to the scene (vertex_points) */
+};
+
+/* Everything but the hits' point blocks, which the arrangements refer to. */
+static void free_pending_records(const mci_ctx *ctx, struct mci_scene_pending *pd)
 {
-    uint32_t *start = NULL, *list = NULL, *face_of = NULL;
-    face_facts ff = {NULL, NULL};
-    vertex_table vt = {NULL, NULL, NULL};
-    arrange_job job = {ctx, s, hits, NULL, NULL, NULL, &ff, planes, &vt};
-    mcsg_status st = MCSG_OK;
-    if (!compute_face_facts(ctx, s, hits, planes, &ff) ||
-        !index_hits(ctx, s, hits, &start, &list) ||
-        !number_arranged_faces(ctx, s, start, &face_of) ||
-        !record_touches(ctx, s, hits, start, list) || !build_vertex_table(ctx, s, face_of, &vt))
-        st = mci_fail_nomem(err, "arranging faces");
-    s->vertex_points = vt.points; /* the arrangements refer to them */
-    job.start = start;
-    job.list = list;
-    job.face_of = face_of;
+    free_hits(ctx, &pd->hits);
+    free_plane_cache(ctx, &pd->planes);
+    free_face_facts(ctx, &pd->ff);
+    mci_free(ctx, pd->start);
+    mci_free(ctx, pd->list);
+    mci_free(ctx, pd->face_of);
+    pd->start = pd->list = pd->face_of = NULL;
+}
+
+static void free_pending(const mci_ctx *ctx, mci_scene *s)
+{
+    if (!s->pending)
+        return;
+    free_pending_records(ctx, s->pending);
+    free_vertex_map(ctx, &s->pending->vt);
+    mci_free(ctx, s->pending);
+    s->pending = NULL;
+}
+
+/* Edges of face f (corners c) whose closed segment holds end k of hit h (bit e: edge
+ * e). The end lies in f, as in the other face of the hit; where neither the pair test
+ * nor the point's definition tells, an exact zero of its orientation against an edge's
+ * line puts it on that edge (what merging the arrangement would find). */
+static uint8_t end_edges(const plane_cache *planes, uint32_t f, const double *const c[3],
+                         const pair_hit *h, int k)
+{
+    mci_point vertex, corner[3];
+    const mci_point *p = &vertex;
+    uint8_t mask = 0;
+    int axis, sign;
+    if ((h->stored >> k) & 1) {
+        uint8_t where = end_location(c, p = h->point[k].at, (h->strict_ends >> k) & 1);
+        if (where == MCI_AT_INSIDE)
+            return 0;
+        if (where != MCI_AT_UNKNOWN)
+            return (uint8_t)(1u << (where - MCI_AT_EDGE));
+    } else {
+        mci_point_explicit(&vertex, h->vertex[k]);
+    }
+    axis = mci_plane_projection_axis(&planes->planes[planes->slot[f]], &sign);
+    if (axis < 0)
+        return 7; /* cannot happen (faces in hits are not degenerate): keep the face */
+    for (int e = 0; e < 3; e++)
+        mci_point_explicit(&corner[e], c[e]);
+    for (int e = 0; e < 3; e++)
+        if (mci_orient2d_projected(&corner[e], &corner[(e + 1) % 3], p, axis) == 0)
+            mask |= (uint8_t)(1u << e);
+    return mask;
+}
+
+/* MCI_CONTACT_* of face f from its hits, as its arrangement would show them: a coplanar
+ * face added, or a crossing segment with both ends on one closed edge (one that merges
+ * to a single point counts too: the face is then kept, which is always safe). */
+static uint8_t face_contact(const mci_scene *s, const struct mci_scene_pending *pd,
+                            uint32_t f)
+{
+    const double *c[3] = {mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
+                          mci_scene_corner(s, f, 2)};
+    uint8_t contact = 0;
+    for (uint32_t i = pd->start[f]; i < pd->start[f + 1]; i++) {
+        const pair_hit *h = &pd->hits.v[pd->list[i]];
+        uint8_t a;
+        if (h->kind != MCI_TT_SEGMENT && h->kind != MCI_TT_POINT)
+            contact |= MCI_CONTACT_COPLANAR;
+        else if (h->kind == MCI_TT_SEGMENT && !(contact & MCI_CONTACT_BORDER) &&
+                 (a = end_edges(&pd->planes, f, c, h, 0)) != 0 &&
+                 (a & end_edges(&pd->planes, f, c, h, 1)) != 0)
+            contact |= MCI_CONTACT_BORDER;
+    }
+    return contact;
+}
+
+enum { CONTACT_CHUNK = 1024 };
+
+static mcsg_status contact_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    mci_scene *s = user;
+    size_t end = mci_chunk_end(s->arr_count, chunk, CONTACT_CHUNK);
+    (void)err;
+    for (size_t k = chunk * CONTACT_CHUNK; k < end; k++)
+        s->arr_contact[k] = face_contact(s, s->pending, s->pending->face_of[k]);
+    return MCSG_OK;
+}
+
+/* Takes the hits and the plane cache into s->pending, with what arranging will need:
+ * face facts, the hit index, arrangement numbers, touch lists, the vertex table and
+ * each face's contacts. */
+static mcsg_status prepare_arrangements(const mci_ctx *ctx, mci_scene *s, hit_list *hits,
+                                        plane_cache *planes, mcsg_error *err)
+{
+    struct mci_scene_pending *pd = mci_calloc_array(ctx, 1, sizeof *pd);
+    if (!pd)
+        return mci_fail_nomem(err, "arranging faces");
+    pd->hits = *hits;
+    pd->planes = *planes;
+    memset(hits, 0, sizeof *hits);
+    planes->slot = NULL;
+    planes->planes = NULL;
+    s->pending = pd;
+    if (!compute_face_facts(ctx, s, &pd->hits, &pd->planes, &pd->ff) ||
+        !index_hits(ctx, s, &pd->hits, &pd->start, &pd->list) ||
+        !number_arranged_faces(ctx, s, pd->start, &pd->face_of) ||
+        !record_touches(ctx, s, &pd->hits, pd->start, pd->list) ||
+        !build_vertex_table(ctx, s, pd->face_of, &pd->vt) ||
+        !(s->arr_contact = mci_malloc_array(ctx, s->arr_count + 1, 1))) {
+        s->vertex_points = pd->vt.points;
+        return mci_fail_nomem(err, "arranging faces");
+    }
+    s->vertex_points = pd->vt.points; /* the arrangements refer to them */
+    return mci_parallel_for(ctx, (s->arr_count + CONTACT_CHUNK - 1) / CONTACT_CHUNK,
+                            contact_chunk, s, err);
+}
+
+/* The hits and the plane cache are freed as soon as the faces have taken their records,
+ * before the arrangements grow (splitting, edge points), except the hits' point blocks,
+ * which move to the scene (the arrangements refer to them). */
+mcsg_status mci_scene_arrange(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    struct mci_scene_pending *pd = s->pending;
+    arrange_job job;
+    mcsg_status st;
+    if (!pd)
+        return mci_fail(err, MCSG_ERR_INTERNAL, "arranging a scene twice");
+    job = (arrange_job){ctx, s, &pd->hits, pd->start, pd->list, pd->face_of, &pd->ff,
+                        &pd->planes, &pd->vt};
+    st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one, &job,
+                                         err);
+    s->hit_blocks = pd->hits.blocks;
+    s->hit_block_count = pd->hits.block_count;
+    pd->hits.blocks = NULL;
+    pd->hits.block_count = 0;
+    free_pending_records(ctx, pd);
     if (st == MCSG_OK)
-        st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one, &job,
-                                             err);
-    s->hit_blocks = hits->blocks; /* the arrangements refer to them */
-    s->hit_block_count = hits->block_count;
-    hits->blocks = NULL;
-    hits->block_count = 0;
-    free_hits(ctx, hits);
-    free_plane_cache(ctx, planes);
-    free_face_facts(ctx, &ff);
-    mci_free(ctx, start);
-    mci_free(ctx, list);
-    mci_free(ctx, face_of);
-    if (st == MCSG_OK)
-        st = share_edge_points(ctx, s, &vt, err);
-    free_vertex_map(ctx, &vt);
+        st = share_edge_points(ctx, s, &pd->vt, err);
+    free_pending(ctx, s);
+    s->stats.seconds_arrange += mci_seconds_now() - t0;
     return st;
 }
 
@@ -1190,7 +1348,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
     if (st == MCSG_OK)
         st = build_neighbours(ctx, s, &hits, err);
     if (st == MCSG_OK)
-        st = build_arrangements(ctx, s, &hits, &planes, err);
+        st = prepare_arrangements(ctx, s, &hits, &planes, err);
     free_hits(ctx, &hits);
     free_plane_cache(ctx, &planes);
     s->stats.seconds_pairs = t1 - t0;
@@ -1203,8 +1361,13 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build_unsplit(ctx, leaves, leaf_count, NULL, scene, err);
-    if (st == MCSG_OK && (st = mci_scene_split(ctx, scene, NULL, err)) != MCSG_OK)
+    mcsg_status st = mci_scene_build_touched(ctx, leaves, leaf_count, NULL, scene, err);
+    if (st != MCSG_OK)
+        return st;
+    st = mci_scene_arrange(ctx, scene, err);
+    if (st == MCSG_OK)
+        st = mci_scene_split(ctx, scene, NULL, err);
+    if (st != MCSG_OK)
         mci_scene_free(ctx, scene);
     return st;
 }
@@ -1214,7 +1377,7 @@ uint32_t mci_scene_leaf_stand_in(const mci_scene *s, uint32_t m)
     return s->alias ? s->alias[m] : m;
 }
 
-mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
                                     mci_scene *scene, mcsg_error *err)
 {
@@ -1259,6 +1422,8 @@ void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);
+    mci_free(ctx, scene->arr_contact);
+    free_pending(ctx, scene);
     free_point_blocks(ctx, scene->hit_blocks, scene->hit_block_count);
     mci_free(ctx, scene->vertex_points);
     scene->hit_blocks = NULL;
@@ -1266,7 +1431,7 @@ void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
     scene->vertex_points = NULL;
     scene->arrs = NULL;
     scene->arr_of = scene->neighbour = scene->gid_start = scene->gid = NULL;
-    scene->explicit_slot = scene->arr_dropped = NULL;
+    scene->explicit_slot = scene->arr_dropped = scene->arr_contact = NULL;
     scene->touch_start = scene->touch_leaf = NULL;
     scene->arr_count = scene->point_count = 0;
     mci_octree_free_cells(ctx, &scene->octree);

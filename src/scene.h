@@ -37,14 +37,28 @@ typedef struct mci_scene {
      * touch_start[f + 1]), from the pair tests (which report every contact, so a face
      * whose list lacks a leaf does not meet that leaf's surface). */
     uint32_t *touch_start, *touch_leaf;
+    /* Per arrangement: MCI_CONTACT_* flags from the pair tests (mci_scene_build_touched),
+     * what the whole-face decision must know before any arrangement is built. */
+    uint8_t *arr_contact;
     /* Per arrangement: 1 when the face is dropped whole (mci_decide_whole_faces; NULL
-     * before): it is not split nor tessellated, and has no pieces. */
+     * before): its arrangement holds its corners only, it is not split nor tessellated,
+     * and has no pieces. */
     uint8_t *arr_dropped;
+    /* The pair tests' records between mci_scene_build_touched and mci_scene_arrange
+     * (intersect.c); NULL outside. */
+    struct mci_scene_pending *pending;
     /* Per leaf (NULL: none): the leaf it is a copy of (itself if none). A copy's faces
      * are left out of the octree: the leaf it copies stands for it (see eval.c). */
     const uint32_t *alias;
     mcsg_intersect_stats stats;
 } mci_scene;
+
+/* Contacts of a touched face that the whole-face decision needs (arr_contact). */
+enum {
+    MCI_CONTACT_COPLANAR = 1, /* a coplanar face of another leaf overlaps it */
+    MCI_CONTACT_BORDER = 2    /* a crossing segment has both ends on one of its closed
+                                 edges: another surface meets it along its border */
+};
 
 /* Build the octree over the leaves (which must outlive the scene), intersect, and build
  * and split every touched face's arrangement. Leaves must be closed and edge-manifold
@@ -52,17 +66,27 @@ typedef struct mci_scene {
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err);
 
-/* mci_scene_build in two steps: everything but the splitting, then the splitting of
- * the arrangements k without skip[k] (skip may be NULL); skipped ones are only merged,
- * so that their points and locations are final (their faces will not be tessellated
- * with their constraints: see mci_decide_whole_faces). Splitting frees every
- * arrangement's segments (only the elementary edges are used after it). */
-mcsg_status mci_scene_build_unsplit(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
+/* mci_scene_build in three steps. First the octree, the pair tests and what they tell
+ * each touched face (arr_of, touch lists, neighbours, arr_contact), their records kept
+ * in `pending`; alias (NULL: none) names each leaf's stand-in (see mci_scene.alias).
+ * Faces dropped whole can be decided then (mci_decide_whole_faces), before anything is
+ * built for them. */
+mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
                                     mci_scene *scene, mcsg_error *err);
 
+/* Second, the arrangements from the pending records (then freed): those flagged in
+ * arr_dropped (if any) get their corners only, and neither give nor receive points on
+ * their edges; the others get their crossings, merged, and the points on their edges
+ * that the face across lacks. */
+mcsg_status mci_scene_arrange(const mci_ctx *ctx, mci_scene *scene, mcsg_error *err);
+
 /* The leaf that stands for leaf m (m itself unless it is a copy). */
 uint32_t mci_scene_leaf_stand_in(const mci_scene *scene, uint32_t m);
+
+/* Third, the splitting of the arrangements k without skip[k] (skip may be NULL); skipped
+ * ones are only merged if they received points. Splitting frees every arrangement's
+ * segments (only the elementary edges are used after it). */
 mcsg_status mci_scene_split(const mci_ctx *ctx, mci_scene *scene, const uint8_t *skip,
                             mcsg_error *err);
 

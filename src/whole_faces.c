@@ -1,6 +1,6 @@
 /*
- * Faces dropped whole, decided before they are split (paper §5.2-5.3: the second trimmed
- * tree of a group of faces decides it without sub-face work).
+ * Faces dropped whole, decided from the pair tests before they are arranged (paper
+ * §5.2-5.3: the second trimmed tree of a group of faces decides it without sub-face work).
  *
  * A touched face meets the surfaces of a few leaves only (mci_scene's touch lists: the
  * pair tests report every contact). With respect to any other leaf M the face lies wholly
@@ -8,7 +8,7 @@
  * faces that do not meet M either (their union is connected and misses M's surface).
  * Those labels alone often decide the face: buried in a leaf that a union adds, or
  * outside one that an intersection keeps, it is dropped whatever the leaves crossing it
- * say. Such a face needs no splitting, no tessellation with its constraints, and no
+ * say. Such a face needs no arrangement, no tessellation with its constraints, and no
  * classification of its pieces: on ring + 800 spheres, 44K of 92K touched faces.
  *
  * For a leaf P and each leaf M that P's trimmed CSGlist reads (mci_blist), the faces of
@@ -287,36 +287,19 @@ static bool may_accept(leaf_decision *d, size_t i, bool *accepts)
     return true;
 }
 
-/* Whether a point at `where` lies on the closed edge e (corner e to corner e + 1). */
-static bool on_closed_edge(uint8_t where, int e)
-{
-    return where == MCI_AT_EDGE + e || where == MCI_AT_CORNER + e ||
-           where == MCI_AT_CORNER + (e + 1) % 3;
-}
-
 /* Whether the face's pieces may carry what a neighbour's classification needs, so that
  * it must not be dropped whole (its neighbours' sides along it become walls, which no
- * region crosses):
- * - another surface meets it along part of its border (a constraint segment with both
- *   ends on one edge): once split, it has elementary edges there, and the neighbour
- *   across reads them as separators (its own arrangement may have none there, when it
- *   is coplanar with that surface);
+ * region crosses), from its contacts (mci_scene.arr_contact):
+ * - another surface meets it along part of its border (a crossing with both ends on
+ *   one edge): once split, it has elementary edges there, and the neighbour across
+ *   reads them as separators (its own arrangement may have none there, when it is
+ *   coplanar with that surface);
  * - it lies in another leaf's surface (a coplanar face): a neighbour in the same plane
  *   has no side of that leaf to test along their common edge, and its regions take
  *   their label from across it, from where the flat part of the surface ends. */
-static bool must_keep_pieces(const mci_face_arr *arr)
+static bool must_keep_pieces(const mci_scene *s, uint32_t f)
 {
-    if (arr->coplanar)
-        return true;
-    for (size_t k = 0; k < arr->segment_count; k++) {
-        const mci_arr_segment *g = &arr->segments[k];
-        if (g->phantom)
-            continue;
-        for (int e = 0; e < 3; e++)
-            if (on_closed_edge(arr->where[g->a], e) && on_closed_edge(arr->where[g->b], e))
-                return true;
-    }
-    return false;
+    return s->arr_contact[s->arr_of[f]] != 0;
 }
 
 /* Flag the touched faces that no value of their unknown labels would keep. */
@@ -326,7 +309,7 @@ static bool flag_dropped(leaf_decision *d, size_t *n)
     *n = 0;
     for (size_t i = 0; i < d->nfaces; i++) {
         bool accepts;
-        if (must_keep_pieces(&s->arrs[s->arr_of[d->faces[i]]]))
+        if (must_keep_pieces(s, d->faces[i]))
             continue;
         if (!may_accept(d, i, &accepts))
             return false;

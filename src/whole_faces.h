@@ -10,9 +10,10 @@
 /* Marks in scene->arr_dropped (allocated here, one flag per arrangement) the touched
  * faces that the result drops entirely: their labels with respect to the leaves whose
  * surfaces they do not meet already reject them, whatever the other labels are. Works on
- * a scene built without splitting (mci_scene_build_unsplit); the flagged faces then need
- * no splitting (mci_scene_split's skip), no tessellation and no classification of their
- * pieces. *count receives the number flagged. */
+ * a scene whose faces are not arranged yet (mci_scene_build_touched); the flagged faces
+ * then need no arrangement (mci_scene_arrange gives them their corners only), no
+ * tessellation and no classification of their pieces. *count receives the number
+ * flagged. */
 mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *scene, const mci_ptree *tree,
                                    size_t *count, mcsg_error *err);
 

@@ -198,16 +198,49 @@ static void check_curves_on_both_surfaces(const mci_scene *s, size_t *pieces)
     }
 }
 
+/* Whether point location `where` is on the closed edge e (corner e to corner e + 1). */
+static bool on_closed_edge(uint8_t where, int e)
+{
+    return where == MCI_AT_EDGE + e || where == MCI_AT_CORNER + e ||
+           where == MCI_AT_CORNER + (e + 1) % 3;
+}
+
+/* The contacts the pair tests gave each face before it was arranged (arr_contact, read
+ * by the whole-face decision) are what its merged arrangement shows: a coplanar face
+ * added, and a crossing segment with both ends on one closed edge. count[i]: faces with
+ * contact bit i. */
+static void check_contacts(const mci_scene *s, size_t count[2])
+{
+    for (size_t k = 0; k < s->arr_count; k++) {
+        const mci_face_arr *arr = &s->arrs[k];
+        uint8_t shown = arr->coplanar ? MCI_CONTACT_COPLANAR : 0;
+        for (size_t g = 0; g < arr->segment_count; g++)
+            for (int e = 0; e < 3 && !arr->segments[g].phantom; e++)
+                if (on_closed_edge(arr->where[arr->segments[g].a], e) &&
+                    on_closed_edge(arr->where[arr->segments[g].b], e))
+                    shown |= MCI_CONTACT_BORDER;
+        CHECK_MSG(s->arr_contact[k] == shown, "face %u: contacts %u from the pair tests, %u "
+                  "in its arrangement", arr->face, s->arr_contact[k], shown);
+        for (int i = 0; i < 2; i++)
+            count[i] += (shown >> i) & 1;
+    }
+}
+
 static void check_scene(scene_case *c, const char *name, bool generic)
 {
     mci_ctx ctx;
     mci_scene s;
     mcsg_error err;
-    size_t pieces = 0;
+    size_t pieces = 0, contacts[2] = {0, 0};
     mci_ctx_init(&ctx, NULL);
     for (size_t i = 0; i < c->leaf_count; i++)
         c->leaves[i] = mcsg_tree_leaf_mesh(c->tree, c->ids[i]);
-    CHECK_OK(mci_scene_build(&ctx, c->leaves, c->leaf_count, &s, &err), &err);
+    /* mci_scene_build's steps, to see the arrangements before splitting frees their
+     * segments. */
+    CHECK_OK(mci_scene_build_touched(&ctx, c->leaves, c->leaf_count, NULL, &s, &err), &err);
+    CHECK_OK(mci_scene_arrange(&ctx, &s, &err), &err);
+    check_contacts(&s, contacts);
+    CHECK_OK(mci_scene_split(&ctx, &s, NULL, &err), &err);
     CHECK_OK(mci_scene_number_points(&ctx, &s, &err), &err);
     for (size_t k = 0; k < s.arr_count; k++) {
         CHECK_OK(mci_arr_triangulate(&ctx, &s.arrs[k], NULL, &err), &err);
@@ -217,8 +250,9 @@ static void check_scene(scene_case *c, const char *name, bool generic)
         check_leaf_closed(&s, leaf);
     if (generic)
         check_curves_on_both_surfaces(&s, &pieces);
-    printf("  %s: %zu faces, %zu arranged, %zu points, %zu crossing pieces\n", name,
-           s.face_count, s.arr_count, s.point_count, pieces);
+    printf("  %s: %zu faces, %zu arranged (%zu meet a coplanar face, %zu a surface along an "
+           "edge), %zu points, %zu crossing pieces\n", name, s.face_count, s.arr_count,
+           contacts[0], contacts[1], s.point_count, pieces);
     mci_scene_free(&ctx, &s);
     mcsg_tree_free(c->tree);
     memset(c, 0, sizeof *c);
