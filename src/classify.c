@@ -1364,9 +1364,30 @@ static void finish_copy_labels(leaf_work *w)
  * OUT for all its faces. CSGlist entries that this decides are dropped when desired and
  * reject the whole leaf when not; the candidates outside the remaining entries need no
  * labels at all (the paper's pseudo-IPs). */
+#ifndef NDEBUG
+/* Debug builds check a list made by the whole-face decision against the trimming here. */
+static mcsg_status check_trimmed_list(leaf_work *w, const mci_trimmed_list *made)
+{
+    mci_csg_entry *list = mci_malloc_array(w->ctx, w->cl->tree->node_count + 1, sizeof *list);
+    bool rejected, same;
+    size_t n;
+    if (!list)
+        return mci_fail_nomem(w->err, "classifying faces");
+    n = mci_csglist_trim(w->cl->tree, w->leaf, w->leaf_labels, w->scratch, list, &rejected);
+    same = rejected == made->rejected && (rejected || n == made->count);
+    for (size_t i = 0; same && !rejected && i < n; i++)
+        same = list[i].node == made->list[i].node && list[i].desired == made->list[i].desired;
+    mci_free(w->ctx, list);
+    return same ? MCSG_OK
+                : mci_fail(w->err, MCSG_ERR_INTERNAL, "primitive %u: the trimmed CSGlist "
+                           "handed on differs from its own", w->leaf);
+}
+#endif
+
 static mcsg_status trim_csglist(leaf_work *w)
 {
     const mci_ptree *t = w->cl->tree;
+    mci_trimmed_list *made = w->cl->trimmed ? &w->cl->trimmed[w->leaf] : NULL;
     int32_t *cover = mci_calloc_array(w->ctx, t->node_count + 2, sizeof *cover);
     w->list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->list);
     w->scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->scratch);
@@ -1380,7 +1401,21 @@ static mcsg_status trim_csglist(leaf_work *w)
         w->leaf_labels[l] = MCI_LABEL_OUT;
     for (size_t c = 0; c < w->ncand; c++)
         w->leaf_labels[w->cand[c]] = MCI_LABEL_UNKNOWN;
-    w->nlist = mci_csglist_trim(t, w->leaf, w->leaf_labels, w->scratch, w->list, &w->rejected);
+    if (made && made->valid) { /* the same labels made it: every other leaf is a candidate */
+#ifndef NDEBUG
+        mcsg_status checked = check_trimmed_list(w, made);
+        if (checked != MCSG_OK) {
+            mci_free(w->ctx, cover);
+            return checked;
+        }
+#endif
+        memcpy(w->list, made->list, made->count * sizeof *w->list);
+        w->nlist = made->count;
+        w->rejected = made->rejected;
+    } else {
+        w->nlist = mci_csglist_trim(t, w->leaf, w->leaf_labels, w->scratch, w->list,
+                                    &w->rejected);
+    }
     if (!w->rejected)
         cover_entries(t, w->list, w->nlist, cover);
     if (trim_copy_lists(w, cover) != MCSG_OK) {
@@ -1392,8 +1427,13 @@ static mcsg_status trim_csglist(leaf_work *w)
     for (size_t c = 0; c < w->ncand; c++)
         w->needed[c] = cover[t->leaf_node[w->cand[c]]] > 0;
     mci_free(w->ctx, cover);
-    if (!w->rejected && !mci_blist_build(w->ctx, t, w->list, w->nlist, w->leaf_labels, &w->blist))
+    if (made && made->valid && !w->rejected) { /* taken over: freed with the leaf's work */
+        w->blist = made->blist;
+        memset(&made->blist, 0, sizeof made->blist);
+    } else if (!w->rejected &&
+               !mci_blist_build(w->ctx, t, w->list, w->nlist, w->leaf_labels, &w->blist)) {
         return mci_fail_nomem(w->err, "classifying faces");
+    }
     return MCSG_OK;
 }
 

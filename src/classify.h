@@ -37,6 +37,9 @@ typedef struct mci_classifier {
     /* Copies (scene->alias): copy_of[copy_start[l] .. copy_start[l + 1]) are the leaves
      * that are copies of leaf l, in increasing order (NULL when there is none). */
     uint32_t *copy_start, *copy_of;
+    /* Per leaf (NULL: none): its trimmed CSGlist and Blist if an earlier pass made them
+     * (mci_decide_whole_faces); the leaf's classification takes them over. Not owned. */
+    mci_trimmed_list *trimmed;
 } mci_classifier;
 
 /* The bounding box of a mesh's vertices: lo[3], hi[3] (zeros for an empty mesh). */

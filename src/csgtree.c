@@ -405,3 +405,12 @@ int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels)
     }
     return at == MCI_BLIST_ACCEPT;
 }
+
+void mci_trimmed_lists_clear(const mci_ctx *ctx, mci_trimmed_list *lists, size_t n)
+{
+    for (size_t i = 0; lists && i < n; i++) {
+        mci_free(ctx, lists[i].list);
+        mci_blist_free(ctx, &lists[i].blist);
+        memset(&lists[i], 0, sizeof lists[i]);
+    }
+}

@@ -134,4 +134,18 @@ void mci_blist_free(const mci_ctx *ctx, mci_blist *b);
  * mci_csglist_accepts). */
 int mci_blist_accepts(const mci_blist *b, const mci_label *leaf_labels);
 
+/* A leaf's CSGlist trimmed by the leaves whose boxes miss its box (every other leaf
+ * UNKNOWN), and its Blist, made by one pass for a later one (see whole_faces.h): the same
+ * lists cost the same walk over the whole tree each time, O(nodes) per leaf. `valid` when
+ * made; no blist when rejected. */
+typedef struct mci_trimmed_list {
+    mci_csg_entry *list;
+    size_t count;
+    bool valid, rejected;
+    mci_blist blist;
+} mci_trimmed_list;
+
+/* Frees the n lists' contents (leaving them not valid). */
+void mci_trimmed_lists_clear(const mci_ctx *ctx, mci_trimmed_list *lists, size_t n);
+
 #endif

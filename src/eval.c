@@ -22,6 +22,7 @@ typedef struct eval_state {
     mci_scene scene;
     mci_classifier cl;
     mci_kept kept;
+    mci_trimmed_list *trimmed; /* per primitive, from the whole-face decision */
     mcsg_eval_stats stats;
     bool no_whole_faces; /* split and classify every touched face (the fallback in run) */
 } eval_state;
@@ -112,6 +113,13 @@ static void add_classify_stats(mcsg_eval_stats *to, const mci_classify_stats *s)
     to->rejected_primitives += s->rejected_leaves;
 }
 
+static void free_trimmed(eval_state *e)
+{
+    mci_trimmed_lists_clear(&e->ctx, e->trimmed, e->tree.leaf_count);
+    mci_free(&e->ctx, e->trimmed);
+    e->trimmed = e->cl.trimmed = NULL;
+}
+
 static mcsg_status classify_all(eval_state *e, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
@@ -121,8 +129,10 @@ static mcsg_status classify_all(eval_state *e, mcsg_error *err)
     mcsg_status st = j.kept && j.stats ? mci_classifier_init(&e->ctx, &e->scene, &e->tree,
                                                              &e->cl, err)
                                        : mci_fail_nomem(err, "classifying faces");
+    e->cl.trimmed = e->trimmed;
     if (st == MCSG_OK)
         st = mci_parallel_for_heaviest_first(&e->ctx, n, classify_cost, classify_one, &j, err);
+    free_trimmed(e);
     if (st == MCSG_OK && !join_kept(e, &j))
         st = mci_fail_nomem(err, "classifying faces");
     for (size_t l = 0; j.kept && j.stats && l < n; l++) {
@@ -531,9 +541,12 @@ static mcsg_status intersect_step(eval_state *e, mcsg_error *err)
 {
     mcsg_status st = build_scene(e, err);
     double t0 = mci_seconds_now();
+    if (st == MCSG_OK && !e->no_whole_faces &&
+        !(e->trimmed = mci_calloc_array(&e->ctx, e->tree.leaf_count + 1, sizeof *e->trimmed)))
+        st = mci_fail_nomem(err, "deciding whole faces");
     if (st == MCSG_OK && !e->no_whole_faces)
         st = mci_decide_whole_faces(&e->ctx, &e->scene, &e->tree, &e->stats.faces_dropped_whole,
-                                    err);
+                                    e->trimmed, err);
     e->stats.seconds_whole_faces = mci_seconds_now() - t0;
     if (st == MCSG_OK)
         st = mci_scene_arrange(&e->ctx, &e->scene, err);
@@ -571,6 +584,7 @@ static mcsg_status evaluate_faces_safely(eval_state *e, mcsg_error *err)
             "evaluating again with every touched face split", err ? err->message : "");
     mci_classifier_free(&e->ctx, &e->cl);
     mci_kept_free(&e->ctx, &e->kept);
+    free_trimmed(e);
     mci_scene_free(&e->ctx, &e->scene);
     mci_free(&e->ctx, e->alias);
     e->alias = NULL;
@@ -624,6 +638,7 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     st = run(&e, tree, out, provenance, err);
     mci_classifier_free(&e.ctx, &e.cl);
     mci_kept_free(&e.ctx, &e.kept);
+    free_trimmed(&e);
     mci_scene_free(&e.ctx, &e.scene);
     mci_ptree_free(&e.ctx, &e.tree);
     mci_free(&e.ctx, e.alias);

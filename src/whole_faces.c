@@ -31,6 +31,7 @@ typedef struct decide_job {
     const double (*box)[6]; /* per leaf */
     size_t *dropped;        /* per leaf: faces flagged */
     uint8_t *copied;        /* per leaf: another leaf is a copy of it (NULL: none is) */
+    mci_trimmed_list *keep; /* per leaf: where its trimmed list goes (NULL: nowhere) */
 } decide_job;
 
 /* One leaf's decision. Vertex arrays are indexed by the leaf mesh's vertex index. */
@@ -41,6 +42,7 @@ typedef struct leaf_decision {
     uint32_t *faces;         /* the leaf's touched faces (global ids) ... */
     size_t nfaces;
     mci_csg_entry *list;
+    size_t nlist;
     mci_label *leaf_labels, *scratch;
     mci_blist blist;         /* each step reads one leaf, no two the same leaf */
     uint32_t *reached, sweep; /* per step: the last sweep (face) that reached it */
@@ -98,7 +100,6 @@ static bool trim_list(leaf_decision *d, bool *rejected)
 {
     const mci_ptree *t = d->j->t;
     const double (*box)[6] = d->j->box;
-    size_t nlist;
     d->list = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->list);
     d->scratch = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->scratch);
     d->leaf_labels = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
@@ -107,10 +108,10 @@ static bool trim_list(leaf_decision *d, bool *rejected)
     for (uint32_t l = 0; l < t->leaf_count; l++)
         d->leaf_labels[l] = l != d->leaf && boxes_meet(box[l], box[d->leaf]) ? MCI_LABEL_UNKNOWN
                                                                             : MCI_LABEL_OUT;
-    nlist = mci_csglist_trim(t, d->leaf, d->leaf_labels, d->scratch, d->list, rejected);
+    d->nlist = mci_csglist_trim(t, d->leaf, d->leaf_labels, d->scratch, d->list, rejected);
     if (*rejected)
         return true;
-    if (!mci_blist_build(d->j->ctx, t, d->list, nlist, d->leaf_labels, &d->blist))
+    if (!mci_blist_build(d->j->ctx, t, d->list, d->nlist, d->leaf_labels, &d->blist))
         return false;
     d->reached = mci_calloc_array(d->j->ctx, d->blist.count + 1, sizeof *d->reached);
     return d->reached != NULL;
@@ -333,6 +334,31 @@ static bool collect_faces(leaf_decision *d)
     return true;
 }
 
+/* Hands the leaf's trimmed list and Blist on to the classification (which would make
+ * the same again), cut to their size (they have room for every node and every leaf).
+ * False when out of memory. */
+static bool keep_trimmed_list(leaf_decision *d, bool rejected)
+{
+    mci_trimmed_list *k = d->j->keep ? &d->j->keep[d->leaf] : NULL;
+    mci_csg_entry *list;
+    mci_blist_step *steps = NULL;
+    if (!k)
+        return true;
+    list = mci_realloc_array(d->j->ctx, d->list, d->nlist + 1, sizeof *list);
+    if (list)
+        d->list = list;
+    if (list && !rejected &&
+        (steps = mci_realloc_array(d->j->ctx, d->blist.steps, d->blist.count + 1,
+                                   sizeof *steps)) != NULL)
+        d->blist.steps = steps;
+    if (!list || (!rejected && !steps))
+        return false;
+    *k = (mci_trimmed_list){d->list, d->nlist, true, rejected, d->blist};
+    d->list = NULL;
+    memset(&d->blist, 0, sizeof d->blist);
+    return true;
+}
+
 static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
 {
     const decide_job *j = user;
@@ -360,17 +386,19 @@ static mcsg_status decide_leaf(void *user, size_t leaf, mcsg_error *err)
                          d.face_box[i]);
         ok = ok && flag_dropped(&d, &j->dropped[leaf]);
     }
+    if (ok && d.list)
+        ok = keep_trimmed_list(&d, rejected);
     free_decision(&d);
     return ok ? MCSG_OK : mci_fail_nomem(err, "deciding whole faces");
 }
 
 mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_ptree *t,
-                                   size_t *count, mcsg_error *err)
+                                   size_t *count, mci_trimmed_list *keep, mcsg_error *err)
 {
     size_t n = s->octree.leaf_count;
     double (*box)[6] = mci_malloc_array(ctx, n + 1, sizeof *box);
     size_t *dropped = mci_calloc_array(ctx, n + 1, sizeof *dropped);
-    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped, NULL};
+    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped, NULL, keep};
     mcsg_status st = MCSG_OK;
     *count = 0;
     s->arr_dropped = mci_calloc_array(ctx, s->arr_count + 1, 1);

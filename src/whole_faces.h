@@ -13,8 +13,10 @@
  * a scene whose faces are not arranged yet (mci_scene_build_touched); the flagged faces
  * then need no arrangement (mci_scene_arrange gives them their corners only), no
  * tessellation and no classification of their pieces. *count receives the number
- * flagged. */
+ * flagged. keep (NULL: not wanted) has a zeroed entry per leaf, where the leaves' trimmed
+ * lists are handed on (mci_classifier.trimmed) when made; the caller frees them
+ * (mci_trimmed_lists_clear). */
 mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *scene, const mci_ptree *tree,
-                                   size_t *count, mcsg_error *err);
+                                   size_t *count, mci_trimmed_list *keep, mcsg_error *err);
 
 #endif
