@@ -13,8 +13,11 @@
 #include <string.h>
 
 /* A hit keeps its end points compactly: an input vertex (most contacts of meshes that
- * share vertices or faces) as its address, other points in the point stores. A
- * full point is ~190 bytes; bunny ∩ bunny has 375K hits, nearly all at vertices. */
+ * share vertices or faces) as its address, other points (edge lines crossing a plane)
+ * by their definition. A full point is 176 bytes, and is built only once the faces
+ * dropped whole are known: on ring-800 a fifth of the crossings lie between two such
+ * faces, and every crossing is found twice (by the two faces along the edge). bunny ∩
+ * bunny has 375K hits, nearly all at vertices. */
 typedef struct pair_hit {
     uint32_t f, g;
     uint8_t kind; /* mci_tt_kind */
@@ -22,23 +25,29 @@ typedef struct pair_hit {
     uint8_t strict_ends; /* mci_tt_result.strict_ends */
     uint8_t stored;     /* bit k: end k is a stored point, else the vertex vertex[k] */
     const double *vertex[2];
-    /* Stored end k: its index in the chunk's store, numbered across the chunks once
-     * they are joined, and finally the point itself (join_chunks). */
+    /* Stored end k: its index in the chunk's definitions, then in the joined list of
+     * distinct definitions (join_chunks), and finally the point itself, or NULL when no
+     * arranged face needs it (build_points). */
     union {
         uint32_t index;
         const mci_point *at;
     } point[2];
 } pair_hit;
 
-/* A chunk's hits and stored points; joined, the hits of all chunks and the chunks'
- * point stores as blocks (kept where they are: the arrangements refer to them). */
+/* A stored end: the line through v[0], v[1] (an edge, in canonical order) meeting the
+ * plane of face plane_face, whose corners are v[2..4]. */
+typedef struct end_def {
+    const double *v[5];
+    uint32_t plane_face;
+} end_def;
+
+/* A chunk's hits and end definitions; joined, the hits of all chunks and their distinct
+ * definitions. */
 typedef struct hit_list {
     pair_hit *v;
     size_t count, capacity;
-    mci_point *points;
-    size_t point_count, point_capacity;
-    mci_point **blocks;
-    size_t block_count;
+    end_def *defs;
+    size_t def_count, def_capacity;
 } hit_list;
 
 
@@ -53,8 +62,21 @@ static void face_plane(const mci_scene *s, uint32_t f, mci_plane *plane)
                    mci_scene_corner(s, f, 2));
 }
 
+/* Planes of the faces that appear in candidate pairs, computed once each. */
+typedef struct plane_cache {
+    uint32_t *slot; /* per face: index in planes, or MCI_NONE */
+    mci_plane *planes;
+} plane_cache;
+
+static const mci_plane *cached_plane(const plane_cache *c, uint32_t f)
+{
+    return &c->planes[c->slot[f]];
+}
+
+/* The pair tests build only two kinds of points: input vertices and edge lines meeting
+ * the plane of f or of g (its corners say which). */
 static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
-                     const mci_tt_result *r)
+                     const mci_tt_result *r, const plane_cache *planes)
 {
     int ends = r->kind == MCI_TT_SEGMENT ? 2 : r->kind == MCI_TT_POINT ? 1 : 0;
     pair_hit *hit;
@@ -73,22 +95,21 @@ static bool push_hit(const mci_ctx *ctx, hit_list *h, uint32_t f, uint32_t g,
             hit->vertex[k] = r->end[k].v[0];
             continue;
         }
-        if (!mci_grow_array(ctx, (void **)&h->points, &h->point_capacity, h->point_count + 1,
-                            sizeof *h->points, 64))
+        const mci_point *p = &r->end[k];
+        const mci_plane *pf = cached_plane(planes, f);
+        end_def *d;
+        if (!mci_grow_array(ctx, (void **)&h->defs, &h->def_capacity, h->def_count + 1,
+                            sizeof *h->defs, 64))
             return false;
         hit->stored |= (uint8_t)(1u << k);
-        hit->point[k].index = (uint32_t)h->point_count;
-        h->points[h->point_count++] = r->end[k];
+        hit->point[k].index = (uint32_t)h->def_count;
+        d = &h->defs[h->def_count++];
+        memcpy(d->v, p->v, sizeof d->v);
+        d->plane_face = p->v[2] == pf->a && p->v[3] == pf->b && p->v[4] == pf->c ? f : g;
     }
     h->count++;
     return true;
 }
-
-/* Planes of the faces that appear in candidate pairs, computed once each. */
-typedef struct plane_cache {
-    uint32_t *slot; /* per face: index in planes, or MCI_NONE */
-    mci_plane *planes;
-} plane_cache;
 
 /* The planes are computed in parallel chunks of faces (each face writes its own slot). */
 enum { PLANE_CHUNK = 8192 };
@@ -155,17 +176,17 @@ typedef struct pair_job {
 static bool trim_hits(const mci_ctx *ctx, hit_list *h)
 {
     pair_hit *v = mci_realloc_array(ctx, h->v, h->count + 1, sizeof *v);
-    mci_point *points;
+    end_def *defs;
     if (v) {
         h->v = v;
         h->capacity = h->count + 1;
     }
-    points = v ? mci_realloc_array(ctx, h->points, h->point_count + 1, sizeof *points) : NULL;
-    if (points) {
-        h->points = points;
-        h->point_capacity = h->point_count + 1;
+    defs = v ? mci_realloc_array(ctx, h->defs, h->def_count + 1, sizeof *defs) : NULL;
+    if (defs) {
+        h->defs = defs;
+        h->def_capacity = h->def_count + 1;
     }
-    return points != NULL;
+    return defs != NULL;
 }
 
 /* Every coplanar pair is kept, touching or not: faces that only share an edge still
@@ -178,136 +199,110 @@ static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
     size_t pairs = end - chunk * PAIR_CHUNK;
     hit_list *h = &c->hits;
     /* Room for a hit per pair and two ends each, trimmed after: growing by doubling
-     * copied every chunk's points about twice (1% of ring-800's instructions), and
-     * room never written takes no memory from the system allocator (an allocator
-     * that counts bytes sees up to 1.4 MB more per thread until the trim). */
+     * copied every chunk's records about twice, and room never written takes no memory
+     * from the system allocator. */
     if (!mci_grow_array(j->ctx, (void **)&h->v, &h->capacity, pairs, sizeof *h->v, 1) ||
-        !mci_grow_array(j->ctx, (void **)&h->points, &h->point_capacity, 2 * pairs,
-                        sizeof *h->points, 1))
+        !mci_grow_array(j->ctx, (void **)&h->defs, &h->def_capacity, 2 * pairs,
+                        sizeof *h->defs, 1))
         return mci_fail_nomem(err, "intersecting faces");
     for (size_t i = chunk * PAIR_CHUNK; i < end; i++) {
         uint32_t f = (uint32_t)(j->pairs[i] >> 32), g = (uint32_t)j->pairs[i];
         mci_tt_result r;
-        mci_triangle_intersection(&j->cache->planes[j->cache->slot[f]],
-                                  &j->cache->planes[j->cache->slot[g]], &r);
+        mci_triangle_intersection_defined(cached_plane(j->cache, f), cached_plane(j->cache, g),
+                                          &r);
         c->crossing += r.kind == MCI_TT_SEGMENT;
         c->points += r.kind == MCI_TT_POINT;
         c->coplanar += r.kind == MCI_TT_COPLANAR && r.overlap;
-        if (r.kind != MCI_TT_DISJOINT && !push_hit(j->ctx, &c->hits, f, g, &r))
+        if (r.kind != MCI_TT_DISJOINT && !push_hit(j->ctx, &c->hits, f, g, &r, j->cache))
             return mci_fail_nomem(err, "intersecting faces");
     }
     return trim_hits(j->ctx, h) ? MCSG_OK : mci_fail_nomem(err, "intersecting faces");
 }
 
-static uint64_t definition_hash(const mci_point *p)
+static uint64_t vertices_hash(uint64_t h, const double *const *v, int n)
 {
-    uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)p->kind;
-    for (int i = 0; i < mci_point_vertex_count(p); i++) {
-        h ^= (uint64_t)(uintptr_t)p->v[i];
+    for (int i = 0; i < n; i++) {
+        h ^= (uint64_t)(uintptr_t)v[i];
         h *= 0xff51afd7ed558ccdu;
         h ^= h >> 32;
     }
     return h;
 }
 
-/* Copies of the pair tests' points (merge_hit_copies), by their number across the
- * blocks. */
-typedef struct hit_copies {
-    mci_point **at;     /* by number: the point */
-    uint32_t *rep;      /* by number: the number of the first copy */
-    uint32_t *bucket;   /* hash table of first copies */
-    size_t size;
-} hit_copies;
-
-static void find_first_copies(hit_copies *c, size_t n)
+/* The hash of a point's definition (kind and vertices), as definition_hash below. */
+static uint64_t end_def_hash(const end_def *d)
 {
-    for (size_t i = 0; i < c->size; i++)
-        c->bucket[i] = MCI_NONE;
-    for (size_t i = 0; i < n; i++) {
-        size_t at = definition_hash(c->at[i]) & (c->size - 1);
-        while (c->bucket[at] != MCI_NONE &&
-               !mci_points_same_definition(c->at[c->bucket[at]], c->at[i]))
-            at = (at + 1) & (c->size - 1);
-        if (c->bucket[at] == MCI_NONE)
-            c->bucket[at] = (uint32_t)i;
-        c->rep[i] = c->bucket[at];
-    }
+    return vertices_hash(0x9e3779b97f4a7c15u ^ (uint64_t)MCI_POINT_LPI, d->v, 5);
 }
 
-/* The end of block b's numbers (block b holds first[b] ..). */
-static size_t block_end(const hit_list *hits, const size_t *first, size_t b)
+static uint64_t definition_hash(const mci_point *p)
 {
-    return b + 1 < hits->block_count ? first[b + 1] : hits->point_count;
+    return vertices_hash(0x9e3779b97f4a7c15u ^ (uint64_t)p->kind, p->v,
+                         mci_point_vertex_count(p));
 }
 
-/* Each block keeps its first copies, in order, and is cut to them; at[] then gives
- * every first copy's final place. */
-static bool compact_blocks(const mci_ctx *ctx, hit_list *hits, const size_t *first,
-                           hit_copies *c)
+static bool same_definition(const end_def *a, const end_def *b)
 {
-    for (size_t b = 0; b < hits->block_count; b++) {
-        size_t end = block_end(hits, first, b), kept = 0;
-        mci_point *fit;
-        for (size_t i = first[b]; i < end; i++)
-            if (c->rep[i] == i)
-                hits->blocks[b][kept++] = *c->at[i]; /* kept <= its index: not read again */
-        if (!(fit = mci_realloc_array(ctx, hits->blocks[b], kept + 1, sizeof *fit)))
+    for (int i = 0; i < 5; i++)
+        if (a->v[i] != b->v[i])
             return false;
-        hits->blocks[b] = fit;
-        kept = 0;
-        for (size_t i = first[b]; i < end; i++)
-            if (c->rep[i] == i)
-                c->at[i] = &fit[kept++];
-    }
     return true;
 }
 
-/* Pair tests of the two faces along an edge with a third face build the same
- * edge-plane point (one definition, so one value): the first copy is kept, since the
- * arrangements refer to these points until the result is assembled. On entry the hits'
- * stored ends are numbered across the blocks (block b from first[b]); on return they
- * point to their points, each block cut to the points it keeps. False when out of
+/* Pair tests of the two faces along an edge with a third face find the same
+ * edge-plane point (one definition, so one value): the hits' stored ends, numbered
+ * across the chunks (`at`: each number's definition), are renumbered among the distinct
+ * definitions, kept in order of first appearance in hits->defs. False when out of
  * memory. */
-static bool merge_hit_copies(const mci_ctx *ctx, hit_list *hits, const size_t *first)
+static bool merge_definitions(const mci_ctx *ctx, hit_list *hits, const end_def **at,
+                              size_t n)
 {
-    size_t n = hits->point_count;
-    hit_copies c = {mci_malloc_array(ctx, n + 1, sizeof *c.at), NULL, NULL, 16};
-    bool ok;
-    while (c.size < 2 * n)
-        c.size *= 2;
-    c.rep = mci_malloc_array(ctx, n + c.size, sizeof *c.rep);
-    c.bucket = c.rep ? c.rep + n : NULL;
-    ok = c.at && c.rep;
-    for (size_t b = 0; ok && b < hits->block_count; b++)
-        for (size_t i = first[b]; i < block_end(hits, first, b); i++)
-            c.at[i] = &hits->blocks[b][i - first[b]];
-    if (ok) {
-        find_first_copies(&c, n);
-        ok = compact_blocks(ctx, hits, first, &c);
+    size_t size = 16, distinct = 0;
+    uint32_t *rep, *bucket;
+    while (size < 2 * n)
+        size *= 2;
+    rep = mci_malloc_array(ctx, n + size, sizeof *rep);
+    hits->defs = mci_malloc_array(ctx, n + 1, sizeof *hits->defs);
+    if (!rep || !hits->defs) {
+        mci_free(ctx, rep);
+        return false;
     }
-    for (size_t h = 0; ok && h < hits->count; h++)
+    bucket = rep + n;
+    for (size_t i = 0; i < size; i++)
+        bucket[i] = MCI_NONE;
+    for (size_t i = 0; i < n; i++) {
+        size_t slot = end_def_hash(at[i]) & (size - 1);
+        while (bucket[slot] != MCI_NONE && !same_definition(&hits->defs[bucket[slot]], at[i]))
+            slot = (slot + 1) & (size - 1);
+        if (bucket[slot] == MCI_NONE) {
+            bucket[slot] = (uint32_t)distinct;
+            hits->defs[distinct++] = *at[i];
+        }
+        rep[i] = bucket[slot];
+    }
+    hits->def_count = hits->def_capacity = distinct;
+    for (size_t h = 0; h < hits->count; h++)
         for (int k = 0; k < 2; k++)
             if ((hits->v[h].stored >> k) & 1)
-                hits->v[h].point[k].at = c.at[c.rep[hits->v[h].point[k].index]];
-    mci_free(ctx, c.at);
-    mci_free(ctx, c.rep);
-    return ok;
+                hits->v[h].point[k].index = rep[hits->v[h].point[k].index];
+    mci_free(ctx, rep);
+    return true;
 }
 
 /* Moves the chunks' hits into *hits (in chunk order; the offsets serially, the copies on
- * the threads) and their point stores into its blocks, as they are (a joined copy cost
- * ring-800 58 MB of copying and page faults); then merges the stored points' copies. */
+ * the threads), then keeps their distinct end definitions. */
 typedef struct join_job {
     pair_chunk *chunks;
     hit_list *hits;
-    size_t *first_hit, *first_point; /* per chunk: where its hits and points go */
+    size_t *first_hit, *first_def; /* per chunk: where its hits and definitions go */
+    const end_def **at;            /* by number across the chunks: the definition */
 } join_job;
 
 static mcsg_status join_chunk(void *user, size_t c, mcsg_error *err)
 {
     const join_job *j = user;
     hit_list *from = &j->chunks[c].hits;
-    uint32_t base = (uint32_t)j->first_point[c];
+    uint32_t base = (uint32_t)j->first_def[c];
     (void)err;
     for (size_t i = 0; i < from->count; i++) {
         pair_hit h = from->v[i];
@@ -316,6 +311,8 @@ static mcsg_status join_chunk(void *user, size_t c, mcsg_error *err)
                 h.point[k].index += base;
         j->hits->v[j->first_hit[c] + i] = h;
     }
+    for (size_t i = 0; i < from->def_count; i++)
+        j->at[base + i] = &from->defs[i];
     return MCSG_OK;
 }
 
@@ -323,46 +320,42 @@ static mcsg_status join_chunks(const mci_ctx *ctx, mci_scene *s, pair_chunk *chu
                                size_t n, hit_list *hits, mcsg_error *err)
 {
     join_job j = {chunks, hits, mci_malloc_array(ctx, n + 1, sizeof *j.first_hit),
-                  mci_malloc_array(ctx, n + 1, sizeof *j.first_point)};
-    size_t total = 0, total_points = 0;
-    mcsg_status st = j.first_hit && j.first_point ? MCSG_OK
-                                                  : mci_fail_nomem(err, "intersecting faces");
+                  mci_malloc_array(ctx, n + 1, sizeof *j.first_def), NULL};
+    size_t total = 0, total_defs = 0;
+    mcsg_status st = j.first_hit && j.first_def ? MCSG_OK
+                                                : mci_fail_nomem(err, "intersecting faces");
     for (size_t c = 0; st == MCSG_OK && c < n; c++) {
         j.first_hit[c] = total;
-        j.first_point[c] = total_points;
+        j.first_def[c] = total_defs;
         total += chunks[c].hits.count;
-        total_points += chunks[c].hits.point_count;
+        total_defs += chunks[c].hits.def_count;
         s->stats.intersecting_pairs += chunks[c].crossing;
         s->stats.point_contacts += chunks[c].points;
         s->stats.coplanar_pairs += chunks[c].coplanar;
     }
-    if (st == MCSG_OK && total_points >= UINT32_MAX)
-        st = mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total_points);
+    if (st == MCSG_OK && total_defs >= UINT32_MAX)
+        st = mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", total_defs);
     if (st == MCSG_OK) {
         hits->v = mci_malloc_array(ctx, total + 1, sizeof *hits->v);
-        hits->blocks = mci_calloc_array(ctx, n + 1, sizeof *hits->blocks);
-        if (!hits->v || !hits->blocks)
+        j.at = mci_malloc_array(ctx, total_defs + 1, sizeof *j.at);
+        if (!hits->v || !j.at)
             st = mci_fail_nomem(err, "intersecting faces");
     }
     if (st == MCSG_OK) {
         hits->capacity = hits->count = total;
-        hits->point_count = total_points;
         st = mci_parallel_for(ctx, n, join_chunk, &j, err);
     }
-    for (size_t c = 0; c < n; c++) {
-        if (hits->blocks && st == MCSG_OK) { /* the block takes the store */
-            hits->blocks[hits->block_count++] = chunks[c].hits.points;
-            chunks[c].hits.points = NULL;
-        }
-        mci_free(ctx, chunks[c].hits.v);
-        mci_free(ctx, chunks[c].hits.points);
-        chunks[c].hits.v = NULL;
-        chunks[c].hits.points = NULL;
-    }
-    if (st == MCSG_OK && !merge_hit_copies(ctx, hits, j.first_point))
+    if (st == MCSG_OK && !merge_definitions(ctx, hits, j.at, total_defs))
         st = mci_fail_nomem(err, "intersecting faces");
+    for (size_t c = 0; c < n; c++) {
+        mci_free(ctx, chunks[c].hits.v);
+        mci_free(ctx, chunks[c].hits.defs);
+        chunks[c].hits.v = NULL;
+        chunks[c].hits.defs = NULL;
+    }
+    mci_free(ctx, j.at);
     mci_free(ctx, j.first_hit);
-    mci_free(ctx, j.first_point);
+    mci_free(ctx, j.first_def);
     return st;
 }
 
@@ -391,7 +384,7 @@ static mcsg_status intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint6
         st = join_chunks(ctx, s, job.chunks, n, hits, err);
     for (size_t c = 0; job.chunks && c < n; c++) {
         mci_free(ctx, job.chunks[c].hits.v);
-        mci_free(ctx, job.chunks[c].hits.points);
+        mci_free(ctx, job.chunks[c].hits.defs);
     }
     mci_free(ctx, job.chunks);
     return st;
@@ -767,14 +760,22 @@ typedef struct arrange_job {
  * meets the other plane strictly inside that edge (the pair test builds such points
  * only for edges whose ends lie strictly on both sides), and an end flagged in
  * mci_tt_result.strict_ends lies strictly inside f. */
+static uint8_t line_end_location(const double *const corner[3], const double *a,
+                                 const double *b, bool strictly_inside)
+{
+    for (int e = 0; e < 3; e++) {
+        const double *u = corner[e], *w = corner[(e + 1) % 3];
+        if ((a == u && b == w) || (a == w && b == u))
+            return (uint8_t)(MCI_AT_EDGE + e);
+    }
+    return strictly_inside ? MCI_AT_INSIDE : MCI_AT_UNKNOWN;
+}
+
 static uint8_t end_location(const double *const corner[3], const mci_point *p,
                             bool strictly_inside)
 {
-    for (int e = 0; p->kind == MCI_POINT_LPI && e < 3; e++) {
-        const double *u = corner[e], *w = corner[(e + 1) % 3];
-        if ((p->v[0] == u && p->v[1] == w) || (p->v[0] == w && p->v[1] == u))
-            return (uint8_t)(MCI_AT_EDGE + e);
-    }
+    if (p->kind == MCI_POINT_LPI)
+        return line_end_location(corner, p->v[0], p->v[1], strictly_inside);
     return strictly_inside ? MCI_AT_INSIDE : MCI_AT_UNKNOWN;
 }
 
@@ -1151,8 +1152,7 @@ static void free_point_blocks(const mci_ctx *ctx, mci_point **blocks, size_t cou
 static void free_hits(const mci_ctx *ctx, hit_list *hits)
 {
     mci_free(ctx, hits->v);
-    mci_free(ctx, hits->points);
-    free_point_blocks(ctx, hits->blocks, hits->block_count);
+    mci_free(ctx, hits->defs);
     memset(hits, 0, sizeof *hits);
 }
 
@@ -1166,7 +1166,7 @@ struct mci_scene_pending {
     vertex_table vt;        /* its points belong to the scene (vertex_points) */
 };
 
-/* Everything but the hits' point blocks, which the arrangements refer to. */
+/* Everything but the vertex table's map. */
 static void free_pending_records(const mci_ctx *ctx, struct mci_scene_pending *pd)
 {
     free_hits(ctx, &pd->hits);
@@ -1192,29 +1192,30 @@ static void free_pending(const mci_ctx *ctx, mci_scene *s)
  * e). The end lies in f, as in the other face of the hit; where neither the pair test
  * nor the point's definition tells, an exact zero of its orientation against an edge's
  * line puts it on that edge (what merging the arrangement would find). */
-static uint8_t end_edges(const plane_cache *planes, uint32_t f, const double *const c[3],
-                         const pair_hit *h, int k)
+static uint8_t end_edges(const hit_list *hits, const plane_cache *planes, uint32_t f,
+                         const double *const c[3], const pair_hit *h, int k)
 {
-    mci_point vertex, corner[3];
-    const mci_point *p = &vertex;
+    mci_point p, corner[3];
     uint8_t mask = 0;
     int axis, sign;
     if ((h->stored >> k) & 1) {
-        uint8_t where = end_location(c, p = h->point[k].at, (h->strict_ends >> k) & 1);
+        const end_def *d = &hits->defs[h->point[k].index];
+        uint8_t where = line_end_location(c, d->v[0], d->v[1], (h->strict_ends >> k) & 1);
         if (where == MCI_AT_INSIDE)
             return 0;
         if (where != MCI_AT_UNKNOWN)
             return (uint8_t)(1u << (where - MCI_AT_EDGE));
+        (void)mci_point_lpi(&p, d->v[0], d->v[1], cached_plane(planes, d->plane_face));
     } else {
-        mci_point_explicit(&vertex, h->vertex[k]);
+        mci_point_explicit(&p, h->vertex[k]);
     }
-    axis = mci_plane_projection_axis(&planes->planes[planes->slot[f]], &sign);
+    axis = mci_plane_projection_axis(cached_plane(planes, f), &sign);
     if (axis < 0)
         return 7; /* cannot happen (faces in hits are not degenerate): keep the face */
     for (int e = 0; e < 3; e++)
         mci_point_explicit(&corner[e], c[e]);
     for (int e = 0; e < 3; e++)
-        if (mci_orient2d_projected(&corner[e], &corner[(e + 1) % 3], p, axis) == 0)
+        if (mci_orient2d_projected(&corner[e], &corner[(e + 1) % 3], &p, axis) == 0)
             mask |= (uint8_t)(1u << e);
     return mask;
 }
@@ -1234,8 +1235,8 @@ static uint8_t face_contact(const mci_scene *s, const struct mci_scene_pending *
         if (h->kind != MCI_TT_SEGMENT && h->kind != MCI_TT_POINT)
             contact |= MCI_CONTACT_COPLANAR;
         else if (h->kind == MCI_TT_SEGMENT && !(contact & MCI_CONTACT_BORDER) &&
-                 (a = end_edges(&pd->planes, f, c, h, 0)) != 0 &&
-                 (a & end_edges(&pd->planes, f, c, h, 1)) != 0)
+                 (a = end_edges(&pd->hits, &pd->planes, f, c, h, 0)) != 0 &&
+                 (a & end_edges(&pd->hits, &pd->planes, f, c, h, 1)) != 0)
             contact |= MCI_CONTACT_BORDER;
     }
     return contact;
@@ -1282,9 +1283,76 @@ static mcsg_status prepare_arrangements(const mci_ctx *ctx, mci_scene *s, hit_li
                             contact_chunk, s, err);
 }
 
+/* Building the stored ends that arranged faces use: in parallel chunks of definitions,
+ * each built into its own slot of one block. */
+typedef struct build_job {
+    const hit_list *hits;
+    const plane_cache *planes;
+    const uint32_t *slot; /* per definition: its place in block, or MCI_NONE */
+    mci_point *block;
+} build_job;
+
+enum { BUILD_CHUNK = 4096 };
+
+static mcsg_status build_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const build_job *j = user;
+    size_t end = mci_chunk_end(j->hits->def_count, chunk, BUILD_CHUNK);
+    (void)err;
+    for (size_t i = chunk * BUILD_CHUNK; i < end; i++) {
+        const end_def *d = &j->hits->defs[i];
+        if (j->slot[i] != MCI_NONE) /* the pair test built it once: it exists */
+            (void)mci_point_lpi(&j->block[j->slot[i]], d->v[0], d->v[1],
+                                cached_plane(j->planes, d->plane_face));
+    }
+    return MCSG_OK;
+}
+
+/* The points of the stored ends of hits with a face that is arranged (not dropped
+ * whole), in the scene's hit_blocks; each hit's stored ends then point to them (NULL:
+ * both faces dropped). */
+static mcsg_status build_points(const mci_ctx *ctx, mci_scene *s, hit_list *hits,
+                                const plane_cache *planes, mcsg_error *err)
+{
+    uint32_t *slot = mci_malloc_array(ctx, hits->def_count + 1, sizeof *slot);
+    build_job job = {hits, planes, slot, NULL};
+    size_t n = 0;
+    mcsg_status st;
+    s->hit_blocks = mci_calloc_array(ctx, 1, sizeof *s->hit_blocks);
+    if (!slot || !s->hit_blocks) {
+        mci_free(ctx, slot);
+        return mci_fail_nomem(err, "arranging faces");
+    }
+    for (size_t i = 0; i < hits->def_count; i++)
+        slot[i] = MCI_NONE;
+    for (size_t h = 0; h < hits->count; h++) {
+        const pair_hit *x = &hits->v[h];
+        bool used = !is_dropped(s, s->arr_of[x->f]) || !is_dropped(s, s->arr_of[x->g]);
+        for (int k = 0; used && k < 2; k++)
+            if ((x->stored >> k) & 1)
+                slot[x->point[k].index] = 0;
+    }
+    for (size_t i = 0; i < hits->def_count; i++)
+        if (slot[i] != MCI_NONE)
+            slot[i] = (uint32_t)n++;
+    s->hit_blocks[0] = job.block = mci_malloc_array(ctx, n + 1, sizeof *job.block);
+    s->hit_block_count = 1;
+    st = job.block ? mci_parallel_for(ctx, (hits->def_count + BUILD_CHUNK - 1) / BUILD_CHUNK,
+                                      build_chunk, &job, err)
+                   : mci_fail_nomem(err, "arranging faces");
+    for (size_t h = 0; st == MCSG_OK && h < hits->count; h++)
+        for (int k = 0; k < 2; k++)
+            if ((hits->v[h].stored >> k) & 1) {
+                uint32_t at = slot[hits->v[h].point[k].index];
+                hits->v[h].point[k].at = at == MCI_NONE ? NULL : &job.block[at];
+            }
+    mci_free(ctx, slot);
+    return st;
+}
+
 /* The hits and the plane cache are freed as soon as the faces have taken their records,
- * before the arrangements grow (splitting, edge points), except the hits' point blocks,
- * which move to the scene (the arrangements refer to them). */
+ * before the arrangements grow (splitting, edge points); the built points stay with the
+ * scene (the arrangements refer to them). */
 mcsg_status mci_scene_arrange(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
@@ -1295,12 +1363,10 @@ mcsg_status mci_scene_arrange(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
         return mci_fail(err, MCSG_ERR_INTERNAL, "arranging a scene twice");
     job = (arrange_job){ctx, s, &pd->hits, pd->start, pd->list, pd->face_of, &pd->ff,
                         &pd->planes, &pd->vt};
-    st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one, &job,
-                                         err);
-    s->hit_blocks = pd->hits.blocks;
-    s->hit_block_count = pd->hits.block_count;
-    pd->hits.blocks = NULL;
-    pd->hits.block_count = 0;
+    st = build_points(ctx, s, &pd->hits, &pd->planes, err);
+    if (st == MCSG_OK)
+        st = mci_parallel_for_heaviest_first(ctx, s->arr_count, arrange_cost, arrange_one,
+                                             &job, err);
     free_pending_records(ctx, pd);
     if (st == MCSG_OK)
         st = share_edge_points(ctx, s, &pd->vt, err);
@@ -1333,7 +1399,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 {
     uint64_t *pairs = NULL;
     size_t count = 0;
-    hit_list hits = {NULL, 0, 0, NULL, 0, 0, NULL, 0};
+    hit_list hits = {NULL, 0, 0, NULL, 0, 0};
     plane_cache planes = {NULL, NULL};
     double t0 = mci_seconds_now(), t1, t2;
     mcsg_status st = mci_octree_candidate_pairs(ctx, &s->octree, &pairs, &count, err);

@@ -25,6 +25,8 @@ typedef struct mci_tt_result {
      * end is where an edge of one triangle crosses the other's plane, strictly inside
      * that edge; bit k says that end k is also strictly inside the other triangle. */
     uint8_t strict_ends;
+    /* Set by mci_triangle_intersection_defined when end[] holds definitions only. */
+    bool defined_only;
     mci_point end[2];
 } mci_tt_result;
 
@@ -33,5 +35,13 @@ typedef struct mci_tt_result {
  * vertices in a canonical order (by address), so that the point where an edge crosses a
  * plane has the same definition from both faces sharing that edge. */
 void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out);
+
+/* The same, for a caller that stores the ends' definitions and builds the points later
+ * (or never): where every corner of each triangle is strictly off the other's plane (the
+ * common case), each LPI end gets its kind and defining vertices v[0..4] only, and
+ * `defined_only` is set; in every other case the ends are built as above. The results
+ * are otherwise the same. */
+void mci_triangle_intersection_defined(const mci_plane *t1, const mci_plane *t2,
+                                       mci_tt_result *out);
 
 #endif

@@ -125,6 +125,19 @@ static void edge_crossing(mci_point *out, const double *u, const double *v,
     (void)mci_point_lpi(out, swap ? v : u, swap ? u : v, plane);
 }
 
+/* Its definition only (see mci_triangle_intersection_defined). */
+static void edge_crossing_defined(mci_point *out, const double *u, const double *v,
+                                  const mci_plane *plane)
+{
+    bool swap = mci_vertex_before(v, u);
+    out->kind = MCI_POINT_LPI;
+    out->v[0] = swap ? v : u;
+    out->v[1] = swap ? u : v;
+    out->v[2] = plane->a;
+    out->v[3] = plane->b;
+    out->v[4] = plane->c;
+}
+
 /* The overlap of sections that are not apart (every corner strictly off the other
  * plane), with the names above: t1's section runs from I (on p1-r1) to J (on p1-q1), t2's
  * from K (on p2-q2) to L (on p2-r2). The plane (p1, r1, p2) holds I and p2, so for a
@@ -137,6 +150,8 @@ static void edge_crossing(mci_point *out, const double *u, const double *v,
 static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const strict_pair *c,
                            mci_tt_result *out)
 {
+    void (*crossing)(mci_point *, const double *, const double *, const mci_plane *) =
+        out->defined_only ? edge_crossing_defined : edge_crossing;
     const double *p1 = c->v1[0], *q1 = c->v1[1], *r1 = c->v1[2];
     const double *p2 = c->v2[0], *q2 = c->v2[1], *r2 = c->v2[2];
     int start_side = mci_orient3d_vertices(p1, r1, p2, q2);
@@ -158,15 +173,15 @@ static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const stric
                                      (end_side != 0) << !c->reversed);
     if (!single || !c->reversed) {
         if (start_k)
-            edge_crossing(start, p2, q2, t1);
+            crossing(start, p2, q2, t1);
         else
-            edge_crossing(start, p1, r1, t2);
+            crossing(start, p1, r1, t2);
     }
     if (!single || c->reversed) {
         if (end_l)
-            edge_crossing(end, p2, r2, t1);
+            crossing(end, p2, r2, t1);
         else
-            edge_crossing(end, p1, q1, t2);
+            crossing(end, p1, q1, t2);
     }
 }
 
@@ -261,7 +276,10 @@ static bool coplanar_interiors_overlap(const mci_plane *t1, const mci_plane *t2)
     return !edge_separates(t1, sign1, t2, axis) && !edge_separates(t2, sign2, t1, axis);
 }
 
-void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out)
+/* With defined_only, strict overlaps leave their ends as definitions (and set the
+ * flag); every other case builds them. */
+static void intersect(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out,
+                      bool defined_only)
 {
     int side1[3], side2[3], n1, n2;
     const double *lone;
@@ -277,8 +295,10 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
     if (all_sides_strict(side1) && all_sides_strict(side2)) {
         strict_pair c;
         name_corners(t1, side1, t2, side2, &c);
-        if (!sections_apart(&c))
+        if (!sections_apart(&c)) {
+            out->defined_only = defined_only;
             strict_overlap(t1, t2, &c, out);
+        }
         return;
     }
     if (side1[0] == 0 && side1[1] == 0 && side1[2] == 0) {
@@ -302,4 +322,15 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
     order_section(s1, n1, &line);
     order_section(s2, n2, &line);
     overlap_on_line(s1, s2, &line, out);
+}
+
+void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_result *out)
+{
+    intersect(t1, t2, out, false);
+}
+
+void mci_triangle_intersection_defined(const mci_plane *t1, const mci_plane *t2,
+                                       mci_tt_result *out)
+{
+    intersect(t1, t2, out, true);
 }

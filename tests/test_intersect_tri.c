@@ -320,6 +320,48 @@ static void check_strict_ends(const mci_plane *p1, const mci_plane *p2, const do
     }
 }
 
+static bool same_fv(mci_fv a, mci_fv b)
+{
+    return a.v == b.v && a.e == b.e;
+}
+
+static bool same_built_point(const mci_point *x, const mci_point *y)
+{
+    bool same = x->exact_axes == y->exact_axes && x->w_sign == y->w_sign &&
+                same_fv(x->w, y->w) && x->r == y->r;
+    for (int k = 0; k < 3; k++)
+        same = same && same_fv(x->y[k], y->y[k]) && x->c[k] == y->c[k];
+    return same;
+}
+
+/* mci_triangle_intersection_defined gives the same result with the strict overlaps'
+ * ends as definitions only (kind and vertices), and every other result whole. */
+static long defined_only_results;
+
+static void check_defined(const mci_plane *p1, const mci_plane *p2, const mci_tt_result *built,
+                          const char *what)
+{
+    mci_tt_result got;
+    int ends = built->kind == MCI_TT_SEGMENT ? 2 : built->kind == MCI_TT_POINT ? 1 : 0;
+    mci_triangle_intersection_defined(p1, p2, &got);
+    CHECK_MSG(got.kind == built->kind && got.overlap == built->overlap &&
+              got.along_edge[0] == built->along_edge[0] &&
+              got.along_edge[1] == built->along_edge[1] &&
+              got.strict_ends == built->strict_ends,
+              "%s: the defined-only result differs", what);
+    CHECK_MSG(!got.defined_only || got.kind == MCI_TT_SEGMENT || got.kind == MCI_TT_POINT,
+              "%s: defined only, but no end", what);
+    defined_only_results += got.defined_only;
+    for (int e = 0; e < ends && got.kind == built->kind; e++) {
+        const mci_point *x = &got.end[e], *y = &built->end[e];
+        int n = mci_point_vertex_count(y);
+        CHECK_MSG(x->kind == y->kind && memcmp(x->v, y->v, (size_t)n * sizeof x->v[0]) == 0,
+                  "%s: end %d is defined differently", what, e);
+        if (!got.defined_only)
+            CHECK_MSG(same_built_point(x, y), "%s: end %d is built differently", what, e);
+    }
+}
+
 static void check_pair(const double *t1[3], const double *t2[3], const char *what)
 {
     mci_plane p1, p2;
@@ -339,6 +381,7 @@ static void check_pair(const double *t1[3], const double *t2[3], const char *wha
     if (got.kind == want.kind && want.kind == MCI_TT_COPLANAR)
         CHECK_MSG(got.overlap == want.overlap, "%s: coplanar overlap %d", what, got.overlap);
     check_strict_ends(&p1, &p2, t1, t2, &got, what);
+    check_defined(&p1, &p2, &got, what);
     for (int e = 0; got.kind == want.kind && e < (int)want.kind && e < 2; e++) {
         if (want.kind == MCI_TT_COPLANAR)
             break;
@@ -383,6 +426,8 @@ TEST(random_and_degenerate_pairs_match_the_reference)
     CHECK(kind_counts[1] > 100 && kind_counts[2] > 100 && kind_counts[3] > 100);
     CHECK(coplanar_overlaps > 50);
     CHECK(strict_inside_ends > 1000 && strict_tied_ends > 100);
+    printf("defined only: %ld results\n", defined_only_results);
+    CHECK(defined_only_results > 1000);
 }
 
 TEST(shared_edge_crossing_is_defined_identically)
