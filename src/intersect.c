@@ -259,6 +259,7 @@ static bool merge_definitions(const mci_ctx *ctx, hit_list *hits, const end_def 
 {
     size_t size = 16, distinct = 0;
     uint32_t *rep, *bucket;
+    end_def *fit;
     while (size < 2 * n)
         size *= 2;
     rep = mci_malloc_array(ctx, n + size, sizeof *rep);
@@ -280,6 +281,12 @@ static bool merge_definitions(const mci_ctx *ctx, hit_list *hits, const end_def 
         }
         rep[i] = bucket[slot];
     }
+    fit = mci_realloc_array(ctx, hits->defs, distinct + 1, sizeof *fit);
+    if (!fit) {
+        mci_free(ctx, rep);
+        return false;
+    }
+    hits->defs = fit;
     hits->def_count = hits->def_capacity = distinct;
     for (size_t h = 0; h < hits->count; h++)
         for (int k = 0; k < 2; k++)
@@ -1347,6 +1354,9 @@ static mcsg_status build_points(const mci_ctx *ctx, mci_scene *s, hit_list *hits
                 hits->v[h].point[k].at = at == MCI_NONE ? NULL : &job.block[at];
             }
     mci_free(ctx, slot);
+    mci_free(ctx, hits->defs); /* the points stand for them now */
+    hits->defs = NULL;
+    hits->def_count = hits->def_capacity = 0;
     return st;
 }
 
