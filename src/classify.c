@@ -462,6 +462,7 @@ typedef struct leaf_work {
     size_t nlist;
     bool rejected;    /* the trimmed CSGlist drops every face of the leaf */
     mci_blist blist;  /* the trimmed CSGlist compiled for IN/OUT labels (paper §5.4) */
+    uint32_t *blist_slot; /* per blist step: the candidate slot of the leaf it reads */
     mci_ray_scratch ray;
     bool out_of_memory; /* set by a ray test that could not allocate */
     mci_label *scratch, *leaf_labels;
@@ -480,7 +481,7 @@ static void free_work(leaf_work *w)
     void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->walls, w->region,
                    w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
                    w->slot_of_leaf, w->labels, w->needed, w->list, w->scratch,
-                   w->leaf_labels};
+                   w->leaf_labels, w->blist_slot};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
     for (size_t k = 0; w->copy_list && k < w->ncopies; k++)
@@ -1059,12 +1060,15 @@ static bool separator_on_leaf(const leaf_work *w, size_t k, uint32_t m)
     return false;
 }
 
+/* memchr first: the ring of ring-800 has ~800 candidates, all needed and labelled. */
 static bool has_unknown_label(const leaf_work *w, uint32_t r)
 {
-    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
-    for (size_t c = 0; c < w->ncand; c++)
-        if (w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN)
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand, *end = lab + w->ncand, *at = lab;
+    while ((at = memchr(at, MCI_LABEL_UNKNOWN, (size_t)(end - at))) != NULL) {
+        if (w->needed[at - lab])
             return true;
+        at++;
+    }
     return false;
 }
 
@@ -1075,11 +1079,13 @@ static bool has_unknown_label(const leaf_work *w, uint32_t r)
  * separators not on that leaf, until nothing changes. */
 static void fill_unknown_labels(leaf_work *w)
 {
-    bool changed = true;
+    bool changed = true, any = false;
     for (uint32_t r = 0; r < w->nreg; r++)
-        if (has_unknown_label(w, r))
+        if (has_unknown_label(w, r)) {
             seed_by_local_tests(w, r);
-    while (changed) {
+            any = any || has_unknown_label(w, r);
+        }
+    while (changed && any) { /* nearly always none left: no pass over every label */
         changed = false;
         for (uint32_t r = 0; r < w->nreg; r++) {
             uint8_t *lab = w->labels + (size_t)r * w->ncand;
@@ -1434,6 +1440,11 @@ static mcsg_status trim_csglist(leaf_work *w)
                !mci_blist_build(w->ctx, t, w->list, w->nlist, w->leaf_labels, &w->blist)) {
         return mci_fail_nomem(w->err, "classifying faces");
     }
+    /* Every leaf a step reads is UNKNOWN in the trimming labels: a candidate. */
+    if (!(w->blist_slot = mci_malloc_array(w->ctx, w->blist.count + 1, sizeof *w->blist_slot)))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t i = 0; i < w->blist.count; i++)
+        w->blist_slot[i] = w->slot_of_leaf[w->blist.steps[i].leaf];
     return MCSG_OK;
 }
 
@@ -1531,19 +1542,39 @@ static bool labels_from_inside(leaf_work *w, uint32_t r)
 }
 
 /* Whether region r is kept, for this leaf or its copy k (-1: its labels do not tell). */
+/* The blist on region r's own labels (mci_blist_accepts without spreading them over the
+ * leaves first: the ring of ring-800 has ~800 candidates, and a walk reads a few). */
+static int region_blist_accepts(const leaf_work *w, uint32_t r)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    int32_t at = w->blist.start;
+    while (at >= 0) {
+        const mci_blist_step *step = &w->blist.steps[at];
+        uint8_t l = lab[w->blist_slot[at]];
+        if (l == MCI_LABEL_IN)
+            at = step->on_in;
+        else if (l == MCI_LABEL_OUT)
+            at = step->on_out;
+        else
+            return -1;
+    }
+    return at == MCI_BLIST_ACCEPT;
+}
+
 static int region_accepts(leaf_work *w, uint32_t r, size_t k)
 {
     const mci_ptree *t = w->cl->tree;
     bool self = k == w->ncopies;
-    int accepts;
-    region_labels(w, r, self ? w->leaf : w->copies[k]);
+    /* IN and OUT do not depend on orientation: reversing the labels changes none of
+     * those the blist reads. */
+    int accepts = self ? region_blist_accepts(w, r) : -1;
+    if (accepts >= 0)
+        return accepts;
     /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
-    accepts = self ? mci_blist_accepts(&w->blist, w->leaf_labels) : -1;
-    if (accepts < 0)
-        accepts = self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch)
-                       : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k],
-                                             w->leaf_labels, w->scratch);
-    return accepts;
+    region_labels(w, r, self ? w->leaf : w->copies[k]);
+    return self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch)
+                : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k], w->leaf_labels,
+                                      w->scratch);
 }
 
 /* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
