@@ -51,11 +51,6 @@ typedef struct hit_list {
 } hit_list;
 
 
-const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
-{
-    return mci_octree_face_vertex(&scene->octree, f, k);
-}
-
 static void face_plane(const mci_scene *s, uint32_t f, mci_plane *plane)
 {
     mci_plane_init(plane, mci_scene_corner(s, f, 0), mci_scene_corner(s, f, 1),
@@ -1446,11 +1441,6 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     if (st != MCSG_OK)
         mci_scene_free(ctx, scene);
     return st;
-}
-
-uint32_t mci_scene_leaf_stand_in(const mci_scene *s, uint32_t m)
-{
-    return s->alias ? s->alias[m] : m;
 }
 
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,

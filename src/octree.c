@@ -115,13 +115,6 @@ typedef struct builder {
     float *face_box; /* per face: min x, y, z, max x, y, z (see face_boxes) */
 } builder;
 
-const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
-{
-    const mcsg_mesh *m = t->leaves[t->face_leaf[face]];
-    uint32_t local = face - t->face_base[t->face_leaf[face]];
-    return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)local + (size_t)k];
-}
-
 static size_t total_faces(const mcsg_mesh *const *leaves, size_t leaf_count)
 {
     size_t total = 0;

@@ -64,8 +64,14 @@ void mci_octree_free_boxes(const mci_ctx *ctx, mci_octree *tree);
  * face_base, face_leaf) stays usable. mci_octree_free is still needed afterwards. */
 void mci_octree_free_cells(const mci_ctx *ctx, mci_octree *tree);
 
-/* Corner k (0..2) of a face given by its global id. */
-const double *mci_octree_face_vertex(const mci_octree *tree, uint32_t face, int k);
+/* Corner k (0..2) of a face given by its global id. Inline: the octree's and the
+ * arrangements' passes call it millions of times. */
+static inline const double *mci_octree_face_vertex(const mci_octree *t, uint32_t face, int k)
+{
+    const mcsg_mesh *m = t->leaves[t->face_leaf[face]];
+    uint32_t local = face - t->face_base[t->face_leaf[face]];
+    return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)local + (size_t)k];
+}
 
 /* Candidate pairs, each as (smaller global id << 32) | larger id, sorted, unique. The
  * array is allocated with ctx; the caller frees it. */

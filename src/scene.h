@@ -82,7 +82,10 @@ mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *
 mcsg_status mci_scene_arrange(const mci_ctx *ctx, mci_scene *scene, mcsg_error *err);
 
 /* The leaf that stands for leaf m (m itself unless it is a copy). */
-uint32_t mci_scene_leaf_stand_in(const mci_scene *scene, uint32_t m);
+static inline uint32_t mci_scene_leaf_stand_in(const mci_scene *scene, uint32_t m)
+{
+    return scene->alias ? scene->alias[m] : m;
+}
 
 /* Third, the splitting of the arrangements k without skip[k] (skip may be NULL); skipped
  * ones are only merged if they received points. Splitting frees every arrangement's
@@ -104,6 +107,9 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene);
 void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene);
 
 /* Corner k of global face f. */
-const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k);
+static inline const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
+{
+    return mci_octree_face_vertex(&scene->octree, f, k);
+}
 
 #endif
