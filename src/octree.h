@@ -11,8 +11,9 @@
 
 #include "internal.h"
 
-/* A leaf cell's faces are face_ids[first .. first + count) (global face ids: faces of
- * leaf i are numbered from face_base[i]). Leaf cells have child == UINT32_MAX; otherwise
+/* A leaf cell's faces are face_ids[first .. first + count), in increasing order (global
+ * face ids: faces of leaf i are numbered from face_base[i], so a leaf's faces in a cell
+ * are one run). Leaf cells have child == UINT32_MAX; otherwise
  * the eight children are cells child .. child + 7 (bit 0 of the index: upper half in x,
  * bit 1: in y, bit 2: in z), and the built tree keeps no list for the cell (first and
  * count are 0). */

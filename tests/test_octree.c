@@ -157,6 +157,10 @@ static void check_structure(const mci_octree *t)
 {
     for (size_t c = 0; c < t->cell_count; c++) {
         const mci_cell *cell = &t->cells[c];
+        /* A leaf cell's list increases (the rays find a leaf's faces in it by bisection). */
+        for (uint32_t i = 1; cell->child == UINT32_MAX && i < cell->count; i++)
+            CHECK_MSG(t->face_ids[cell->first + i - 1] < t->face_ids[cell->first + i],
+                      "cell %zu: face list not increasing at %u", c, i);
         if (cell->child == UINT32_MAX)
             continue;
         for (int i = 0; i < 8; i++) {
