@@ -493,19 +493,6 @@ void mci_point_round(const mci_point *p, double out[3])
             out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
 }
 
-void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
-{
-    for (int k = 0; k < 3; k++) {
-        if ((p->exact_axes >> k) & 1) {
-            lo[k] = hi[k] = p->c[k];
-        } else {
-            /* one step outward covers the rounding of c -+ r */
-            lo[k] = mci_next_down(p->c[k] - p->r);
-            hi[k] = mci_next_up(p->c[k] + p->r);
-        }
-    }
-}
-
 /* Offset of p from `origin`, scaled by p's W: (base - origin) W + Y. */
 static void fv_offset(const mci_point *p, const double *origin, mci_fv out[3])
 {

@@ -282,8 +282,20 @@ void mci_point_round(const mci_point *p, double out[3]);
 
 /* A box certainly containing the point (possibly infinite when the cached W is too
  * uncertain): the cached box, a single value on the exactly known axes. For culling
- * only: decisions stay with the predicates. */
-void mci_point_bounds(const mci_point *p, double lo[3], double hi[3]);
+ * only: decisions stay with the predicates. Inline: the arrangements' sweeps and merges
+ * and the point numbering ask it ~1.5M times on ring-800. */
+static inline void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        if ((p->exact_axes >> k) & 1) {
+            lo[k] = hi[k] = p->c[k];
+        } else {
+            /* one step outward covers the rounding of c -+ r */
+            lo[k] = mci_next_down(p->c[k] - p->r);
+            hi[k] = mci_next_up(p->c[k] + p->r);
+        }
+    }
+}
 
 /* Each predicate above is the combination of two stages, exposed for tests (which check
  * the exact stage on every case, not only where the filter gives up) and benchmarks
