@@ -136,9 +136,6 @@ static inline bool u32_less(const uint32_t *a, const uint32_t *b)
 
 MCI_DEFINE_SORT(sort_u32, uint32_t, u32_less)
 
-/* Faces of leaf m in the leaf cells the ray meets, sorted and unique in s->faces. Every
- * face the (perturbed) ray crosses, or that holds p, touches the closed ray, so it is
- * in a leaf cell that meets it. */
 /* The first index in [lo, hi) of the increasing ids[] whose id is >= x (hi if none). */
 static uint32_t first_at_least(const uint32_t *ids, uint32_t lo, uint32_t hi, uint32_t x)
 {
@@ -152,6 +149,9 @@ static uint32_t first_at_least(const uint32_t *ids, uint32_t lo, uint32_t hi, ui
     return lo;
 }
 
+/* Faces of leaf m in the leaf cells the ray meets, sorted and unique in s->faces. Every
+ * face the (perturbed) ray crosses, or that holds p, touches the closed ray, so it is
+ * in a leaf cell that meets it. */
 static bool collect_ray_faces(const mci_ctx *ctx, const mci_octree *o, uint32_t m,
                               const double lo[3], const double hi[3], mci_ray_scratch *s)
 {
