@@ -113,6 +113,7 @@ static void add_classify_stats(mcsg_eval_stats *to, const mci_classify_stats *s)
     to->rejected_primitives += s->rejected_leaves;
 }
 
+/* The lists the whole-face decision handed on: the classification took what it used. */
 static void free_trimmed(eval_state *e)
 {
     mci_trimmed_lists_clear(&e->ctx, e->trimmed, e->tree.leaf_count);
