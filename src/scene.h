@@ -19,8 +19,9 @@ typedef struct mci_scene {
     uint32_t *arr_of;         /* per face: index in arrs, or MCI_NONE if untouched */
     mci_face_arr *arrs;       /* in increasing face order */
     /* The points the arrangements refer to, besides their own pools: the pair tests'
-     * (segment ends and contact points not at a vertex; a block per chunk of pairs)
-     * and one per vertex of an arranged face (see intersect.c). Arrangements refer to
+     * (segment ends and contact points not at a vertex, built by mci_scene_arrange in
+     * one block, those that an arranged face uses) and one per vertex of an arranged
+     * face (see intersect.c). Arrangements refer to
      * each other's pools too (shared edge points): a scene's arrangements are freed
      * together. */
     mci_point **hit_blocks;
