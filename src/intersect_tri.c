@@ -116,23 +116,21 @@ static const double *shared_lone_corner(const mci_plane *t1, const int side1[3],
     return NULL;
 }
 
-/* The edge line through u and v, defined in a canonical vertex order. */
+/* The edge line through u and v, defined in a canonical vertex order, meeting the
+ * plane: built, or (see mci_triangle_intersection_defined) its definition only. */
 static void edge_crossing(mci_point *out, const double *u, const double *v,
-                          const mci_plane *plane)
+                          const mci_plane *plane, bool build)
 {
     bool swap = mci_vertex_before(v, u);
-    /* The sides differ strictly, so the line is not parallel to the plane. */
-    (void)mci_point_lpi(out, swap ? v : u, swap ? u : v, plane);
-}
-
-/* Its definition only (see mci_triangle_intersection_defined). */
-static void edge_crossing_defined(mci_point *out, const double *u, const double *v,
-                                  const mci_plane *plane)
-{
-    bool swap = mci_vertex_before(v, u);
+    const double *a = swap ? v : u, *b = swap ? u : v;
+    if (build) {
+        /* The sides differ strictly, so the line is not parallel to the plane. */
+        (void)mci_point_lpi(out, a, b, plane);
+        return;
+    }
     out->kind = MCI_POINT_LPI;
-    out->v[0] = swap ? v : u;
-    out->v[1] = swap ? u : v;
+    out->v[0] = a;
+    out->v[1] = b;
     out->v[2] = plane->a;
     out->v[3] = plane->b;
     out->v[4] = plane->c;
@@ -150,8 +148,7 @@ static void edge_crossing_defined(mci_point *out, const double *u, const double 
 static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const strict_pair *c,
                            mci_tt_result *out)
 {
-    void (*crossing)(mci_point *, const double *, const double *, const mci_plane *) =
-        out->defined_only ? edge_crossing_defined : edge_crossing;
+    bool build = !out->defined_only;
     const double *p1 = c->v1[0], *q1 = c->v1[1], *r1 = c->v1[2];
     const double *p2 = c->v2[0], *q2 = c->v2[1], *r2 = c->v2[2];
     int start_side = mci_orient3d_vertices(p1, r1, p2, q2);
@@ -173,15 +170,15 @@ static void strict_overlap(const mci_plane *t1, const mci_plane *t2, const stric
                                      (end_side != 0) << !c->reversed);
     if (!single || !c->reversed) {
         if (start_k)
-            crossing(start, p2, q2, t1);
+            edge_crossing(start, p2, q2, t1, build);
         else
-            crossing(start, p1, r1, t2);
+            edge_crossing(start, p1, r1, t2, build);
     }
     if (!single || c->reversed) {
         if (end_l)
-            crossing(end, p2, r2, t1);
+            edge_crossing(end, p2, r2, t1, build);
         else
-            crossing(end, p1, q1, t2);
+            edge_crossing(end, p1, q1, t2, build);
     }
 }
 
@@ -195,7 +192,7 @@ static int plane_section(const mci_plane *t, const mci_plane *plane, const int s
         if (side[i] == 0)
             mci_point_explicit(&out[n++], corner(t, i));
         if (n < 2 && side[i] * side[j] < 0)
-            edge_crossing(&out[n++], corner(t, i), corner(t, j), plane);
+            edge_crossing(&out[n++], corner(t, i), corner(t, j), plane, true);
     }
     return n;
 }

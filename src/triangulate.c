@@ -305,8 +305,20 @@ static uint32_t fan_step(const cdt *c, uint32_t t, uint32_t u, bool ccw)
     return c->t[t].n[ccw ? next3(iu) : prev3(iu)];
 }
 
-/* What find_around looks for in the triangle t = (u, q, r) around u. */
-typedef enum fan_goal { FAN_HAS_EDGE, FAN_SEES } fan_goal;
+/* What find_around looks for in the triangle t = (u, q, r) around u. FAN_SEES_ROUGHLY
+ * is FAN_SEES tested exactly only where a rough test in doubles (the projected boxes'
+ * centres, borders included) agrees: it may miss, never finds a wrong triangle. */
+typedef enum fan_goal { FAN_HAS_EDGE, FAN_SEES, FAN_SEES_ROUGHLY } fan_goal;
+
+/* Whether the direction from u to w lies within the angle q-u-r, roughly. */
+static bool roughly_sees(const cdt *c, uint32_t u, uint32_t q, uint32_t r, uint32_t w)
+{
+    const double *U = c->box[u], *Q = c->box[q], *R = c->box[r], *W = c->box[w];
+    double wx = W[0] - U[0], wy = W[1] - U[1];
+    double to_q = (Q[0] - U[0]) * wy - (Q[1] - U[1]) * wx;
+    double to_r = (R[0] - U[0]) * wy - (R[1] - U[1]) * wx;
+    return c->in->sign * to_q >= 0 && c->in->sign * to_r <= 0;
+}
 
 static bool fan_match(const cdt *c, uint32_t t, uint32_t u, uint32_t w, fan_goal goal)
 {
@@ -315,8 +327,10 @@ static bool fan_match(const cdt *c, uint32_t t, uint32_t u, uint32_t w, fan_goal
     uint32_t q = tr->v[next3(iu)], r = tr->v[prev3(iu)];
     if (q == w || r == w)
         return true;
+    if (goal == FAN_HAS_EDGE || (goal == FAN_SEES_ROUGHLY && !roughly_sees(c, u, q, r, w)))
+        return false;
     /* w strictly inside the angle q-u-r: the segment u w leaves through edge q r. */
-    return goal == FAN_SEES && orient(c, u, q, w) > 0 && orient(c, u, r, w) < 0;
+    return orient(c, u, q, w) > 0 && orient(c, u, r, w) < 0;
 }
 
 /* A triangle around u that has the edge u-w, or (FAN_SEES) whose angle at u contains
@@ -337,42 +351,15 @@ static uint32_t find_around(const cdt *c, uint32_t u, uint32_t w, fan_goal goal)
     return NONE;
 }
 
-/* Whether the direction from u to w lies within the angle q-u-r, roughly: from the
- * centres of the projected boxes, in doubles, with the borders included. Only to choose
- * which triangle fan_match tests first. */
-static bool roughly_sees(const cdt *c, uint32_t u, uint32_t q, uint32_t r, uint32_t w)
-{
-    const double *U = c->box[u], *Q = c->box[q], *R = c->box[r], *W = c->box[w];
-    double wx = W[0] - U[0], wy = W[1] - U[1];
-    double to_q = (Q[0] - U[0]) * wy - (Q[1] - U[1]) * wx;
-    double to_r = (R[0] - U[0]) * wy - (R[1] - U[1]) * wx;
-    return c->in->sign * to_q >= 0 && c->in->sign * to_r <= 0;
-}
-
 /* find_around(FAN_SEES) where u-w is no edge. At most one triangle around u has the
  * direction to w strictly inside its angle (w is not on the line of an edge at u: no
  * point lies inside a constraint), so which one is tested first changes nothing but the
- * cost: the fan is walked once with the rough test, and only a rough match gets the
- * exact one (about one triangle instead of half the fan, two orientations each). */
+ * cost: a rough walk first tests about one triangle exactly instead of half the fan,
+ * and the exact walk remains for what the rough test misses. */
 static uint32_t find_seeing(const cdt *c, uint32_t u, uint32_t w)
 {
-    uint32_t start = c->vt[u], t = start;
-    bool ccw = true;
-    while (t != NONE) {
-        const tri *tr = &c->t[t];
-        int iu = vertex_index(tr, u);
-        uint32_t q = tr->v[next3(iu)], r = tr->v[prev3(iu)];
-        if (roughly_sees(c, u, q, r, w) && fan_match(c, t, u, w, FAN_SEES))
-            return t;
-        t = tr->n[ccw ? next3(iu) : prev3(iu)];
-        if (t == start)
-            break;
-        if (t == NONE && ccw) { /* an open fan: the other way from the start */
-            ccw = false;
-            t = fan_step(c, start, u, false);
-        }
-    }
-    return find_around(c, u, w, FAN_SEES);
+    uint32_t t = find_around(c, u, w, FAN_SEES_ROUGHLY);
+    return t != NONE ? t : find_around(c, u, w, FAN_SEES);
 }
 
 static bool push_edge(cdt *c, uint32_t u, uint32_t w, uint32_t t)
