@@ -360,15 +360,21 @@ static void lpi_box(mci_point *p, const double *l0, const double *l1, const mci_
     set_box(p, exact, axes);
 }
 
-bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane)
+void mci_point_lpi_define(mci_point *p, const double *l0, const double *l1,
+                          const mci_plane *plane)
 {
-    mci_fv u[3], to_plane[3], s;
     p->kind = MCI_POINT_LPI;
     p->v[0] = l0;
     p->v[1] = l1;
     p->v[2] = plane->a;
     p->v[3] = plane->b;
     p->v[4] = plane->c;
+}
+
+bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane)
+{
+    mci_fv u[3], to_plane[3], s;
+    mci_point_lpi_define(p, l0, l1, plane);
     for (int k = 0; k < 3; k++) {
         u[k] = fv_diff(l1[k], l0[k]);
         to_plane[k] = fv_diff(plane->a[k], l0[k]);

@@ -145,6 +145,10 @@ typedef struct mci_point {
  * used: nothing is copied. */
 void mci_point_explicit(mci_point *p, const double *x);
 bool mci_point_lpi(mci_point *p, const double *l0, const double *l1, const mci_plane *plane);
+/* An LPI's definition only (kind and v[]; nothing else set): a record to build later
+ * with mci_point_lpi, never an argument of a predicate. */
+void mci_point_lpi_define(mci_point *p, const double *l0, const double *l1,
+                          const mci_plane *plane);
 bool mci_point_tpi(mci_point *p, const mci_plane *p1, const mci_plane *p2, const mci_plane *p3);
 
 /* Side of point p with respect to the plane: +1 in front (the side n points to),

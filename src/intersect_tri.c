@@ -123,17 +123,10 @@ static void edge_crossing(mci_point *out, const double *u, const double *v,
 {
     bool swap = mci_vertex_before(v, u);
     const double *a = swap ? v : u, *b = swap ? u : v;
-    if (build) {
-        /* The sides differ strictly, so the line is not parallel to the plane. */
+    if (build) /* the sides differ strictly: the line is not parallel to the plane */
         (void)mci_point_lpi(out, a, b, plane);
-        return;
-    }
-    out->kind = MCI_POINT_LPI;
-    out->v[0] = a;
-    out->v[1] = b;
-    out->v[2] = plane->a;
-    out->v[3] = plane->b;
-    out->v[4] = plane->c;
+    else
+        mci_point_lpi_define(out, a, b, plane);
 }
 
 /* The overlap of sections that are not apart (every corner strictly off the other
