@@ -362,6 +362,10 @@ static mcsg_status split_touching(eval_state *e, mcsg_mesh *out, mcsg_error *err
     if (split.unpaired_edges > 0) /* only after rounding moved vertices: leave them */
         mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu edges of the result with more than two "
                 "triangles could not be separated after rounding", split.unpaired_edges);
+    if (split.reordered_edges > 0)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "%zu edges of the result with more than two "
+                "triangles were reordered by rounding and paired by their order",
+                split.reordered_edges);
     return MCSG_OK;
 }
 

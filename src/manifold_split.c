@@ -34,7 +34,8 @@ typedef struct splitter {
     uint32_t *start, *corner; /* corners (= outgoing edge slots) of vertex v:
                                  corner[start[v] .. start[v + 1]) */
     size_t chunks;
-    size_t *bad_edges;        /* per chunk */
+    size_t *bad_edges;        /* per chunk: edges left unpaired */
+    size_t *reordered_edges;  /* per chunk: edges paired by pair_by_brackets */
     uint32_t *parent, *copy;  /* per corner: union-find, the copy of a root */
     size_t *extra;            /* per chunk: new vertices; then the first new id */
 } splitter;
@@ -119,9 +120,55 @@ static bool angle_before(const double *u, const double *v, const double *r, cons
     return (c1 == 1 || c1 == 3) && turn(u, v, w1, w2) > 0;
 }
 
-/* Pair the 2k slots of one edge (slots[0 .. n)) by angle; false if they do not
- * alternate in direction (then the edge is left unpaired). */
-static bool pair_around_edge(splitter *sp, uint32_t *slots, size_t n)
+static void pair_slots(splitter *sp, uint32_t a, uint32_t b)
+{
+    sp->mate[a] = b;
+    sp->mate[b] = a;
+}
+
+/* The slot y -> x reached by turning about x from slot s (x -> y) across x's other
+ * edges, through the slots already paired: consistent orientation makes the turn end at
+ * an edge y -> x. MCI_NONE if an edge on the way is not paired yet. */
+static uint32_t turn_about_from(const splitter *sp, uint32_t s)
+{
+    const mcsg_mesh *m = sp->m;
+    uint32_t x = slot_from(m, s), y = slot_to(m, s);
+    for (uint32_t steps = sp->start[x + 1] - sp->start[x]; steps > 0; steps--) {
+        uint32_t in = prev_in_triangle(s); /* w -> x */
+        if (slot_from(m, in) == y)
+            return in;
+        if ((s = sp->mate[in]) == MCI_NONE)
+            return MCI_NONE;
+    }
+    return MCI_NONE;
+}
+
+/* Pair each slot leaving x with the slot where the turn about x from it ends: the pairs
+ * then lie in distinct umbrellas at x, which copies of x separate. False (nothing
+ * written) if a turn fails or two end at the same slot. */
+static bool pair_by_turns(splitter *sp, const uint32_t *slots, size_t n, uint32_t x)
+{
+    uint32_t from[32], to[32];
+    size_t pairs = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (slot_from(sp->m, slots[i]) != x)
+            continue;
+        from[pairs] = slots[i];
+        to[pairs] = turn_about_from(sp, slots[i]);
+        if (to[pairs] == MCI_NONE)
+            return false;
+        for (size_t k = 0; k < pairs; k++)
+            if (to[k] == to[pairs])
+                return false;
+        pairs++;
+    }
+    for (size_t k = 0; k < pairs; k++)
+        pair_slots(sp, from[k], to[k]);
+    return true;
+}
+
+/* Sort the slots of edge u-v (slots[0] runs u -> v) by angle about u -> v. */
+static void sort_by_angle(const splitter *sp, uint32_t *slots, size_t n)
 {
     const mcsg_mesh *m = sp->m;
     uint32_t u = slot_from(m, slots[0]), v = slot_to(m, slots[0]);
@@ -134,15 +181,46 @@ static bool pair_around_edge(splitter *sp, uint32_t *slots, size_t n)
             slots[j] = slots[j - 1];
             slots[j - 1] = t;
         }
-    for (size_t i = 0; i < n; i++) {
-        uint32_t s = slots[i], before = slots[(i + n - 1) % n];
-        if (slot_from(m, s) != u)
-            continue;
-        if (slot_from(m, before) != v)
-            return false;
-        sp->mate[s] = before;
-        sp->mate[before] = s;
+}
+
+/* The last resort: any pairing of opposite directions makes the edge manifold. This one
+ * reads the turn about u -> v as a bracket sequence (v -> u opens, u -> v closes) and
+ * pairs matching brackets, so that no two pairs interleave. Both directions occur n / 2
+ * times. */
+static void pair_by_brackets(splitter *sp, uint32_t *slots, size_t n)
+{
+    uint32_t open[32], u = slot_from(sp->m, slots[0]);
+    size_t first = 0, depth = 0;
+    long balance = 0, lowest = 0;
+    sort_by_angle(sp, slots, n);
+    for (size_t i = 0; i < n; i++) { /* start just after the lowest prefix balance */
+        balance += slot_from(sp->m, slots[i]) == u ? -1 : 1;
+        if (balance < lowest)
+            lowest = balance, first = i + 1;
     }
+    for (size_t k = 0; k < n; k++) {
+        uint32_t s = slots[(first + k) % n];
+        if (slot_from(sp->m, s) != u)
+            open[depth++] = s;
+        else
+            pair_slots(sp, s, open[--depth]);
+    }
+}
+
+/* Pair the 2k slots of one edge (slots[0 .. n)) by angle: each u -> v slot with the one
+ * just before it in the turn, which runs v -> u wherever the directions alternate.
+ * Returns false, with nothing paired, if they do not (see pair_reordered). */
+static bool pair_by_angle(splitter *sp, uint32_t *slots, size_t n)
+{
+    const mcsg_mesh *m = sp->m;
+    uint32_t u = slot_from(m, slots[0]), v = slot_to(m, slots[0]);
+    sort_by_angle(sp, slots, n);
+    for (size_t i = 0; i < n; i++)
+        if (slot_from(m, slots[i]) == u && slot_from(m, slots[(i + n - 1) % n]) != v)
+            return false;
+    for (size_t i = 0; i < n; i++)
+        if (slot_from(m, slots[i]) == u)
+            pair_slots(sp, slots[i], slots[(i + n - 1) % n]);
     return true;
 }
 
@@ -213,47 +291,96 @@ static uint32_t run_to(const splitter *sp, uint32_t u, uint32_t v, size_t *count
     return first;
 }
 
-/* Pair the slots of every edge u-v with u < v in the chunk's vertices: the two opposite
- * ones of a manifold edge directly, the 2k of a non-manifold edge by angle. u's corners
- * come in runs u -> v; the run v -> u is found by a binary search among v's. */
+/* How the slots of a non-manifold edge are paired: by angle (the first pass, on the
+ * threads), or, for the edges that pass left (reordered by rounding), by turns, or by
+ * turns or else brackets. */
+typedef enum pairing { BY_ANGLE, BY_TURNS, BY_TURNS_OR_BRACKETS } pairing;
+
+/* Pair the slots of the edges u-v with u < v: the two opposite ones of a manifold edge
+ * directly, the 2k of a non-manifold edge as `how` says. u's corners come in runs u -> v;
+ * the run v -> u is found by a binary search among v's. Returns the number of edges that
+ * BY_ANGLE left or the others paired. */
+static size_t pair_at_vertex(splitter *sp, size_t chunk, uint32_t u, pairing how)
+{
+    const mcsg_mesh *m = sp->m;
+    uint32_t slots[64];
+    size_t counted = 0;
+    for (uint32_t k = sp->start[u]; k < sp->start[u + 1];) {
+        uint32_t v = slot_to(m, sp->corner[k]), back_first;
+        size_t ahead = 1, back;
+        while (k + ahead < sp->start[u + 1] && slot_to(m, sp->corner[k + ahead]) == v)
+            ahead++;
+        k += (uint32_t)ahead;
+        if (v < u)
+            continue;
+        back_first = run_to(sp, v, u, &back);
+        if (ahead == 1 && back == 1) {
+            if (how == BY_ANGLE)
+                pair_slots(sp, sp->corner[k - 1], sp->corner[back_first]);
+            continue;
+        }
+        if (ahead != back || ahead + back > sizeof slots / sizeof slots[0]) {
+            sp->bad_edges[chunk] += how == BY_ANGLE;
+            continue;
+        }
+        if (how != BY_ANGLE && sp->mate[sp->corner[k - 1]] != MCI_NONE)
+            continue;
+        memcpy(slots, sp->corner + k - ahead, ahead * sizeof *slots);
+        memcpy(slots + ahead, sp->corner + back_first, back * sizeof *slots);
+        if (how == BY_ANGLE)
+            counted += !pair_by_angle(sp, slots, ahead + back);
+        else if (pair_by_turns(sp, slots, ahead + back, u) ||
+                 pair_by_turns(sp, slots, ahead + back, v))
+            counted++;
+        else if (how == BY_TURNS_OR_BRACKETS) {
+            pair_by_brackets(sp, slots, ahead + back);
+            counted++;
+        }
+    }
+    return counted;
+}
+
 static mcsg_status pair_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     splitter *sp = user;
-    const mcsg_mesh *m = sp->m;
-    uint32_t slots[64];
     (void)err;
     for (uint32_t u = (uint32_t)(chunk * VERTEX_CHUNK); u < chunk_end(sp, chunk); u++)
-        for (uint32_t k = sp->start[u]; k < sp->start[u + 1];) {
-            uint32_t v = slot_to(m, sp->corner[k]), back_first;
-            size_t ahead = 1, back;
-            while (k + ahead < sp->start[u + 1] && slot_to(m, sp->corner[k + ahead]) == v)
-                ahead++;
-            k += (uint32_t)ahead;
-            if (v < u)
-                continue;
-            back_first = run_to(sp, v, u, &back);
-            if (ahead == 1 && back == 1) {
-                sp->mate[sp->corner[k - 1]] = sp->corner[back_first];
-                sp->mate[sp->corner[back_first]] = sp->corner[k - 1];
-                continue;
-            }
-            if (ahead != back || ahead + back > sizeof slots / sizeof slots[0]) {
-                sp->bad_edges[chunk]++;
-                continue;
-            }
-            memcpy(slots, sp->corner + k - ahead, ahead * sizeof *slots);
-            memcpy(slots + ahead, sp->corner + back_first, back * sizeof *slots);
-            if (!pair_around_edge(sp, slots, ahead + back))
-                sp->bad_edges[chunk]++;
-        }
+        sp->reordered_edges[chunk] += pair_at_vertex(sp, chunk, u, BY_ANGLE);
     return MCSG_OK;
+}
+
+/* Rounding can reorder nearly coplanar triangles around an edge, or, where it joined
+ * vertices, bring in triangles of another edge, so that the directions no longer
+ * alternate. Such an edge is paired so that copies of one of its ends can separate the
+ * pairs (pair_by_turns), which needs the other edges on the turns paired first: passes
+ * in vertex order (the same for any thread count) until one pairs nothing, then one that
+ * pairs what is left by brackets. */
+static void pair_reordered(splitter *sp)
+{
+    size_t left = 0;
+    for (size_t c = 0; c < sp->chunks; c++)
+        left += sp->reordered_edges[c];
+    pairing how = BY_TURNS;
+    while (left > 0) {
+        size_t paired = 0;
+        for (uint32_t u = 0; u < sp->m->vertex_count; u++)
+            paired += pair_at_vertex(sp, 0, u, how);
+        left -= paired;
+        if (how == BY_TURNS_OR_BRACKETS)
+            break;
+        if (paired == 0)
+            how = BY_TURNS_OR_BRACKETS;
+    }
 }
 
 static bool pair_edges(splitter *sp)
 {
     for (size_t s = 0; s < 3 * sp->m->triangle_count; s++)
         sp->mate[s] = MCI_NONE;
-    return mci_parallel_for(sp->ctx, sp->chunks, pair_chunk, sp, NULL) == MCSG_OK;
+    if (mci_parallel_for(sp->ctx, sp->chunks, pair_chunk, sp, NULL) != MCSG_OK)
+        return false;
+    pair_reordered(sp);
+    return true;
 }
 
 /* The corner of the triangle holding slot s (paired with an edge at vertex x) at x. */
@@ -383,12 +510,17 @@ bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *re
     sp.chunks = (m->vertex_count + VERTEX_CHUNK - 1) / VERTEX_CHUNK;
     sp.mate = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *sp.mate);
     sp.bad_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.bad_edges);
-    ok = sp.mate && sp.bad_edges && corners_by_vertex(&sp) && pair_edges(&sp) &&
+    sp.reordered_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.reordered_edges);
+    ok = sp.mate && sp.bad_edges && sp.reordered_edges && corners_by_vertex(&sp) &&
+         pair_edges(&sp) &&
          split_vertices(&sp, &result->new_vertices);
-    for (size_t c = 0; sp.bad_edges && c < sp.chunks; c++)
+    for (size_t c = 0; sp.bad_edges && sp.reordered_edges && c < sp.chunks; c++) {
         result->unpaired_edges += sp.bad_edges[c];
+        result->reordered_edges += sp.reordered_edges[c];
+    }
     mci_free(ctx, sp.mate);
     mci_free(ctx, sp.bad_edges);
+    mci_free(ctx, sp.reordered_edges);
     mci_free(ctx, sp.start);
     mci_free(ctx, sp.corner);
     mci_free(ctx, sp.parent);

@@ -10,7 +10,10 @@
 
 typedef struct mci_touching_split {
     size_t new_vertices;   /* vertex copies added */
-    size_t unpaired_edges; /* edges whose triangles could not be paired (left as they are) */
+    size_t unpaired_edges; /* edges whose triangles could not be paired (left as they are):
+                              not as many in each direction, or over 64 */
+    size_t reordered_edges; /* edges whose triangles did not alternate in direction around
+                               them after rounding, paired by their order */
 } mci_touching_split;
 
 /* m: closed, consistently oriented triangle mesh allocated with ctx (its vertex array

@@ -32,8 +32,10 @@
  * the leaf is subtracted an odd number of times. A result may be edge-non-manifold only
  * where two parts of it can touch exactly along an edge: in grid and tilted trees, and in
  * trees with two copies of a leaf ((A | B) - (A & B) touches itself along the curve where
- * the surfaces of A and B cross). Then every edge must still be used as often in each
- * direction (closed and oriented).
+ * the surfaces of A and B cross), or, in any tree, where rounding joined distinct exact
+ * vertices (and dropped the triangles that collapsed), which can bring two parts together
+ * along an edge; there the output must still be manifold by vertex index. Then every edge
+ * must still be used as often in each direction (closed and oriented).
  *
  * A failing case is shrunk (a subtree as the whole tree, a child removed, an operation
  * replaced by one of its children) while it still fails, and printed as a CSG file.
@@ -853,9 +855,14 @@ static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
                              report.degenerate_triangles <= stats->rounding_flat_triangles &&
                              report.boundary_edges == 0 && report.inconsistent_edges == 0 &&
                              unbalanced == 0;
+        /* Rounding that joins distinct exact vertices (which drops the triangles it
+         * collapses) can bring two parts of any result together along an edge; the
+         * output must then still be manifold by index. */
+        bool touching_by_rounding = stats->rounding_dropped_triangles > 0 && defects == 0;
         if (rounding_only)
             r->rounding_artifacts = true;
-        else if (!allow_touching || !only_shared_edges || unbalanced > 0)
+        else if (!(allow_touching || touching_by_rounding) || !only_shared_edges ||
+                 unbalanced > 0)
             return fail(r, "invalid output (%zu triangles): %zu boundary, %zu non-manifold, "
                         "%zu inconsistent, %zu unbalanced edges; %zu degenerate, %zu "
                         "duplicate triangles; %zu non-finite vertices", out->triangle_count,
