@@ -366,6 +366,9 @@ static mcsg_status split_touching(eval_state *e, mcsg_mesh *out, mcsg_error *err
         mci_log(&e->ctx, MCSG_LOG_INFO, "%zu edges of the result with more than two "
                 "triangles were reordered by rounding and paired by their order",
                 split.reordered_edges);
+    if (split.separated_edges > 0)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "%zu edges where parts of the result touch were "
+                "paired so that vertex copies separate the parts", split.separated_edges);
     return MCSG_OK;
 }
 

@@ -13,6 +13,11 @@
  * at a manifold edge, to the paired one at a non-manifold edge); each group beyond the
  * first gets a new vertex. All angle comparisons are exact predicates on the rounded
  * coordinates.
+ *
+ * Two serial passes, only where edges have more than two triangles, pair by turns about
+ * an end instead (pair_reordered, separate_shared_edges): where rounding reordered the
+ * triangles about an edge so that directions do not alternate, and where the angle pairs
+ * would share both ends' umbrellas, so that no copy could separate them.
  */
 #include "manifold_split.h"
 
@@ -35,7 +40,9 @@ typedef struct splitter {
                                  corner[start[v] .. start[v + 1]) */
     size_t chunks;
     size_t *bad_edges;        /* per chunk: edges left unpaired */
-    size_t *reordered_edges;  /* per chunk: edges paired by pair_by_brackets */
+    size_t *reordered_edges;  /* per chunk: edges the angle pairing left (reordered) */
+    size_t *shared_edges;     /* per chunk: edges with over two triangles, paired */
+    size_t separated_edges;   /* paired again by separate_pairs */
     uint32_t *parent, *copy;  /* per corner: union-find, the copy of a root */
     size_t *extra;            /* per chunk: new vertices; then the first new id */
 } splitter;
@@ -143,12 +150,13 @@ static uint32_t turn_about_from(const splitter *sp, uint32_t s)
     return MCI_NONE;
 }
 
-/* Pair each slot leaving x with the slot where the turn about x from it ends: the pairs
- * then lie in distinct umbrellas at x, which copies of x separate. False (nothing
- * written) if a turn fails or two end at the same slot. */
-static bool pair_by_turns(splitter *sp, const uint32_t *slots, size_t n, uint32_t x)
+/* The pairs that let copies of x separate them: each slot leaving x (from[k]) with the
+ * slot where the turn about x from it ends (to[k]), which puts every pair in an umbrella
+ * of its own at x. Returns the number of pairs, or 0 if a turn fails or two end at the
+ * same slot. */
+static size_t pairs_by_turns(const splitter *sp, const uint32_t *slots, size_t n, uint32_t x,
+                             uint32_t *from, uint32_t *to)
 {
-    uint32_t from[32], to[32];
     size_t pairs = 0;
     for (size_t i = 0; i < n; i++) {
         if (slot_from(sp->m, slots[i]) != x)
@@ -156,15 +164,24 @@ static bool pair_by_turns(splitter *sp, const uint32_t *slots, size_t n, uint32_
         from[pairs] = slots[i];
         to[pairs] = turn_about_from(sp, slots[i]);
         if (to[pairs] == MCI_NONE)
-            return false;
+            return 0;
         for (size_t k = 0; k < pairs; k++)
             if (to[k] == to[pairs])
-                return false;
+                return 0;
         pairs++;
     }
+    return pairs;
+}
+
+/* Pair the edge by turns about x (see pairs_by_turns); false, with nothing written, if
+ * that fails. */
+static bool pair_by_turns(splitter *sp, const uint32_t *slots, size_t n, uint32_t x)
+{
+    uint32_t from[32], to[32];
+    size_t pairs = pairs_by_turns(sp, slots, n, x, from, to);
     for (size_t k = 0; k < pairs; k++)
         pair_slots(sp, from[k], to[k]);
-    return true;
+    return pairs > 0;
 }
 
 /* Sort the slots of edge u-v (slots[0] runs u -> v) by angle about u -> v. */
@@ -222,13 +239,6 @@ static bool pair_by_angle(splitter *sp, uint32_t *slots, size_t n)
         if (slot_from(m, slots[i]) == u)
             pair_slots(sp, slots[i], slots[(i + n - 1) % n]);
     return true;
-}
-
-static uint32_t find(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-    return x;
 }
 
 /* One stable counting sort of corners by their edge's target vertex (by_target) or by
@@ -291,10 +301,85 @@ static uint32_t run_to(const splitter *sp, uint32_t u, uint32_t v, size_t *count
     return first;
 }
 
+static uint32_t find(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+/* Whether the pairs of an edge u-v (from[k]: u -> v, paired) get vertex copies that
+ * separate them: each pair's umbrellas at u and at v differ from every other pair's. */
+static bool pairs_separate(const splitter *sp, const uint32_t *from, size_t pairs)
+{
+    uint32_t at_u[32], at_v[32];
+    for (size_t k = 0; k < pairs; k++) {
+        at_u[k] = find(sp->parent, from[k]);
+        at_v[k] = find(sp->parent, next_in_triangle(from[k]));
+        for (size_t j = 0; j < k; j++)
+            if (at_u[j] == at_u[k] && at_v[j] == at_v[k])
+                return false;
+    }
+    return true;
+}
+
+static size_t position(const uint32_t *slots, uint32_t s)
+{
+    size_t i = 0;
+    while (slots[i] != s)
+        i++;
+    return i;
+}
+
+/* Whether two of the pairs (from[k], to[k]) cross as chords of the angle order about the
+ * edge (slots, sorted by sort_by_angle). */
+static bool pairs_cross(const uint32_t *slots, const uint32_t *from, const uint32_t *to,
+                        size_t pairs)
+{
+    size_t lo[32], hi[32];
+    for (size_t k = 0; k < pairs; k++) {
+        size_t a = position(slots, from[k]), b = position(slots, to[k]);
+        lo[k] = a < b ? a : b;
+        hi[k] = a < b ? b : a;
+        for (size_t j = 0; j < k; j++)
+            if ((lo[j] < lo[k] && lo[k] < hi[j] && hi[j] < hi[k]) ||
+                (lo[k] < lo[j] && lo[j] < hi[k] && hi[k] < hi[j]))
+                return true;
+    }
+    return false;
+}
+
+/* Parts touching along an edge whose ends each have a single umbrella are not separated
+ * by vertex copies (and rounding can bring such an edge about). Where the turn pairing
+ * about u or v differs from the pairs and, in the angle order, pairs neighbours as well
+ * (no two of its pairs cross; with four triangles, it is the other pairing of adjacent
+ * ones), it takes their place. Returns whether it did. The slots are those of edge u-v,
+ * paired, with slots[0 .. pairs) running u -> v. */
+static bool separate_pairs(splitter *sp, uint32_t *slots, size_t n, uint32_t u, uint32_t v)
+{
+    uint32_t from[32], to[32], ends[2] = {u, v};
+    if (pairs_separate(sp, slots, n / 2))
+        return false;
+    for (int e = 0; e < 2; e++) {
+        size_t pairs = pairs_by_turns(sp, slots, n, ends[e], from, to), same = 0;
+        for (size_t k = 0; k < pairs; k++)
+            same += sp->mate[from[k]] == to[k];
+        if (pairs == 0 || same == pairs)
+            continue;
+        sort_by_angle(sp, slots, n);
+        if (pairs_cross(slots, from, to, pairs))
+            continue;
+        for (size_t k = 0; k < pairs; k++)
+            pair_slots(sp, from[k], to[k]);
+        return true;
+    }
+    return false;
+}
+
 /* How the slots of a non-manifold edge are paired: by angle (the first pass, on the
  * threads), or, for the edges that pass left (reordered by rounding), by turns, or by
- * turns or else brackets. */
-typedef enum pairing { BY_ANGLE, BY_TURNS, BY_TURNS_OR_BRACKETS } pairing;
+ * turns or else brackets; SEPARATING revisits the paired edges (separate_pairs). */
+typedef enum pairing { BY_ANGLE, BY_TURNS, BY_TURNS_OR_BRACKETS, SEPARATING } pairing;
 
 /* Pair the slots of the edges u-v with u < v: the two opposite ones of a manifold edge
  * directly, the 2k of a non-manifold edge as `how` says. u's corners come in runs u -> v;
@@ -323,12 +408,17 @@ static size_t pair_at_vertex(splitter *sp, size_t chunk, uint32_t u, pairing how
             sp->bad_edges[chunk] += how == BY_ANGLE;
             continue;
         }
-        if (how != BY_ANGLE && sp->mate[sp->corner[k - 1]] != MCI_NONE)
+        if ((how == BY_TURNS || how == BY_TURNS_OR_BRACKETS) &&
+            sp->mate[sp->corner[k - 1]] != MCI_NONE)
             continue;
         memcpy(slots, sp->corner + k - ahead, ahead * sizeof *slots);
         memcpy(slots + ahead, sp->corner + back_first, back * sizeof *slots);
-        if (how == BY_ANGLE)
+        if (how == SEPARATING)
+            counted += separate_pairs(sp, slots, ahead + back, u, v);
+        else if (how == BY_ANGLE) {
             counted += !pair_by_angle(sp, slots, ahead + back);
+            sp->shared_edges[chunk]++;
+        }
         else if (pair_by_turns(sp, slots, ahead + back, u) ||
                  pair_by_turns(sp, slots, ahead + back, v))
             counted++;
@@ -465,6 +555,30 @@ static mcsg_status number_chunk(void *user, size_t chunk, mcsg_error *err)
     return MCSG_OK;
 }
 
+/* Umbrellas of every vertex (parent), and the number beyond the first per chunk (extra). */
+static void group(splitter *sp)
+{
+    for (size_t c = 0; c < 3 * sp->m->triangle_count; c++)
+        sp->parent[c] = (uint32_t)c, sp->copy[c] = MCI_NONE;
+    mci_parallel_for(sp->ctx, sp->chunks, group_chunk, sp, NULL);
+}
+
+/* Once grouped: the edges with over two triangles that vertex copies would not separate
+ * are paired again where that helps (separate_pairs), serially in vertex order; returns
+ * whether any was (then the caller groups again). Every edge is judged on the first
+ * grouping's umbrellas, and turns read the pairs as they are at that point. */
+static bool separate_shared_edges(splitter *sp)
+{
+    size_t shared = 0;
+    for (size_t c = 0; c < sp->chunks; c++)
+        shared += sp->shared_edges[c];
+    if (shared == 0)
+        return false;
+    for (uint32_t u = 0; u < sp->m->vertex_count; u++)
+        sp->separated_edges += pair_at_vertex(sp, 0, u, SEPARATING);
+    return sp->separated_edges > 0;
+}
+
 /* New vertices for every umbrella of a vertex but the one with its first corner. */
 static bool split_vertices(splitter *sp, size_t *added)
 {
@@ -477,9 +591,9 @@ static bool split_vertices(splitter *sp, size_t *added)
     *added = 0;
     if (!sp->parent || !sp->copy || !sp->extra)
         return false;
-    for (size_t c = 0; c < n; c++)
-        sp->parent[c] = (uint32_t)c, sp->copy[c] = MCI_NONE;
-    mci_parallel_for(sp->ctx, sp->chunks, group_chunk, sp, NULL);
+    group(sp);
+    if (separate_shared_edges(sp))
+        group(sp);
     for (size_t c = 0; c < sp->chunks; c++) {
         size_t count = sp->extra[c];
         sp->extra[c] = nv + extra;
@@ -511,16 +625,20 @@ bool mci_split_touching(const mci_ctx *ctx, mcsg_mesh *m, mci_touching_split *re
     sp.mate = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *sp.mate);
     sp.bad_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.bad_edges);
     sp.reordered_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.reordered_edges);
-    ok = sp.mate && sp.bad_edges && sp.reordered_edges && corners_by_vertex(&sp) &&
+    sp.shared_edges = mci_calloc_array(ctx, sp.chunks + 1, sizeof *sp.shared_edges);
+    ok = sp.mate && sp.bad_edges && sp.reordered_edges && sp.shared_edges &&
+         corners_by_vertex(&sp) &&
          pair_edges(&sp) &&
          split_vertices(&sp, &result->new_vertices);
     for (size_t c = 0; sp.bad_edges && sp.reordered_edges && c < sp.chunks; c++) {
         result->unpaired_edges += sp.bad_edges[c];
         result->reordered_edges += sp.reordered_edges[c];
     }
+    result->separated_edges = sp.separated_edges;
     mci_free(ctx, sp.mate);
     mci_free(ctx, sp.bad_edges);
     mci_free(ctx, sp.reordered_edges);
+    mci_free(ctx, sp.shared_edges);
     mci_free(ctx, sp.start);
     mci_free(ctx, sp.corner);
     mci_free(ctx, sp.parent);

@@ -14,6 +14,7 @@ typedef struct mci_touching_split {
                               not as many in each direction, or over 64 */
     size_t reordered_edges; /* edges whose triangles did not alternate in direction around
                                them after rounding, paired by their order */
+    size_t separated_edges; /* edges paired again so that vertex copies separate them */
 } mci_touching_split;
 
 /* m: closed, consistently oriented triangle mesh allocated with ctx (its vertex array

@@ -278,6 +278,11 @@ TEST(touching_solids)
      * in two groups and gives five vertex copies instead of three). */
     expect_touching("union() { cube(1); translate([1,1,0]) cube(1); translate([0,1,1]) cube(1);"
                     " translate([1,1,1]) cube(1); }", 4, 3);
+    /* Two notches touching along an edge whose ends lie inside the solid's surface:
+     * around each end the surface is one umbrella when the four triangles at the edge are
+     * paired by angle (solid wedge with solid wedge), so they are paired by notch. */
+    expect_touching("difference() { cube([2,2,3]); translate([0,0,1]) cube([1,1,1]);"
+                    " translate([1,1,1]) cube([1,1,1]); }", 10, 2);
     /* A box carved from the inside of a face: a pocket. */
     expect_solid("difference() { cube(2); translate([0.5,0.5,1]) cube([1,1,1]); }", 7, 1);
 }
