@@ -505,6 +505,28 @@ static void group_corners(const splitter *sp, const uint32_t *corners, size_t n,
 
 /* Group the chunk's corners and count the umbrellas beyond each vertex's first (copy[]
  * marks the roots seen). */
+/* Whether the n corners of vertex v (corners[0 .. n)) form one umbrella: turning about v
+ * from the first corner (across each corner's incoming edge w -> v to its pair, the slot
+ * v -> w, which is the corner at v of the triangle across) comes back to it after n steps.
+ * Then all of them get the first as their root, without the union-find. */
+static bool one_umbrella(const splitter *sp, const uint32_t *corners, size_t n)
+{
+    uint32_t c = corners[0];
+    for (size_t steps = 1; steps <= n; steps++) {
+        c = sp->mate[prev_in_triangle(c)];
+        if (c == MCI_NONE)
+            return false;
+        if (c == corners[0]) {
+            if (steps != n)
+                return false;
+            for (size_t k = 0; k < n; k++)
+                sp->parent[corners[k]] = corners[0];
+            return true;
+        }
+    }
+    return false;
+}
+
 static mcsg_status group_chunk(void *user, size_t chunk, mcsg_error *err)
 {
     splitter *sp = user;
@@ -513,7 +535,8 @@ static mcsg_status group_chunk(void *user, size_t chunk, mcsg_error *err)
     (void)err;
     for (size_t v = chunk * VERTEX_CHUNK; v < chunk_end(sp, chunk); v++) {
         uint32_t first_root;
-        if (start[v] == start[v + 1])
+        if (start[v] == start[v + 1] ||
+            one_umbrella(sp, corner + start[v], start[v + 1] - start[v]))
             continue;
         group_corners(sp, corner + start[v], start[v + 1] - start[v], sp->parent);
         first_root = find(sp->parent, corner[start[v]]);
