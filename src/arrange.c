@@ -1120,7 +1120,10 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
     /* One block: insert (point_count ids), pairs (2 edge_count + 1 ids), then mark (one
      * flag per point, in room for as many ids). */
     size_t ids = arr->point_count + 2 * arr->edge_count + 1;
-    uint32_t *insert = mci_malloc_array(ctx, ids + arr->point_count, sizeof *insert);
+    uint32_t stack_ids[512]; /* most faces: no allocation */
+    bool on_heap = ids + arr->point_count > sizeof stack_ids / sizeof *stack_ids;
+    uint32_t *insert = on_heap ? mci_malloc_array(ctx, ids + arr->point_count, sizeof *insert)
+                               : stack_ids;
     uint32_t *pairs = insert ? insert + arr->point_count : NULL;
     bool *mark = insert ? (bool *)(void *)(insert + ids) : NULL;
     mcsg_status st = MCSG_OK;
@@ -1148,6 +1151,7 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
             arr->tri_count = out.tri_count;
         }
     }
-    mci_free(ctx, insert);
+    if (on_heap)
+        mci_free(ctx, insert);
     return st;
 }
