@@ -1199,12 +1199,15 @@ static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first, co
 {
     mci_face_arr *arr = &w->cl->scene->arrs[w->s->arr_of[f]];
     const uint32_t *gid = w->s->gid + w->s->gid_start[w->s->arr_of[f]];
-    uint8_t *piece_keep = mci_malloc_array(w->ctx, arr->tri_count + 1, 1), *tri_keep = NULL;
+    uint8_t stack_keep[2 * 256]; /* piece and triangle flags: most faces allocate none */
+    uint8_t *piece_keep = arr->tri_count <= 256 ? stack_keep
+                                                : mci_malloc_array(w->ctx, 2 * arr->tri_count, 1);
+    uint8_t *tri_keep = piece_keep ? piece_keep + arr->tri_count : NULL;
     mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
     for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
         piece_keep[i] = o->keep[w->region[first + i]];
     if (st == MCSG_OK)
-        st = mci_arr_retessellate(w->ctx, arr, piece_keep, &tri_keep, w->err);
+        st = mci_arr_retessellate(w->ctx, arr, piece_keep, tri_keep, w->err);
     for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
         uint32_t v[3];
         if (!tri_keep[t])
@@ -1214,8 +1217,8 @@ static mcsg_status emit_arranged_face(leaf_work *w, uint32_t f, size_t first, co
         if (!push_triangle(w->ctx, o->kept, v, o->reversed, f + o->face_offset))
             st = mci_fail_nomem(w->err, "classifying faces");
     }
-    mci_free(w->ctx, piece_keep);
-    mci_free(w->ctx, tri_keep);
+    if (piece_keep != stack_keep)
+        mci_free(w->ctx, piece_keep);
     return st;
 }
 

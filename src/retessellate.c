@@ -31,8 +31,30 @@ typedef struct old_sides {
     size_t boundary_count, constraint_count;
 } old_sides;
 
+/* Scratch on the stack for faces of up to STACK_PIECES triangles (nearly all): the old
+ * sides, the chosen edges and the spreading queue need no allocation there. */
+enum { STACK_PIECES = 64 };
+
+typedef struct scratch {
+    side sides[3 * STACK_PIECES];
+    bool use[3 * STACK_PIECES];
+    uint32_t queue[STACK_PIECES];
+} scratch;
+
+/* room for n items of `size` bytes: the stack's when it fits, else the heap's */
+static void *room(const mci_ctx *ctx, void *stack, size_t stack_bytes, size_t n, size_t size)
+{
+    return n * size <= stack_bytes ? stack : mci_malloc_array(ctx, n, size);
+}
+
+static void free_room(const mci_ctx *ctx, void *p, const void *stack)
+{
+    if (p != stack)
+        mci_free(ctx, p);
+}
+
 static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
-                              const uint8_t *piece_keep, old_sides *o)
+                              const uint8_t *piece_keep, scratch *sc, old_sides *o)
 {
     size_t n = 3 * arr->tri_count, nb = 0, nc = 0;
     for (size_t r = 0; r < n; r++) {
@@ -42,7 +64,7 @@ static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
               r < (across & ~MCI_CDT_CONSTRAINT);
     }
     /* One block for both lists (freed through o->boundary). */
-    o->boundary = mci_malloc_array(ctx, nb + nc + 1, sizeof *o->boundary);
+    o->boundary = room(ctx, sc->sides, sizeof sc->sides, nb + nc + 1, sizeof *o->boundary);
     o->constraint = o->boundary ? o->boundary + nb : NULL;
     o->boundary_count = o->constraint_count = 0;
     if (!o->boundary)
@@ -60,9 +82,9 @@ static bool collect_old_sides(const mci_ctx *ctx, const mci_face_arr *arr,
     return true;
 }
 
-static void free_old_sides(const mci_ctx *ctx, old_sides *o)
+static void free_old_sides(const mci_ctx *ctx, old_sides *o, const scratch *sc)
 {
-    mci_free(ctx, o->boundary); /* and the constraints, in the same block */
+    free_room(ctx, o->boundary, sc->sides); /* and the constraints, in the same block */
 }
 
 /* Whether `key` is an interior constraint of the old tessellation, and a valid one. */
@@ -78,11 +100,11 @@ static bool is_interior(const old_sides *o, uint64_t key, bool *valid)
  * triangle is unreached. */
 static mcsg_status spread_status(const mci_ctx *ctx, const old_sides *old,
                                  const uint8_t *piece_keep, const mci_face_arr *arr,
-                                 uint8_t *keep, mcsg_error *err)
+                                 scratch *sc, uint8_t *keep, mcsg_error *err)
 {
     const uint32_t *tris = arr->tris;
     size_t n = arr->tri_count, tail = 0;
-    uint32_t *queue = mci_malloc_array(ctx, n + 1, sizeof *queue);
+    uint32_t *queue = room(ctx, sc->queue, sizeof sc->queue, n + 1, sizeof *queue);
     mcsg_status st;
     for (size_t t = 0; queue && t < n; t++)
         keep[t] = 2;
@@ -114,7 +136,8 @@ static mcsg_status spread_status(const mci_ctx *ctx, const old_sides *old,
          : tail < n ? mci_fail(err, MCSG_ERR_INTERNAL,
                                "face %u: a part of its tessellation is unclassified", arr->face)
                     : MCSG_OK;
-    mci_free(ctx, queue);
+    if (queue)
+        free_room(ctx, queue, sc->queue);
     return st;
 }
 
@@ -132,39 +155,34 @@ static void choose_valid(const mci_face_arr *arr, const old_sides *old, bool *us
 }
 
 mcsg_status mci_arr_retessellate(const mci_ctx *ctx, mci_face_arr *arr,
-                                 const uint8_t *piece_keep, uint8_t **tri_keep,
-                                 mcsg_error *err)
+                                 const uint8_t *piece_keep, uint8_t *tri_keep, mcsg_error *err)
 {
     size_t n = arr->tri_count;
+    scratch sc;
     old_sides old = {NULL, NULL, 0, 0};
-    bool *use = mci_malloc_array(ctx, arr->edge_count + 1, sizeof *use);
-    uint8_t *keep = NULL;
+    bool *use = room(ctx, sc.use, sizeof sc.use, arr->edge_count + 1, sizeof *use);
     bool droppable = false, any_kept = false;
-    mcsg_status st = use && collect_old_sides(ctx, arr, piece_keep, &old)
+    mcsg_status st = use && collect_old_sides(ctx, arr, piece_keep, &sc, &old)
                          ? MCSG_OK
                          : mci_fail_nomem(err, "tessellating the result");
-    *tri_keep = NULL;
     for (size_t t = 0; t < n; t++)
         any_kept = any_kept || piece_keep[t];
     if (st == MCSG_OK && any_kept)
         choose_valid(arr, &old, use, &droppable);
     if (st == MCSG_OK && droppable)
         st = mci_arr_triangulate(ctx, arr, use, err);
-    if (st == MCSG_OK) {
-        keep = mci_malloc_array(ctx, arr->tri_count + 1, 1);
-        if (!keep)
-            st = mci_fail_nomem(err, "tessellating the result");
-        else if (!droppable)
-            memcpy(keep, piece_keep, n);
-        else
-            st = spread_status(ctx, &old, piece_keep, arr, keep, err);
-    }
-    if (st == MCSG_OK)
-        *tri_keep = keep;
-    else
-        mci_free(ctx, keep);
-    free_old_sides(ctx, &old);
-    mci_free(ctx, use);
+    /* Same boundary points and no more inside: never more triangles than before. */
+    if (st == MCSG_OK && arr->tri_count > n)
+        st = mci_fail(err, MCSG_ERR_INTERNAL, "face %u: more triangles after re-tessellating",
+                      arr->face);
+    if (st == MCSG_OK && !droppable)
+        memcpy(tri_keep, piece_keep, n);
+    else if (st == MCSG_OK)
+        st = spread_status(ctx, &old, piece_keep, arr, &sc, tri_keep, err);
+    if (old.boundary)
+        free_old_sides(ctx, &old, &sc);
+    if (use)
+        free_room(ctx, use, sc.use);
     /* Nothing reads the adjacency after this; the face's triangles stay until assembly. */
     mci_free(ctx, arr->adj);
     arr->adj = NULL;
