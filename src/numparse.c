@@ -439,9 +439,10 @@ static const char *scan_special(const char *s, const char *end, double *value)
  * the machine's (compilers turn the byte assembly into one load where they can). */
 static bool eight_digits(const char *p, uint64_t *out)
 {
-    uint64_t x = 0;
-    for (int i = 7; i >= 0; i--)
-        x = x << 8 | (unsigned char)p[i];
+    const unsigned char *b = (const unsigned char *)p;
+    uint64_t x = (uint64_t)b[0] | (uint64_t)b[1] << 8 | (uint64_t)b[2] << 16 |
+                 (uint64_t)b[3] << 24 | (uint64_t)b[4] << 32 | (uint64_t)b[5] << 40 |
+                 (uint64_t)b[6] << 48 | (uint64_t)b[7] << 56;
     /* every byte in '0'..'9': high nibble 3, and adding 6 keeps the high nibble at 3 */
     if (((x & UINT64_C(0xF0F0F0F0F0F0F0F0)) |
          (((x + UINT64_C(0x0606060606060606)) & UINT64_C(0xF0F0F0F0F0F0F0F0)) >> 4)) !=
@@ -704,43 +705,47 @@ static bool exact_digits(double value, int precision, u128 *digits_out, int *exp
 /* printf's "%.*g" text of value from its exact digits (exact_digits). */
 static size_t layout_g(char *text, double value, u128 digits, int precision, int exponent)
 {
-    char d[40];
-    size_t len = 0, count;
-    int decimals;
     /* digits < 10^precision <= 10^17 < 2^64: 64-bit division is a multiplication, the
      * 128-bit one a library call. */
-    write_digits(d, (uint64_t)digits, precision);
-    count = (size_t)precision;
-    while (count > 1 && d[count - 1] == '0')
-        count--; /* %g drops trailing zeros */
+    uint64_t n = (uint64_t)digits;
+    int count = precision, point;
+    size_t len = 0;
+    /* %g drops trailing zeros; n has exactly `count` digits (no leading zero), so the
+     * pairs stop with at least one digit left. */
+    while (count > 2 && n % 100 == 0)
+        n /= 100, count -= 2;
+    if (count > 1 && n % 10 == 0)
+        n /= 10, count--;
     if (value < 0)
         text[len++] = '-';
     if (exponent < -4 || exponent >= precision) {
-        text[len++] = d[0];
-        if (count > 1)
-            text[len++] = '.';
-        memcpy(text + len, d + 1, count - 1);
-        len += count - 1;
+        text[len] = '0'; /* d.ddd: the digits, then the point moved in after the first */
+        write_digits(text + len + 1, n, count);
+        text[len] = text[len + 1];
+        text[len + 1] = '.';
+        len += count > 1 ? (size_t)count + 1 : 1;
         len += (size_t)snprintf(text + len, 16, "e%c%02d", exponent < 0 ? '-' : '+',
                                 exponent < 0 ? -exponent : exponent);
         return len;
     }
-    decimals = (int)count - 1 - exponent; /* digits after the point, may be <= 0 */
-    if (exponent < 0) {
+    if (exponent < 0) { /* 0.000ddd */
         text[len++] = '0';
         text[len++] = '.';
         for (int k = -1; k > exponent; k--)
             text[len++] = '0';
-        memcpy(text + len, d, count);
-        len += count;
-    } else {
-        for (int k = 0; k <= exponent; k++)
-            text[len++] = k < (int)count ? d[k] : '0';
-        if (decimals > 0) {
-            text[len++] = '.';
-            memcpy(text + len, d + exponent + 1, (size_t)decimals);
-            len += (size_t)decimals;
-        }
+        write_digits(text + len, n, count);
+        len += (size_t)count;
+    } else if (count <= exponent + 1) { /* ddd000: an integer */
+        write_digits(text + len, n, count);
+        len += (size_t)count;
+        for (int k = count; k <= exponent; k++)
+            text[len++] = '0';
+    } else { /* ddd.ddd: the digits with the point moved in */
+        point = exponent + 1;
+        write_digits(text + len + 1, n, count);
+        memmove(text + len, text + len + 1, (size_t)point);
+        text[len + (size_t)point] = '.';
+        len += (size_t)count + 1;
     }
     text[len] = '\0';
     return len;
