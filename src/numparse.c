@@ -87,16 +87,20 @@ static bool match_word(const char *s, const char *end, const char *word)
     return true;
 }
 
+/* The number of bits of x (0 for 0), from the exponent of x converted to double: the
+ * conversion can round up to the next power of two, which one shift corrects. */
 static int bit_length64(uint64_t x)
 {
-    int n = 0;
-    for (int half = 32; half > 0; half /= 2) {
-        if (x >> half) {
-            n += half;
-            x >>= half;
-        }
-    }
-    return n + (int)x;
+    double d = (double)x;
+    uint64_t bits;
+    int n;
+    if (x == 0)
+        return 0;
+    memcpy(&bits, &d, sizeof bits);
+    n = (int)((bits >> 52) & 0x7ff) - 1022; /* 2^(n-1) <= d < 2^n */
+    if (n > 64)
+        n = 64;
+    return (x >> (n - 1)) ? n : n - 1;
 }
 
 static int bit_length128(u128 x)
