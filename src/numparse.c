@@ -723,8 +723,7 @@ static size_t layout_g(char *text, double value, u128 digits, int precision, int
     if (value < 0)
         text[len++] = '-';
     if (exponent < -4 || exponent >= precision) {
-        text[len] = '0'; /* d.ddd: the digits, then the point moved in after the first */
-        write_digits(text + len + 1, n, count);
+        write_digits(text + len + 1, n, count); /* d.ddd: the point moved in after d */
         text[len] = text[len + 1];
         text[len + 1] = '.';
         len += count > 1 ? (size_t)count + 1 : 1;

@@ -41,10 +41,10 @@ typedef struct scratch {
     uint32_t queue[STACK_PIECES];
 } scratch;
 
-/* room for n items of `size` bytes: the stack's when it fits, else the heap's */
+/* Room for n items of `size` bytes: the stack's when they fit, else the heap's. */
 static void *room(const mci_ctx *ctx, void *stack, size_t stack_bytes, size_t n, size_t size)
 {
-    return n * size <= stack_bytes ? stack : mci_malloc_array(ctx, n, size);
+    return n <= stack_bytes / size ? stack : mci_malloc_array(ctx, n, size);
 }
 
 static void free_room(const mci_ctx *ctx, void *p, const void *stack)
