@@ -133,6 +133,14 @@ static double round_to_double(uint64_t top, int64_t e2, bool sticky)
     int64_t leading = e2 + 63; /* binary exponent of the leading bit */
     int64_t drop = 11;         /* 64 - 53 bits dropped for a normal double */
     u128 kept, rest, half;
+    /* Normal, below overflow, and 2^(e2 + 11) itself normal: in 64 bits. */
+    if (leading >= -1022 + 52 && leading < 1023) {
+        uint64_t k = top >> 11, r = top & 0x7FF, bits = (uint64_t)(e2 + 11 + 1023) << 52;
+        double scale;
+        k += r > 0x400 || (r == 0x400 && (sticky || (k & 1)));
+        memcpy(&scale, &bits, sizeof scale); /* 2^(e2 + 11): k <= 2^53, so exact */
+        return (double)k * scale;
+    }
     if (leading > 1023)
         return INFINITY;
     if (leading < -1022)
