@@ -298,6 +298,69 @@ static double parse_big_fraction(const decimal *d)
 
 /* m * 10^e, m != 0, by paths 1 and 2 of the file comment; false when neither applies
  * (the exponent is out of their range). */
+/* floor(2^b / 5^k) for k = 1 .. 21, each in [2^127, 2^128) (b = 127 + the bit length of
+ * 5^k), as high and low words: m 10^-k = m 5^-k 2^-k is then a 192-bit product. */
+static const struct {
+    uint64_t hi, lo;
+    int b;
+} inverse_five[22] = {
+    {0, 0, 0}, /* k = 0 is not used */
+    {UINT64_C(0xcccccccccccccccc), UINT64_C(0xcccccccccccccccc), 130}, /* 5^-1 */
+    {UINT64_C(0xa3d70a3d70a3d70a), UINT64_C(0x3d70a3d70a3d70a3), 132}, /* 5^-2 */
+    {UINT64_C(0x83126e978d4fdf3b), UINT64_C(0x645a1cac083126e9), 134}, /* 5^-3 */
+    {UINT64_C(0xd1b71758e219652b), UINT64_C(0xd3c36113404ea4a8), 137}, /* 5^-4 */
+    {UINT64_C(0xa7c5ac471b478423), UINT64_C(0x0fcf80dc33721d53), 139}, /* 5^-5 */
+    {UINT64_C(0x8637bd05af6c69b5), UINT64_C(0xa63f9a49c2c1b10f), 141}, /* 5^-6 */
+    {UINT64_C(0xd6bf94d5e57a42bc), UINT64_C(0x3d32907604691b4c), 144}, /* 5^-7 */
+    {UINT64_C(0xabcc77118461cefc), UINT64_C(0xfdc20d2b36ba7c3d), 146}, /* 5^-8 */
+    {UINT64_C(0x89705f4136b4a597), UINT64_C(0x31680a88f8953030), 148}, /* 5^-9 */
+    {UINT64_C(0xdbe6fecebdedd5be), UINT64_C(0xb573440e5a884d1b), 151}, /* 5^-10 */
+    {UINT64_C(0xafebff0bcb24aafe), UINT64_C(0xf78f69a51539d748), 153}, /* 5^-11 */
+    {UINT64_C(0x8cbccc096f5088cb), UINT64_C(0xf93f87b7442e45d3), 155}, /* 5^-12 */
+    {UINT64_C(0xe12e13424bb40e13), UINT64_C(0x2865a5f206b06fb9), 158}, /* 5^-13 */
+    {UINT64_C(0xb424dc35095cd80f), UINT64_C(0x538484c19ef38c94), 160}, /* 5^-14 */
+    {UINT64_C(0x901d7cf73ab0acd9), UINT64_C(0x0f9d37014bf60a10), 162}, /* 5^-15 */
+    {UINT64_C(0xe69594bec44de15b), UINT64_C(0x4c2ebe687989a9b3), 165}, /* 5^-16 */
+    {UINT64_C(0xb877aa3236a4b449), UINT64_C(0x09befeb9fad487c2), 167}, /* 5^-17 */
+    {UINT64_C(0x9392ee8e921d5d07), UINT64_C(0x3aff322e62439fcf), 169}, /* 5^-18 */
+    {UINT64_C(0xec1e4a7db69561a5), UINT64_C(0x2b31e9e3d06c32e5), 172}, /* 5^-19 */
+    {UINT64_C(0xbce5086492111aea), UINT64_C(0x88f4bb1ca6bcf584), 174}, /* 5^-20 */
+    {UINT64_C(0x971da05074da7bee), UINT64_C(0xd3f6fc16ebca5e03), 176}, /* 5^-21 */
+};
+
+/* m 10^-k correctly rounded, for m != 0 and 1 <= k <= 21, by one 64 x 128-bit product
+ * with the truncated 5^-k above (Eisel and Lemire's method). The product P is below the
+ * exact m 2^b / 5^k by less than m < 2^64, so its top word is exact unless the middle
+ * word is all ones (then a carry may reach it), and the bits below the top word can only
+ * be larger than they look: they decide the rounding unless the kept bits end exactly
+ * half way with nothing visible below. False in those two rare cases (the caller then
+ * divides exactly). */
+static bool times_inverse_five(uint64_t m, int k, double *out)
+{
+    int lz = 64 - bit_length64(m);
+    uint64_t w = m << lz, top, middle, low;
+    u128 high = (u128)w * inverse_five[k].hi, lower = (u128)w * inverse_five[k].lo;
+    int64_t e2 = 128 - lz - inverse_five[k].b - k;
+    low = (uint64_t)lower;
+    high += lower >> 64; /* < 2^128: w * hi <= (2^64 - 1)^2 */
+    top = (uint64_t)(high >> 64);
+    middle = (uint64_t)high;
+    if (!(top >> 63)) { /* the product has 191 bits: move one up */
+        if ((middle | (UINT64_C(1) << 63)) == UINT64_MAX)
+            return false;
+        top = top << 1 | middle >> 63;
+        middle = middle << 1 | low >> 63;
+        low <<= 1;
+        e2--;
+    } else if (middle == UINT64_MAX) {
+        return false;
+    }
+    if ((top & 0x7FF) == 0x400 && (middle | low) == 0)
+        return false;
+    *out = round_to_double(top, e2, (middle | low) != 0);
+    return true;
+}
+
 static bool small_to_double(uint64_t m, int64_t e, double *out)
 {
 #if FLT_EVAL_METHOD == 0 /* one rounding per operation (not x87 extended precision) */
@@ -314,6 +377,8 @@ static bool small_to_double(uint64_t m, int64_t e, double *out)
         }
     }
     if (e < 0 && e >= -21) {
+        if (times_inverse_five(m, (int)-e, out))
+            return true;
         /* 10^21 < 2^70 and the numerator has 127 bits: the quotient has >= 57. */
         int shift = 127 - bit_length64(m);
         u128 num = (u128)m << shift, den = pow10_u128((int)-e);
