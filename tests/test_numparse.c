@@ -342,6 +342,29 @@ static bool shortest_is_right(double d, const char *out)
     return false;
 }
 
+/* The one-product path for up to 19 digits times 10^-1 .. 10^-21 (times_inverse_five)
+ * must give up exactly where its product cannot decide: at values half way between two
+ * doubles, (2 j + 1) 2^-(s + 1) written as (2 j + 1) 5^s 10^-s with a 53-bit j, and at
+ * their decimal neighbours; and 17-digit fractions like a mesh file's. */
+TEST(halfway_fractions)
+{
+    char text[64];
+    int before = test_failures;
+    for (int i = 0; i < 100000 && test_failures - before < 10; i++) {
+        uint64_t j = (next_random() >> 11) | (UINT64_C(1) << 52), v = 2 * j + 1;
+        int s = 1 + (int)(next_random() % 2); /* 5^s v stays below 2^64 */
+        for (int k = 0; k < s; k++)
+            v *= 5;
+        for (int d = -1; d <= 1; d++) {
+            snprintf(text, sizeof text, "%llue-%d", (unsigned long long)(v + (uint64_t)d), s);
+            quick_compare(text);
+        }
+        snprintf(text, sizeof text, "%d.%016llu", (int)(next_random() % 10),
+                 (unsigned long long)(next_random() % UINT64_C(10000000000000000)));
+        quick_compare(text);
+    }
+}
+
 TEST(format_round_trip)
 {
     char out[MCI_DOUBLE_TEXT_MAX];
@@ -481,6 +504,7 @@ int main(void)
     RUN(random_digit_strings);
     RUN(short_numbers);
     RUN(halfway_cases);
+    RUN(halfway_fractions);
     RUN(format_round_trip);
     RUN(format_short_decimals);
     RUN(format_typical_range);
