@@ -457,6 +457,10 @@ typedef struct mcsg_eval_stats {
     size_t rounding_split_triangles; /* rounded to three collinear corners and removed by
                                         splitting the neighbour at the middle corner */
     size_t rounding_flat_triangles;  /* rounded flat and left (neighbour flat as well) */
+    size_t rounding_dropped_shells;  /* closed parts of the result thinner than the
+                                        spacing of doubles, which rounding made flat
+                                        (volume 0) or inside out where no outer part's
+                                        bounding box holds them: removed */
     size_t touching_vertices_split;  /* vertex copies added where parts of the result
                                         touch along an edge or at a point, so that the
                                         output is edge- and vertex-manifold */

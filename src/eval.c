@@ -8,6 +8,7 @@
 #include "classify.h"
 #include "leaf_check.h"
 #include "manifold_split.h"
+#include "void_shells.h"
 #include "rounding_repair.h"
 #include "whole_faces.h"
 
@@ -372,6 +373,22 @@ static mcsg_status split_touching(eval_state *e, mcsg_mesh *out, mcsg_error *err
     return MCSG_OK;
 }
 
+/* Shells that rounding left flat or inside out (see void_shells.c) go, with their tags
+ * in kept_tri. */
+static mcsg_status drop_void_shells(eval_state *e, mcsg_mesh *out, uint32_t *kept_tri,
+                                    mcsg_error *err)
+{
+    mci_void_shells removed;
+    if (!mci_drop_void_shells(&e->ctx, out, kept_tri, &removed))
+        return mci_fail_nomem(err, "assembling the result");
+    e->stats.rounding_dropped_shells = removed.shells;
+    if (removed.shells > 0)
+        mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu shells of the result (%zu triangles) were "
+                "flat or inside out after rounding to doubles and were removed",
+                removed.shells, removed.triangles);
+    return MCSG_OK;
+}
+
 static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size_t n,
                                    mcsg_provenance **provenance, mcsg_error *err)
 {
@@ -404,6 +421,8 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
         st = build_output(e, &r, out, &kept_tri, err);
     if (st == MCSG_OK)
         st = split_touching(e, out, err);
+    if (st == MCSG_OK)
+        st = drop_void_shells(e, out, kept_tri, err);
     if (st == MCSG_OK && provenance)
         st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
     if (st != MCSG_OK)

@@ -96,6 +96,13 @@ static inline size_t mci_chunk_end(size_t n, size_t chunk, size_t size)
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 
+/* Exact sign of the signed volume enclosed by the triangles tris[3 * which[k] ..] for
+ * k < n (tris[3 k ..] when which is NULL) over the vertices xyz (finite); the volume in
+ * double in *volume (optional). A floating-point sum decides when its error bound allows,
+ * big integers otherwise. */
+int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uint32_t *which,
+                              size_t n, double *volume);
+
 /* mcsg_mesh_check with the context's allocator; the mesh's counts must fit uint32_t. */
 mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err);

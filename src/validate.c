@@ -348,21 +348,31 @@ static bool count_components_and_unused(check_state *s)
     return true;
 }
 
-/* Exact sign of the sum of det(a, b, c) over all triangles: every coordinate becomes an
- * integer at the mesh's smallest lsb exponent, and the sum is kept exactly. */
-static int exact_volume_sign(const check_state *s)
+/* Triangle `which[k]` (k itself when which is NULL) of the list. */
+static const uint32_t *listed_triangle(const uint32_t *tris, const uint32_t *which, size_t k)
 {
-    const mcsg_mesh *m = s->mesh;
+    return tris + 3 * (size_t)(which ? which[k] : k);
+}
+
+/* Exact sign of the sum of det(a, b, c) over the triangles: every coordinate becomes an
+ * integer at the triangles' smallest lsb exponent, and the sum is kept exactly. */
+static int exact_volume_sign(const double *xyz, const uint32_t *tris, const uint32_t *which,
+                             size_t n)
+{
     int e0 = INT_MAX;
     mci_big sum = {0}, det;
-    for (size_t i = 0; i < 3 * m->vertex_count; i++) {
-        int e = mci_lsb_exponent(m->vertices[i]);
-        e0 = e < e0 ? e : e0;
-    }
+    for (size_t k = 0; k < n; k++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                int e = mci_lsb_exponent(xyz[3 * (size_t)listed_triangle(tris, which, k)[i] + j]);
+                e0 = e < e0 ? e : e0;
+            }
     if (e0 == INT_MAX)
         return 0;
-    for (size_t t = 0; t < m->triangle_count; t++) {
-        mci_det3_big(&det, corner(s, t, 0), corner(s, t, 1), corner(s, t, 2), e0);
+    for (size_t k = 0; k < n; k++) {
+        const uint32_t *t = listed_triangle(tris, which, k);
+        mci_det3_big(&det, xyz + 3 * (size_t)t[0], xyz + 3 * (size_t)t[1],
+                     xyz + 3 * (size_t)t[2], e0);
         mci_big_add(&sum, &sum, &det);
     }
     return mci_big_sign(&sum);
@@ -371,29 +381,37 @@ static int exact_volume_sign(const check_state *s)
 /* Signed volume in double, and its exact sign when the floating-point sum cannot prove
  * it. The bound: each determinant has relative error <= 5 eps of its magnitude sum, and
  * summing n terms adds at most (n-1) eps of the running magnitude. */
-static void compute_volume(check_state *s)
+int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uint32_t *which,
+                              size_t n, double *volume)
 {
-    const mcsg_mesh *m = s->mesh;
-    double sum = 0, magnitude = 0, amplified_underflow = 0;
-    for (size_t t = 0; t < m->triangle_count; t++) {
-        const double *a = corner(s, t, 0), *b = corner(s, t, 1), *c = corner(s, t, 2);
+    double sum = 0, magnitude = 0, amplified_underflow = 0, bound;
+    for (size_t k = 0; k < n; k++) {
+        const uint32_t *t = listed_triangle(tris, which, k);
+        const double *a = xyz + 3 * (size_t)t[0], *b = xyz + 3 * (size_t)t[1],
+                     *c = xyz + 3 * (size_t)t[2];
         for (int i = 0; i < 3; i++) {
-            int j = (i + 1) % 3, k = (i + 2) % 3;
-            double p = b[j] * c[k], q = b[k] * c[j];
+            int j = (i + 1) % 3, l = (i + 2) % 3;
+            double p = b[j] * c[l], q = b[l] * c[j];
             sum += a[i] * (p - q);
             magnitude += fabs(a[i]) * (fabs(p) + fabs(q));
             amplified_underflow += fabs(a[i]);
         }
     }
-    s->report->volume = sum / 6;
+    if (volume)
+        *volume = sum / 6;
     /* As in mci_det3_sign, plus the underflow of p and q amplified by |a_i|. */
-    double bound = (double)(m->triangle_count * 3 + 16) * (DBL_EPSILON / 2) * magnitude * 1.01 +
-                   amplified_underflow * 0x1p-1072;
-    int sign;
+    bound = (double)(n * 3 + 16) * (DBL_EPSILON / 2) * magnitude * 1.01 +
+            amplified_underflow * 0x1p-1072;
     if (isfinite(bound) && magnitude >= 0x1p-960 && fabs(sum) > bound)
-        sign = sum > 0 ? 1 : -1;
-    else
-        sign = exact_volume_sign(s);
+        return sum > 0 ? 1 : -1;
+    return exact_volume_sign(xyz, tris, which, n);
+}
+
+static void compute_volume(check_state *s)
+{
+    const mcsg_mesh *m = s->mesh;
+    int sign = mci_triangles_volume_sign(m->vertices, m->triangles, NULL, m->triangle_count,
+                                         &s->report->volume);
     s->report->inverted = sign < 0;
     s->report->volume_sign = sign;
 }

@@ -630,6 +630,9 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
         printf("  rounding to doubles: %zu triangles collapsed or folded and dropped, %zu flat "
                "ones split away, %zu flat left\n", s->rounding_dropped_triangles,
                s->rounding_split_triangles, s->rounding_flat_triangles);
+    if (s->rounding_dropped_shells)
+        printf("  rounding to doubles: %zu flat or inside-out shells removed\n",
+               s->rounding_dropped_shells);
     if (s->touching_vertices_split)
         printf("  touching parts: %zu vertices given separate copies\n",
                s->touching_vertices_split);

@@ -1,0 +1,23 @@
+/*
+ * Output shells that rounding to doubles left without volume. See void_shells.c.
+ */
+#ifndef MESHCSG_VOID_SHELLS_H
+#define MESHCSG_VOID_SHELLS_H
+
+#include "internal.h"
+
+typedef struct mci_void_shells {
+    size_t shells;    /* shells removed */
+    size_t triangles; /* their triangles */
+} mci_void_shells;
+
+/* m: closed, consistently oriented triangle mesh allocated with ctx, its shells made
+ * apart by vertex (mci_split_touching). Removes every shell whose exact volume is zero,
+ * and every shell of negative volume that no shell of positive volume encloses within its
+ * bounding box; then the vertices no triangle uses. tag (optional) holds one value per
+ * triangle and is compacted with the triangles. Returns false only when out of memory
+ * (m is then unchanged). */
+bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
+                          mci_void_shells *result);
+
+#endif
