@@ -263,37 +263,17 @@ static mci_label subtree_label(const mci_ptree *t, uint32_t node, const mci_labe
     return mci_ptree_eval(t, node, leaf_labels, scratch);
 }
 
-/* The path walk of mci_csglist, evaluating each entry as it is made. */
 size_t mci_csglist_trim(const mci_ptree *t, uint32_t leaf, const mci_label *leaf_labels,
                         mci_label *scratch, mci_csg_entry *list, bool *rejected)
 {
-    size_t kept = 0;
-    uint32_t node = t->leaf_node[leaf];
+    size_t n = mci_csglist(t, leaf, list), kept = 0;
     *rejected = false;
-    while (t->nodes[node].parent != NONE) {
-        const mci_pnode *a = &t->nodes[t->nodes[node].parent];
-        uint8_t base = a->kind == MCI_PNODE_UNION ? MCI_LABEL_BIT(MCI_LABEL_OUT)
-                                                  : MCI_LABEL_BIT(MCI_LABEL_IN);
-        bool after_path = false;
-        for (uint32_t c = 0; c < a->count; c++) {
-            uint32_t s = t->child[a->first + c];
-            uint8_t desired;
-            mci_label l;
-            if (s == node) {
-                after_path = true;
-                continue;
-            }
-            desired = (uint8_t)(base | (after_path ? MCI_LABEL_BIT(MCI_LABEL_SAME) : 0));
-            l = subtree_label(t, s, leaf_labels, scratch);
-            if (l == MCI_LABEL_UNKNOWN) {
-                list[kept].node = s;
-                list[kept++].desired = desired;
-            } else if (!(desired & MCI_LABEL_BIT(l))) {
-                *rejected = true;
-                return kept;
-            }
-        }
-        node = t->nodes[node].parent;
+    for (size_t i = 0; i < n && !*rejected; i++) {
+        mci_label l = subtree_label(t, list[i].node, leaf_labels, scratch);
+        if (l == MCI_LABEL_UNKNOWN)
+            list[kept++] = list[i];
+        else if (!(list[i].desired & MCI_LABEL_BIT(l)))
+            *rejected = true;
     }
     return kept;
 }
