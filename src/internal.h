@@ -96,6 +96,16 @@ static inline size_t mci_chunk_end(size_t n, size_t chunk, size_t size)
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 
+/* Six times a signed volume in double, summed a triangle at a time (det(a, b, c) each),
+ * with what its error bound needs. */
+typedef struct mci_volume_sum {
+    double sum, magnitude, amplified_underflow;
+    size_t triangles;
+} mci_volume_sum;
+void mci_volume_sum_add(mci_volume_sum *v, const double *a, const double *b, const double *c);
+/* +1 or -1 when the error bound proves the sum's sign, 0 when it cannot. */
+int mci_volume_sum_sign(const mci_volume_sum *v);
+
 /* Exact sign of the signed volume enclosed by the triangles tris[3 * which[k] ..] for
  * k < n (tris[3 k ..] when which is NULL) over the vertices xyz (finite); the volume in
  * double in *volume (optional). A floating-point sum decides when its error bound allows,

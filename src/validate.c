@@ -378,33 +378,44 @@ static int exact_volume_sign(const double *xyz, const uint32_t *tris, const uint
     return mci_big_sign(&sum);
 }
 
-/* Signed volume in double, and its exact sign when the floating-point sum cannot prove
- * it. The bound: each determinant has relative error <= 5 eps of its magnitude sum, and
- * summing n terms adds at most (n-1) eps of the running magnitude. */
+void mci_volume_sum_add(mci_volume_sum *v, const double *a, const double *b, const double *c)
+{
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, l = (i + 2) % 3;
+        double p = b[j] * c[l], q = b[l] * c[j];
+        v->sum += a[i] * (p - q);
+        v->magnitude += fabs(a[i]) * (fabs(p) + fabs(q));
+        v->amplified_underflow += fabs(a[i]);
+    }
+    v->triangles++;
+}
+
+/* The bound: each determinant has relative error <= 5 eps of its magnitude sum, and
+ * summing n terms adds at most (n-1) eps of the running magnitude; as in mci_det3_sign,
+ * plus the underflow of the products amplified by |a_i|. */
+int mci_volume_sum_sign(const mci_volume_sum *v)
+{
+    double bound = (double)(v->triangles * 3 + 16) * (DBL_EPSILON / 2) * v->magnitude * 1.01 +
+                   v->amplified_underflow * 0x1p-1072;
+    if (isfinite(bound) && v->magnitude >= 0x1p-960 && fabs(v->sum) > bound)
+        return v->sum > 0 ? 1 : -1;
+    return 0;
+}
+
 int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uint32_t *which,
                               size_t n, double *volume)
 {
-    double sum = 0, magnitude = 0, amplified_underflow = 0, bound;
+    mci_volume_sum v = {0, 0, 0, 0};
+    int sign;
     for (size_t k = 0; k < n; k++) {
         const uint32_t *t = listed_triangle(tris, which, k);
-        const double *a = xyz + 3 * (size_t)t[0], *b = xyz + 3 * (size_t)t[1],
-                     *c = xyz + 3 * (size_t)t[2];
-        for (int i = 0; i < 3; i++) {
-            int j = (i + 1) % 3, l = (i + 2) % 3;
-            double p = b[j] * c[l], q = b[l] * c[j];
-            sum += a[i] * (p - q);
-            magnitude += fabs(a[i]) * (fabs(p) + fabs(q));
-            amplified_underflow += fabs(a[i]);
-        }
+        mci_volume_sum_add(&v, xyz + 3 * (size_t)t[0], xyz + 3 * (size_t)t[1],
+                           xyz + 3 * (size_t)t[2]);
     }
     if (volume)
-        *volume = sum / 6;
-    /* As in mci_det3_sign, plus the underflow of p and q amplified by |a_i|. */
-    bound = (double)(n * 3 + 16) * (DBL_EPSILON / 2) * magnitude * 1.01 +
-            amplified_underflow * 0x1p-1072;
-    if (isfinite(bound) && magnitude >= 0x1p-960 && fabs(sum) > bound)
-        return sum > 0 ? 1 : -1;
-    return exact_volume_sign(xyz, tris, which, n);
+        *volume = v.sum / 6;
+    sign = mci_volume_sum_sign(&v);
+    return sign != 0 ? sign : exact_volume_sign(xyz, tris, which, n);
 }
 
 static void compute_volume(check_state *s)

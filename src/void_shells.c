@@ -21,8 +21,9 @@
 
 typedef struct shell {
     double lo[3], hi[3];
+    mci_volume_sum volume;
     int sign;
-    size_t first, count; /* its triangles: by_shell[first .. first + count) */
+    size_t first, count; /* if settled exactly, its triangles: by_shell[first ..) */
 } shell;
 
 static uint32_t find_root(uint32_t *parent, uint32_t x)
@@ -56,24 +57,19 @@ static size_t number_shells(const mcsg_mesh *m, uint32_t *parent, uint32_t *shel
     return count;
 }
 
-/* Each shell's triangles grouped (a counting sort into by_shell), and its box. */
-static void gather_shells(const mcsg_mesh *m, const uint32_t *shell_of, shell *shells,
-                          size_t n, uint32_t *by_shell)
+/* Each shell's box and its volume in double, with the sign where that decides it. */
+static void measure_shells(const mcsg_mesh *m, const uint32_t *shell_of, shell *shells,
+                           size_t n)
 {
     for (size_t s = 0; s < n; s++) {
         memset(&shells[s], 0, sizeof shells[s]);
         for (int k = 0; k < 3; k++)
             shells[s].lo[k] = INFINITY, shells[s].hi[k] = -INFINITY;
     }
-    for (size_t t = 0; t < m->triangle_count; t++)
-        shells[shell_of[m->triangles[3 * t]]].count++;
-    for (size_t s = 1; s < n; s++)
-        shells[s].first = shells[s - 1].first + shells[s - 1].count;
-    for (size_t s = 0; s < n; s++)
-        shells[s].count = 0;
     for (size_t t = 0; t < m->triangle_count; t++) {
-        shell *sh = &shells[shell_of[m->triangles[3 * t]]];
-        by_shell[sh->first + sh->count++] = (uint32_t)t;
+        const uint32_t *tri = m->triangles + 3 * t;
+        mci_volume_sum_add(&shells[shell_of[tri[0]]].volume, m->vertices + 3 * (size_t)tri[0],
+                           m->vertices + 3 * (size_t)tri[1], m->vertices + 3 * (size_t)tri[2]);
     }
     for (size_t v = 0; v < m->vertex_count; v++) {
         shell *sh;
@@ -86,6 +82,31 @@ static void gather_shells(const mcsg_mesh *m, const uint32_t *shell_of, shell *s
             sh->hi[k] = x > sh->hi[k] ? x : sh->hi[k];
         }
     }
+    for (size_t s = 0; s < n; s++)
+        shells[s].sign = mci_volume_sum_sign(&shells[s].volume);
+}
+
+/* The exact sign of the shells the double sum left undecided (thin ones), their
+ * triangles grouped first (a counting sort into by_shell). */
+static void settle_signs(const mcsg_mesh *m, const uint32_t *shell_of, shell *shells,
+                         size_t n, uint32_t *by_shell)
+{
+    size_t undecided = 0;
+    for (size_t s = 0; s < n; s++)
+        undecided += shells[s].sign == 0;
+    if (undecided == 0)
+        return;
+    for (size_t s = 1; s < n; s++)
+        shells[s].first = shells[s - 1].first + shells[s - 1].volume.triangles;
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        shell *sh = &shells[shell_of[m->triangles[3 * t]]];
+        by_shell[sh->first + sh->count++] = (uint32_t)t;
+    }
+    for (size_t s = 0; s < n; s++)
+        if (shells[s].sign == 0)
+            shells[s].sign = mci_triangles_volume_sign(m->vertices, m->triangles,
+                                                       by_shell + shells[s].first,
+                                                       shells[s].count, NULL);
 }
 
 static bool box_holds(const shell *outer, const shell *inner)
@@ -154,15 +175,12 @@ bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
         ok = shells && removed;
     }
     if (ok) {
-        gather_shells(m, shell_of, shells, n, by_shell);
-        for (size_t s = 0; s < n; s++)
-            shells[s].sign = mci_triangles_volume_sign(m->vertices, m->triangles,
-                                                       by_shell + shells[s].first,
-                                                       shells[s].count, NULL);
+        measure_shells(m, shell_of, shells, n);
+        settle_signs(m, shell_of, shells, n, by_shell);
         for (size_t s = 0; s < n; s++)
             if ((removed[s] = is_void(shells, n, s))) {
                 result->shells++;
-                result->triangles += shells[s].count;
+                result->triangles += shells[s].volume.triangles;
             }
         if (result->shells > 0)
             compact(m, tag, shell_of, removed, parent); /* parent: reused as the new ids */
