@@ -33,8 +33,9 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
     return x;
 }
 
-/* shell_of[v] for every vertex used (dense ids in vertex order; NO_SHELL for unused
- * vertices); returns the number of shells. parent has room for the vertices. */
+/* shell_of[v] for every vertex used (dense ids, in the order of the shells' first
+ * triangles; NO_SHELL for unused vertices); returns the number of shells. parent has room
+ * for the vertices. */
 static size_t number_shells(const mcsg_mesh *m, uint32_t *parent, uint32_t *shell_of)
 {
     size_t count = 0;
@@ -131,7 +132,7 @@ static bool is_void(const shell *shells, size_t n, size_t s)
 }
 
 /* Keep the triangles of shells not removed (and their tags) and the vertices they use,
- * in order. new_id has room for the vertices. */
+ * in order. new_id has room for the vertices (NO_SHELL there: a vertex that goes). */
 static void compact(mcsg_mesh *m, uint32_t *tag, const uint32_t *shell_of,
                     const bool *removed, uint32_t *new_id)
 {
