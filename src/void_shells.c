@@ -88,15 +88,19 @@ static void measure_shells(const mcsg_mesh *m, const uint32_t *shell_of, shell *
 }
 
 /* The exact sign of the shells the double sum left undecided (thin ones), their
- * triangles grouped first (a counting sort into by_shell). */
-static void settle_signs(const mcsg_mesh *m, const uint32_t *shell_of, shell *shells,
-                         size_t n, uint32_t *by_shell)
+ * triangles grouped first (a counting sort into by_shell, allocated only then). False
+ * when out of memory. */
+static bool settle_signs(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t *shell_of,
+                         shell *shells, size_t n)
 {
     size_t undecided = 0;
+    uint32_t *by_shell;
     for (size_t s = 0; s < n; s++)
         undecided += shells[s].sign == 0;
     if (undecided == 0)
-        return;
+        return true;
+    if (!(by_shell = mci_malloc_array(ctx, m->triangle_count + 1, sizeof *by_shell)))
+        return false;
     for (size_t s = 1; s < n; s++)
         shells[s].first = shells[s - 1].first + shells[s - 1].volume.triangles;
     for (size_t t = 0; t < m->triangle_count; t++) {
@@ -108,6 +112,8 @@ static void settle_signs(const mcsg_mesh *m, const uint32_t *shell_of, shell *sh
             shells[s].sign = mci_triangles_volume_sign(m->vertices, m->triangles,
                                                        by_shell + shells[s].first,
                                                        shells[s].count, NULL);
+    mci_free(ctx, by_shell);
+    return true;
 }
 
 static bool box_holds(const shell *outer, const shell *inner)
@@ -158,7 +164,7 @@ static void compact(mcsg_mesh *m, uint32_t *tag, const uint32_t *shell_of,
 bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
                           mci_void_shells *result)
 {
-    uint32_t *parent, *shell_of, *by_shell;
+    uint32_t *parent, *shell_of;
     shell *shells = NULL;
     bool *removed = NULL, ok;
     size_t n = 0;
@@ -167,8 +173,7 @@ bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
         return true;
     parent = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *parent);
     shell_of = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *shell_of);
-    by_shell = mci_malloc_array(ctx, m->triangle_count + 1, sizeof *by_shell);
-    ok = parent && shell_of && by_shell;
+    ok = parent && shell_of;
     if (ok) {
         n = number_shells(m, parent, shell_of);
         shells = mci_malloc_array(ctx, n + 1, sizeof *shells);
@@ -177,7 +182,9 @@ bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
     }
     if (ok) {
         measure_shells(m, shell_of, shells, n);
-        settle_signs(m, shell_of, shells, n, by_shell);
+        ok = settle_signs(ctx, m, shell_of, shells, n);
+    }
+    if (ok) {
         for (size_t s = 0; s < n; s++)
             if ((removed[s] = is_void(shells, n, s))) {
                 result->shells++;
@@ -188,7 +195,6 @@ bool mci_drop_void_shells(const mci_ctx *ctx, mcsg_mesh *m, uint32_t *tag,
     }
     mci_free(ctx, parent);
     mci_free(ctx, shell_of);
-    mci_free(ctx, by_shell);
     mci_free(ctx, shells);
     mci_free(ctx, removed);
     return ok;
