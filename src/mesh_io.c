@@ -305,23 +305,24 @@ float mci_io_to_float32(double d)
 
 char *mci_io_put_uint(char *p, uint64_t value)
 {
-    char digits[20];
-    int n = 0;
-    do {
-        digits[n++] = (char)('0' + value % 10);
-        value /= 10;
-    } while (value);
-    while (n)
-        *p++ = digits[--n];
+    char digits[20], *end = digits + sizeof digits, *first = end;
+    uint32_t small;
+    for (; value > UINT32_MAX; value /= 100) /* two digits per division */
+        memcpy(first -= 2, mci_digit_pairs + 2 * (value % 100), 2);
+    for (small = (uint32_t)value; small >= 100; small /= 100) /* 32-bit: cheaper */
+        memcpy(first -= 2, mci_digit_pairs + 2 * (small % 100), 2);
+    if (small >= 10)
+        memcpy(first -= 2, mci_digit_pairs + 2 * small, 2);
+    else
+        *--first = (char)('0' + small);
+    while (first < end)
+        *p++ = *first++;
     return p;
 }
 
 char *mci_io_put_double(char *p, double value)
 {
-    char text[MCI_DOUBLE_TEXT_MAX];
-    size_t n = mci_format_double(text, value);
-    memcpy(p, text, n);
-    return p + n;
+    return p + mci_format_double(p, value);
 }
 
 char *mci_io_put_text(char *p, const char *text)

@@ -143,7 +143,8 @@ float mci_io_to_float32(double d);
 
 /* Append-only text output. Each writer reserves room for a record, then fills it. */
 char *mci_io_put_uint(char *p, uint64_t value);
-char *mci_io_put_double(char *p, double value); /* at most MCI_DOUBLE_TEXT_MAX - 1 */
+/* p needs MCI_DOUBLE_TEXT_MAX bytes of room; the text is shorter (see numparse.h). */
+char *mci_io_put_double(char *p, double value);
 char *mci_io_put_text(char *p, const char *text);
 /* Room for one record of text: returns the write position or NULL (out of memory). */
 char *mci_io_reserve_text(const mci_ctx *ctx, mci_buf *out, size_t bytes);

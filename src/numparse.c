@@ -19,9 +19,11 @@
  * Formatting writes the text printf's %.15g, %.16g or %.17g would (17 digits always
  * round-trip), the first that parses back to the same double, with '.' whatever the
  * locale. printf itself is the fallback only: the 15, 16 or 17 digits come from an exact
- * 128-bit product m 5^k 2^j, correctly rounded, and whether they read back is decided on
- * the same integers (printf's multi-precision path cost ~5,000 instructions per number,
- * most of the time of writing a mesh).
+ * 128-bit product m 5^k 2^j, correctly rounded, and whether they read back is decided from
+ * the same product and a bound on the gap between doubles, or on exact integers where the
+ * bound cannot tell (printf's multi-precision path cost ~5,000 instructions per number,
+ * most of the time of writing a mesh). Digits are written eight at a time by fixed-point
+ * multiplication, without divisions.
  */
 #include "numparse.h"
 
@@ -654,13 +656,27 @@ static void split_double(double value, uint64_t *m, int *e)
  * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
 /* |value| * 10^scale as m * 2^shift with m = mantissa * 5^scale, 0 <= scale <= 32 (so m
  * < 2^53 * 5^32 < 2^128). */
+static u128 times_power_of_five(uint64_t mantissa, int e, int scale, int *shift)
+{
+    /* 5^k for k < 28 (below 2^64) */
+    static const uint64_t five[28] = {
+        1u, 5u, 25u, 125u, 625u, 3125u, 15625u, 78125u, 390625u, 1953125u, 9765625u,
+        48828125u, 244140625u, 1220703125u, 6103515625u, 30517578125u, 152587890625u,
+        762939453125u, 3814697265625u, 19073486328125u, 95367431640625u, 476837158203125u,
+        2384185791015625u, 11920928955078125u, 59604644775390625u, 298023223876953125u,
+        1490116119384765625u, 7450580596923828125u};
+    *shift = e - 53 + scale;
+    if (scale < 28)
+        return (u128)mantissa * five[scale];
+    return (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale: 10^scale / 2^scale */
+}
+
 static u128 times_power_of_ten(double value, int scale, int *shift)
 {
     int e;
     uint64_t mantissa;
     split_double(value, &mantissa, &e);
-    *shift = e - 53 + scale;
-    return (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale: 10^scale / 2^scale */
+    return times_power_of_five(mantissa, e, scale, shift);
 }
 
 static bool scaled_decimal(double value, int scale, u128 *out)
@@ -687,19 +703,51 @@ static bool scaled_decimal(double value, int scale, u128 *out)
     return true;
 }
 
-static const char digit_pairs[] = /* "00" "01" ... "99" */
+const char mci_digit_pairs[201] = /* "00" "01" ... "99" */
     "00010203040506070809101112131415161718192021222324"
     "25262728293031323334353637383940414243444546474849"
     "50515253545556575859606162636465666768697071727374"
     "75767778798081828384858687888990919293949596979899";
 
-/* The `count` decimal digits of n (with leading zeros) into out, two at a time. */
-static void write_digits(char *out, uint64_t n, int count)
+/* The eight decimal digits of x < 10^8, leading zeros kept. t = x 2^57 / 10^6 in fixed
+ * point, rounded up: its excess, under 0.15 x units, stays below the 2^57 / 10^6 units
+ * between the fractions k / 10^6 that x / 10^6 can have, and both scale alike with every
+ * multiplication by 100, so each pair read from the top bits is exact (test_numparse
+ * checks every x). A pair costs a mask, a multiplication and a shift instead of a 64-bit
+ * division. */
+static void write_eight(char *out, uint32_t x)
 {
-    for (; count >= 2; count -= 2, n /= 100)
-        memcpy(out + count - 2, digit_pairs + 2 * (n % 100), 2);
-    if (count == 1)
-        out[0] = (char)('0' + (int)(n % 10));
+    const uint64_t fraction = (UINT64_C(1) << 57) - 1;
+    uint64_t t = (uint64_t)x * UINT64_C(144115188076); /* ceil(2^57 / 10^6) */
+    memcpy(out, mci_digit_pairs + 2 * (t >> 57), 2);
+    t = (t & fraction) * 100;
+    memcpy(out + 2, mci_digit_pairs + 2 * (t >> 57), 2);
+    t = (t & fraction) * 100;
+    memcpy(out + 4, mci_digit_pairs + 2 * (t >> 57), 2);
+    t = (t & fraction) * 100;
+    memcpy(out + 6, mci_digit_pairs + 2 * (t >> 57), 2);
+}
+
+/* Room for the digits of a 64-bit number in blocks of eight, and for copies of a fixed
+ * DIGIT_COPY bytes from any digit (the text buffers have room for those too): fixed-size
+ * copies are a few moves, variable ones a library call. */
+enum { DIGIT_BLOCKS = 24, DIGIT_COPY = 24 };
+
+/* The `count` (1..20) decimal digits of n < 10^count, leading zeros kept: they end at
+ * block + DIGIT_BLOCKS, and the start is returned. block has DIGIT_BLOCKS + DIGIT_COPY
+ * bytes. */
+static const char *write_digits(char block[DIGIT_BLOCKS + DIGIT_COPY], uint64_t n, int count)
+{
+    uint64_t high = n / 100000000;
+    write_eight(block + 16, (uint32_t)(n - high * 100000000));
+    if (count > 8) {
+        uint64_t top = high / 100000000;
+        write_eight(block + 8, (uint32_t)(high - top * 100000000));
+        if (count > 16)
+            write_eight(block, (uint32_t)top);
+    }
+    memset(block + DIGIT_BLOCKS, '0', DIGIT_COPY);
+    return block + DIGIT_BLOCKS - count;
 }
 
 /* Whether the decimal digits * 10^-scale reads back as the nonzero double value
@@ -737,14 +785,18 @@ static int reads_back(double value, u128 digits, int scale)
 /* floor(log10(|value|)) or one less, from the binary exponent alone: |value| is in
  * [2^(e-1), 2^e), and 78913 / 2^18 is log10(2) to 7 digits (floor division by hand: a
  * right shift of a negative number is implementation-defined). */
+static int decimal_exponent_from_binary(int e)
+{
+    long t = (long)(e - 1) * 78913;
+    return (int)(t >= 0 ? t / 262144 : -((-t + 262143) / 262144));
+}
+
 static int decimal_exponent_estimate(double value)
 {
     uint64_t m;
     int e;
-    long t;
     split_double(value, &m, &e);
-    t = (long)(e - 1) * 78913;
-    return (int)(t >= 0 ? t / 262144 : -((-t + 262143) / 262144));
+    return decimal_exponent_from_binary(e);
 }
 
 /* The `precision` significant digits of a nonzero finite value, correctly rounded as
@@ -779,48 +831,57 @@ static bool exact_digits(double value, int precision, u128 *digits_out, int *exp
     return true;
 }
 
-/* printf's "%.*g" text of value from its exact digits (exact_digits). */
-static size_t layout_g(char *text, double value, u128 digits, int precision, int exponent)
+/* "e+dd", "e-dd" or with three digits, as printf writes a %g exponent. */
+static size_t put_exponent(char *text, int exponent)
 {
-    /* digits < 10^precision <= 10^17 < 2^64: 64-bit division is a multiplication, the
-     * 128-bit one a library call. */
-    uint64_t n = (uint64_t)digits;
+    int magnitude = exponent < 0 ? -exponent : exponent;
+    size_t len = 2;
+    text[0] = 'e';
+    text[1] = exponent < 0 ? '-' : '+';
+    if (magnitude >= 100) {
+        text[len++] = (char)('0' + magnitude / 100);
+        magnitude %= 100;
+    }
+    memcpy(text + len, mci_digit_pairs + 2 * magnitude, 2);
+    return len + 2;
+}
+
+/* printf's "%.*g" text of value from its exact digits (exact_digits). The digits are
+ * moved DIGIT_COPY bytes at a time, so up to 42 bytes of text are written (a sign, 16
+ * digits and the point before the last copy): text has MCI_DOUBLE_TEXT_MAX. */
+static size_t layout_g(char text[MCI_DOUBLE_TEXT_MAX], double value, u128 digits, int precision,
+                       int exponent)
+{
+    /* digits < 10^precision <= 10^17: exactly `precision` digits, no leading zero */
+    char block[DIGIT_BLOCKS + DIGIT_COPY];
+    const char *d = write_digits(block, (uint64_t)digits, precision);
     int count = precision, point;
     size_t len = 0;
-    /* %g drops trailing zeros; n has exactly `count` digits (no leading zero), so the
-     * pairs stop with at least one digit left. */
-    while (count > 2 && n % 100 == 0)
-        n /= 100, count -= 2;
-    if (count > 1 && n % 10 == 0)
-        n /= 10, count--;
+    while (count > 1 && d[count - 1] == '0') /* %g drops trailing zeros */
+        count--;
     if (value < 0)
         text[len++] = '-';
-    if (exponent < -4 || exponent >= precision) {
-        write_digits(text + len + 1, n, count); /* d.ddd: the point moved in after d */
-        text[len] = text[len + 1];
-        text[len + 1] = '.';
-        len += count > 1 ? (size_t)count + 1 : 1;
-        len += (size_t)snprintf(text + len, 16, "e%c%02d", exponent < 0 ? '-' : '+',
-                                exponent < 0 ? -exponent : exponent);
-        return len;
-    }
-    if (exponent < 0) { /* 0.000ddd */
-        text[len++] = '0';
-        text[len++] = '.';
-        for (int k = -1; k > exponent; k--)
-            text[len++] = '0';
-        write_digits(text + len, n, count);
+    if (exponent < -4 || exponent >= precision) { /* d.ddde+xx */
+        text[len++] = d[0];
+        if (count > 1) {
+            text[len++] = '.';
+            memcpy(text + len, d + 1, DIGIT_COPY);
+            len += (size_t)count - 1;
+        }
+        len += put_exponent(text + len, exponent);
+    } else if (exponent < 0) { /* 0.000ddd */
+        memcpy(text + len, "0.0000", 6);
+        len += (size_t)(1 - exponent);
+        memcpy(text + len, d, DIGIT_COPY);
         len += (size_t)count;
-    } else if (count <= exponent + 1) { /* ddd000: an integer */
-        write_digits(text + len, n, count);
-        len += (size_t)count;
-        for (int k = count; k <= exponent; k++)
-            text[len++] = '0';
-    } else { /* ddd.ddd: the digits with the point moved in */
+    } else if (count <= exponent + 1) { /* ddd000: an integer (the block's padding is '0') */
+        memcpy(text + len, d, DIGIT_COPY);
+        len += (size_t)exponent + 1;
+    } else { /* ddd.ddd */
         point = exponent + 1;
-        write_digits(text + len + 1, n, count);
-        memmove(text + len, text + len + 1, (size_t)point);
+        memcpy(text + len, d, DIGIT_COPY);
         text[len + (size_t)point] = '.';
+        memcpy(text + len + (size_t)point + 1, d + point, DIGIT_COPY);
         len += (size_t)count + 1;
     }
     text[len] = '\0';
@@ -856,10 +917,11 @@ static bool format_round_trips(double value, int precision, char text[64], size_
 
 /* floor(|value| * 10^scale) and whether anything was cut off, for 0 <= scale <= 32.
  * False when that does not fit 64 bits. */
-static bool scaled_floor(double value, int scale, uint64_t *floor_out, bool *sticky)
+static bool scaled_floor(uint64_t mantissa, int e, int scale, uint64_t *floor_out,
+                         bool *sticky)
 {
     int shift;
-    u128 m = times_power_of_ten(value, scale, &shift);
+    u128 m = times_power_of_five(mantissa, e, scale, &shift);
     if (shift >= 0) {
         if (bit_length128(m) + shift > 63)
             return false;
@@ -874,54 +936,96 @@ static bool scaled_floor(double value, int scale, uint64_t *floor_out, bool *sti
     return true;
 }
 
-/* The digits exact_digits gives for 15, 16 and 17 significant digits, from one exact
- * product: with F = floor(|value| * 10^(17 - E)) in [10^17, 10^18) (E the exact decimal
- * exponent) and the sticky bit, p digits are F / 10^(18 - p) rounded half-even on the
- * remainder; a carry to 10^p moves to the next exponent. False outside decimal exponents
- * -15..17 (the caller then takes the general path). */
-static bool digits_15_to_17(double value, u128 digits[3], int exponents[3])
+/* F = floor(|value| 10^(17 - E)) in [10^17, 10^18), E the decimal exponent of |value|
+ * (10^E <= |value| < 10^(E + 1)), and whether the floor cut anything off. False outside
+ * E in -15..17 (the caller then takes the general path). */
+static bool eighteen_digits(uint64_t m, int e, uint64_t *f, bool *sticky, int *exponent)
 {
-    int estimate = decimal_exponent_estimate(value);
-    for (int exponent = estimate; exponent <= estimate + 1; exponent++) {
-        uint64_t f, div = 1000;
-        bool sticky;
-        if (17 - exponent < 0 || 17 - exponent > 32 ||
-            !scaled_floor(value, 17 - exponent, &f, &sticky))
+    int estimate = decimal_exponent_from_binary(e);
+    for (*exponent = estimate; *exponent <= estimate + 1; ++*exponent) {
+        if (17 - *exponent < 0 || 17 - *exponent > 32 ||
+            !scaled_floor(m, e, 17 - *exponent, f, sticky))
             return false;
-        if (f < 100000000000000000u)
+        if (*f < 100000000000000000u)
             return false; /* the estimate is never one too high: not expected */
-        if (f >= 1000000000000000000u)
-            continue;
-        for (int p = 15; p <= 17; p++, div /= 10) {
-            uint64_t q = f / div, r = f % div, half = div / 2;
-            q += r > half || (r == half && (sticky || (q & 1)));
-            digits[p - 15] = q;
-            exponents[p - 15] = exponent;
-            if (q == (uint64_t)pow10_u128(p)) {
-                digits[p - 15] = q / 10;
-                exponents[p - 15] = exponent + 1;
-            }
-        }
-        return true;
+        if (*f < 1000000000000000000u)
+            return true;
     }
     return false;
 }
 
-/* mci_format_double's search with the digits of all three precisions from one product;
- * false when it cannot decide (the caller then tries each precision on its own). */
-static bool format_from_one_product(double value, char text[64], size_t *len)
+/* Half the gap between value and its neighbouring doubles in units of 10^(E - 17) (the
+ * units of eighteen_digits' F): 2^(e - 54) 10^(17 - E) for |value| = m 2^(e - 53), within
+ * a relative 2^-52 (10^k is exact in double up to k = 22, one rounding beyond). */
+static double half_gap_in_units(int e, int exponent)
 {
-    u128 digits[3];
-    int exponents[3];
-    if (value == 0 || !digits_15_to_17(value, digits, exponents))
+    uint64_t bits;
+    int scale = 17 - exponent;
+    double power_of_two, power_of_ten = scale <= 22 ? exact_pow10[scale]
+                                                    : exact_pow10[22] * exact_pow10[scale - 22];
+    bits = (uint64_t)(e - 54 + 1023) << 52; /* normal: |value| >= 1e-15 gives e >= -49 */
+    memcpy(&power_of_two, &bits, sizeof bits);
+    return power_of_two * power_of_ten;
+}
+
+/* Whether the decimal `scaled` (units of 10^(E - 17)) reads back as value, from F and its
+ * sticky bit alone: the exact |value| 10^(17 - E) is F, or lies strictly between F and
+ * F + 1, so the distance to `scaled` is known within one unit, and `half_gap` within a
+ * relative 2^-52. 1 or 0 when the bounds decide, -1 when they do not (a distance within
+ * about a unit of the half gap: a possible tie, decided exactly by reads_back) and for
+ * the binade's lowest mantissa, whose gap below is half the gap above. */
+static int reads_back_from_floor(uint64_t scaled, uint64_t f, bool sticky, double half_gap,
+                                 uint64_t m)
+{
+    uint64_t near, far; /* the distance is within [near, far] */
+    if (m == (UINT64_C(1) << 52))
+        return -1;
+    if (scaled > f) {
+        far = scaled - f;
+        near = sticky ? far - 1 : far;
+    } else {
+        near = f - scaled;
+        far = sticky ? near + 1 : near;
+    }
+    if ((double)far < half_gap * (1 - 0x1p-40))
+        return 1;
+    if ((double)near > half_gap * (1 + 0x1p-40))
+        return 0;
+    return -1;
+}
+
+/* mci_format_double's search with the digits of all three precisions from one exact
+ * product: p digits are F / 10^(18 - p) rounded half-even on the remainder and the sticky
+ * bit (a carry to 10^p moves to the next exponent). False when it cannot decide (the
+ * caller then tries each precision on its own). */
+static bool format_from_one_product(double value, char text[MCI_DOUBLE_TEXT_MAX], size_t *len)
+{
+    uint64_t m, f, div = 1000;
+    bool sticky;
+    int e, exponent;
+    double half_gap;
+    if (value == 0)
         return false;
-    for (int p = 15; p <= 17; p++) {
-        int back = p == 17 ? 1
-                           : reads_back(value, digits[p - 15], p - 1 - exponents[p - 15]);
+    split_double(value, &m, &e);
+    if (!eighteen_digits(m, e, &f, &sticky, &exponent))
+        return false;
+    half_gap = half_gap_in_units(e, exponent);
+    for (int p = 15; p <= 17; p++, div /= 10) {
+        uint64_t q = f / div, r = f % div, half = div / 2, digits;
+        int back, digits_exponent = exponent;
+        q += r > half || (r == half && (sticky || (q & 1)));
+        digits = q;
+        if (q == pow10_u64[p]) {
+            digits = q / 10;
+            digits_exponent++;
+        }
+        back = p == 17 ? 1 : reads_back_from_floor(q * div, f, sticky, half_gap, m);
+        if (back < 0)
+            back = reads_back(value, digits, p - 1 - digits_exponent);
         if (back < 0)
             return false;
         if (back == 1) {
-            *len = layout_g(text, value, digits[p - 15], p, exponents[p - 15]);
+            *len = layout_g(text, value, digits, p, digits_exponent);
             return true;
         }
     }
@@ -938,13 +1042,13 @@ size_t mci_format_double(char buf[MCI_DOUBLE_TEXT_MAX], double value)
         memcpy(buf, word, len + 1);
         return len;
     }
-    /* The shortest of 15, 16 and 17 significant digits that reads back as value: each
-     * try costs two 128-bit products (the digits and the read-back test), and the text is
-     * laid out once. */
-    if (!format_from_one_product(value, text, &len))
-        for (int precision = 15; precision <= 17; precision++)
-            if (format_round_trips(value, precision, text, &len))
-                break;
+    if (format_from_one_product(value, buf, &len)) /* laid out in place */
+        return len;
+    /* The shortest of 15, 16 and 17 significant digits that reads back as value, one
+     * precision at a time (the general path: each try costs two 128-bit products). */
+    for (int precision = 15; precision <= 17; precision++)
+        if (format_round_trips(value, precision, text, &len))
+            break;
     memcpy(buf, text, len + 1);
     return len;
 }

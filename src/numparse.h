@@ -18,8 +18,13 @@
  * at s. Values beyond the double range give +-inf; tiny ones round to subnormals or 0. */
 bool mci_parse_double(const char *s, const char *end, double *out, const char **next);
 
-/* Largest text mci_format_double writes, including the terminating NUL. */
-#define MCI_DOUBLE_TEXT_MAX 32
+/* "00", "01", ... "99": the two digits of k at 2 k. */
+extern const char mci_digit_pairs[201];
+
+/* The room mci_format_double needs at buf: its text (at most 24 characters and the
+ * terminating NUL) is laid out in place, with fixed-size copies of digits that may reach
+ * past the text's end. */
+#define MCI_DOUBLE_TEXT_MAX 48
 
 /* Write the shortest decimal (%.15g, %.16g or %.17g style) that mci_parse_double reads
  * back to exactly `value`, with '.' as decimal point whatever the locale. "inf", "-inf"

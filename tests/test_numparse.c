@@ -462,6 +462,42 @@ TEST(format_typical_range)
     }
 }
 
+/* The formatter decides whether 15 or 16 digits read back from one 18-digit product and
+ * a bound on the half gap, and defers to the exact test within a unit of it: the doubles
+ * next to a short decimal sit on both sides of that boundary; integers exercise the
+ * digit blocks (eight digits at a time by fixed-point multiplication) at every length. */
+TEST(format_read_back_boundaries)
+{
+    char out[MCI_DOUBLE_TEXT_MAX], text[64];
+    int before = test_failures;
+    for (int i = 0; i < 100000 && test_failures - before < 10; i++) {
+        int digits = 15 + (int)(next_random() % 2), exponent = (int)(next_random() % 34) - 17;
+        uint64_t low = digits == 15 ? UINT64_C(100000000000000) : UINT64_C(1000000000000000);
+        double d, near;
+        snprintf(text, sizeof text, "%llue%d",
+                 (unsigned long long)(low + next_random() % (9 * low)), exponent - digits + 1);
+        d = strtod(text, NULL);
+        near = d;
+        for (int step = 0; step < 3; step++, near = nextafter(near, 0)) {
+            mci_format_double(out, near);
+            CHECK_MSG(shortest_is_right(near, out), "%a formatted as %s", near, out);
+        }
+        near = nextafter(d, INFINITY);
+        for (int step = 0; step < 2; step++, near = nextafter(near, INFINITY)) {
+            mci_format_double(out, near);
+            CHECK_MSG(shortest_is_right(near, out), "%a formatted as %s", near, out);
+        }
+    }
+    for (int i = 0; i < 200000 && test_failures - before < 10; i++) {
+        uint64_t n = next_random() % (UINT64_C(1) << (1 + next_random() % 53));
+        mci_format_double(out, (double)n);
+        snprintf(text, sizeof text, "%llu", (unsigned long long)n);
+        CHECK_MSG((n >= UINT64_C(1000000000000000) && shortest_is_right((double)n, out)) ||
+                      strcmp(out, text) == 0,
+                  "%llu formatted as %s", (unsigned long long)n, out);
+    }
+}
+
 TEST(locale_independence)
 {
     char out[MCI_DOUBLE_TEXT_MAX];
@@ -508,6 +544,7 @@ int main(void)
     RUN(format_round_trip);
     RUN(format_short_decimals);
     RUN(format_typical_range);
+    RUN(format_read_back_boundaries);
     RUN(locale_independence);
     return test_summary();
 }
