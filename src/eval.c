@@ -382,10 +382,15 @@ static mcsg_status drop_void_shells(eval_state *e, mcsg_mesh *out, uint32_t *kep
     if (!mci_drop_void_shells(&e->ctx, out, kept_tri, &removed))
         return mci_fail_nomem(err, "assembling the result");
     e->stats.rounding_dropped_shells = removed.shells;
+    if (removed.shells > removed.folded)
+        mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu shells of the result were flat or inside out "
+                "after rounding to doubles and were removed", removed.shells - removed.folded);
+    if (removed.folded > 0)
+        mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu slivers of the result were folded onto "
+                "another part by rounding to doubles and were removed", removed.folded);
     if (removed.shells > 0)
-        mci_log(&e->ctx, MCSG_LOG_WARNING, "%zu shells of the result (%zu triangles) were "
-                "flat or inside out after rounding to doubles and were removed",
-                removed.shells, removed.triangles);
+        mci_log(&e->ctx, MCSG_LOG_INFO, "the removed shells had %zu triangles",
+                removed.triangles);
     return MCSG_OK;
 }
 

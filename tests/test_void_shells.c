@@ -1,8 +1,10 @@
 /*
  * Shells that rounding left flat or inside out (void_shells.c), on hand-built meshes:
  * an inside-out tetrahedron apart from a cube goes, the same inside the cube's box stays
- * (it could be a cavity), a flat two-triangle shell goes; what stays keeps its order, and
- * the per-triangle tags follow the triangles.
+ * (it could be a cavity), a flat two-triangle shell goes; a thin tetrahedron folded onto a
+ * cube's face (a triangle of each with the same corners in the same order) goes, two
+ * cubes touching face to face (the same corners in opposite orders) stay; what stays
+ * keeps its order, and the per-triangle tags follow the triangles.
  */
 #include "testlib.h"
 #include "internal.h"
@@ -94,9 +96,59 @@ TEST(flat_shell_goes_and_outward_shells_stay_as_they_are)
     mci_mesh_free(&ctx, &m);
 }
 
+TEST(sliver_folded_onto_a_larger_shell_goes)
+{
+    static const double origin[3] = {0, 0, 0};
+    static const uint32_t tetrahedron[12] = {8, 9, 10, 9, 8, 11, 10, 9, 11, 8, 10, 11};
+    mci_ctx ctx;
+    mcsg_mesh m;
+    mci_void_shells removed;
+    uint32_t tag[16];
+    mci_ctx_init(&ctx, NULL);
+    if (!alloc_mesh(&ctx, &m, 12, 16))
+        return;
+    put_cube(&m, 0, 0, origin, 1, false);
+    /* The cube's triangle {0, 2, 1} (on z = 0, facing down) with its own vertices, and an
+     * apex just inside the cube: the sliver lies behind the same face as the cube. */
+    memcpy(m.vertices + 24, (const double[]){0, 0, 0, 0, 1, 0, 1, 0, 0, 0.25, 0.25, 1e-20},
+           12 * sizeof(double));
+    memcpy(m.triangles + 36, tetrahedron, sizeof tetrahedron);
+    for (uint32_t t = 0; t < 16; t++)
+        tag[t] = t;
+    CHECK(mci_drop_void_shells(&ctx, &m, tag, &removed));
+    CHECK_EQ_SIZE(removed.shells, 1);
+    CHECK_EQ_SIZE(removed.folded, 1);
+    CHECK_EQ_SIZE(removed.triangles, 4);
+    CHECK_EQ_SIZE(m.vertex_count, 8);
+    CHECK_EQ_SIZE(m.triangle_count, 12);
+    CHECK_EQ_SIZE(tag[11], 11);
+    CHECK_EQ_DOUBLE(test_signed_volume(&m), 1);
+    mci_mesh_free(&ctx, &m);
+}
+
+TEST(shells_touching_face_to_face_stay)
+{
+    static const double origin[3] = {0, 0, 0}, next[3] = {1, 0, 0};
+    mci_ctx ctx;
+    mcsg_mesh m;
+    mci_void_shells removed;
+    mci_ctx_init(&ctx, NULL);
+    if (!alloc_mesh(&ctx, &m, 16, 24))
+        return;
+    put_cube(&m, 0, 0, origin, 1, false);
+    put_cube(&m, 8, 12, next, 1, false); /* its x = 0 face is the first's x = 1 face, reversed */
+    CHECK(mci_drop_void_shells(&ctx, &m, NULL, &removed));
+    CHECK_EQ_SIZE(removed.shells, 0);
+    CHECK_EQ_SIZE(m.triangle_count, 24);
+    CHECK_EQ_DOUBLE(test_signed_volume(&m), 2);
+    mci_mesh_free(&ctx, &m);
+}
+
 int main(void)
 {
     RUN(inside_out_shell_apart_from_the_others_goes);
     RUN(flat_shell_goes_and_outward_shells_stay_as_they_are);
+    RUN(sliver_folded_onto_a_larger_shell_goes);
+    RUN(shells_touching_face_to_face_stay);
     return test_summary();
 }
