@@ -652,10 +652,8 @@ static void split_double(double value, uint64_t *m, int *e)
     *e = biased - 1022;
 }
 
-/* round_half_even(|value| * 10^scale) for 0 <= scale <= 32, exactly: |value| = m 2^e,
- * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
-/* |value| * 10^scale as m * 2^shift with m = mantissa * 5^scale, 0 <= scale <= 32 (so m
- * < 2^53 * 5^32 < 2^128). */
+/* |value| 10^scale, for |value| = mantissa 2^(e - 53), as m 2^shift with m = mantissa
+ * 5^scale, 0 <= scale <= 32 (so m < 2^53 5^32 < 2^128). */
 static u128 times_power_of_five(uint64_t mantissa, int e, int scale, int *shift)
 {
     /* 5^k for k < 28 (below 2^64) */
@@ -671,6 +669,7 @@ static u128 times_power_of_five(uint64_t mantissa, int e, int scale, int *shift)
     return (u128)mantissa * (pow10_u128(scale) >> scale); /* 5^scale: 10^scale / 2^scale */
 }
 
+/* The same from the double. */
 static u128 times_power_of_ten(double value, int scale, int *shift)
 {
     int e;
@@ -679,6 +678,8 @@ static u128 times_power_of_ten(double value, int scale, int *shift)
     return times_power_of_five(mantissa, e, scale, shift);
 }
 
+/* round_half_even(|value| * 10^scale) for 0 <= scale <= 32, exactly: |value| = m 2^e,
+ * and m 5^scale < 2^53 * 5^32 < 2^128. Returns false when the product cannot be held. */
 static bool scaled_decimal(double value, int scale, u128 *out)
 {
     u128 m, q, rest, half;
@@ -712,9 +713,9 @@ const char mci_digit_pairs[201] = /* "00" "01" ... "99" */
 /* The eight decimal digits of x < 10^8, leading zeros kept. t = x 2^57 / 10^6 in fixed
  * point, rounded up: its excess, under 0.15 x units, stays below the 2^57 / 10^6 units
  * between the fractions k / 10^6 that x / 10^6 can have, and both scale alike with every
- * multiplication by 100, so each pair read from the top bits is exact (test_numparse
- * checks every x). A pair costs a mask, a multiplication and a shift instead of a 64-bit
- * division. */
+ * multiplication by 100, so each pair read from the top bits is exact (it was checked
+ * for every x; test_numparse compares integers of every length with printf). A pair
+ * costs a mask, a multiplication and a shift instead of a 64-bit division. */
 static void write_eight(char *out, uint32_t x)
 {
     const uint64_t fraction = (UINT64_C(1) << 57) - 1;
