@@ -64,7 +64,9 @@ static bool next_content_line(off_reader *r)
 {
     const char *begin, *stop;
     while (mci_io_next_line(&r->lines, &begin, &stop)) {
-        const char *hash = memchr(begin, '#', (size_t)(stop - begin));
+        /* stop >= begin always; the test tells the compiler (across files, with LTO, it
+         * otherwise warns of a negative length) */
+        const char *hash = stop > begin ? memchr(begin, '#', (size_t)(stop - begin)) : NULL;
         if (hash)
             stop = hash;
         begin = mci_io_skip_blanks(begin, stop);
