@@ -107,7 +107,9 @@ static mcsg_status next_record(obj_reader *r, const char **begin, const char **s
     r->line = r->lines.number;
     if (continuation_mark(*begin, *stop))
         status = join_lines(r, begin, stop);
-    hash = status == MCSG_OK ? memchr(*begin, '#', (size_t)(*stop - *begin)) : NULL;
+    /* *stop >= *begin always; the test tells the compiler (see mesh_io_off.c) */
+    hash = status == MCSG_OK && *stop > *begin ? memchr(*begin, '#', (size_t)(*stop - *begin))
+                                               : NULL;
     if (hash)
         *stop = hash;
     return status;
