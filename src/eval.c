@@ -250,13 +250,13 @@ static void free_rounded(const mci_ctx *ctx, rounded *r)
     mci_free(ctx, r->canon);
 }
 
-/* Whether rounding joined distinct exact vertices. */
-static bool any_joined(const rounded *r)
+/* How many distinct exact vertices rounding joined into another. */
+static size_t joined_count(const rounded *r)
 {
+    size_t joined = 0;
     for (size_t v = 0; v < r->count; v++)
-        if (r->canon[v] != v)
-            return true;
-    return false;
+        joined += r->canon[v] != v;
+    return joined;
 }
 
 /* Drop the vertices no triangle uses any more (after cancelled triangles), keeping the
@@ -342,8 +342,9 @@ static mcsg_status build_output(eval_state *e, const rounded *r, mcsg_mesh *out,
     if (st == MCSG_OK && nt > 0)
         memcpy(out->triangles, tris, 3 * nt * sizeof *tris);
     e->stats.rounding_dropped_triangles = e->kept.count - nt;
+    e->stats.rounding_joined_vertices = joined_count(r);
     if (st == MCSG_OK)
-        st = repair_rounding(e, out, which, final, any_joined(r), err);
+        st = repair_rounding(e, out, which, final, e->stats.rounding_joined_vertices > 0, err);
     mci_free(&e->ctx, final);
     mci_free(&e->ctx, tris);
     if (st == MCSG_OK)

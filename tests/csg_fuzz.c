@@ -853,10 +853,13 @@ static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
                              report.degenerate_triangles <= stats->rounding_flat_triangles &&
                              report.boundary_edges == 0 && report.inconsistent_edges == 0 &&
                              unbalanced == 0;
-        /* Rounding that joins distinct exact vertices (which drops the triangles it
-         * collapses) can bring two parts of any result together along an edge; the
-         * output must then still be manifold by index. */
-        bool touching_by_rounding = stats->rounding_dropped_triangles > 0 && defects == 0;
+        /* Rounding that joins distinct exact vertices can bring two parts of any result
+         * together along an edge, whether or not it collapses triangles (seed
+         * 0xdf20a53a6838d150: a sliver's edge joined to a sphere's diagonal); the output
+         * must then still be manifold by index. */
+        bool touching_by_rounding =
+            (stats->rounding_joined_vertices > 0 || stats->rounding_dropped_triangles > 0) &&
+            defects == 0;
         if (rounding_only)
             r->rounding_artifacts = true;
         else if (!(allow_touching || touching_by_rounding) || !only_shared_edges ||

@@ -626,9 +626,11 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
            s->local_tests, s->rejected_primitives);
     printf("  assemble         %8.3f s  (%zu vertices, %zu triangles)\n", s->seconds_assemble,
            s->output_vertices, s->output_triangles);
-    if (s->rounding_dropped_triangles + s->rounding_split_triangles + s->rounding_flat_triangles)
-        printf("  rounding to doubles: %zu triangles collapsed or folded and dropped, %zu flat "
-               "ones split away, %zu flat left\n", s->rounding_dropped_triangles,
+    if (s->rounding_joined_vertices + s->rounding_dropped_triangles +
+        s->rounding_split_triangles + s->rounding_flat_triangles)
+        printf("  rounding to doubles: %zu vertices joined, %zu triangles collapsed or folded "
+               "and dropped, %zu flat ones split away, %zu flat left\n",
+               s->rounding_joined_vertices, s->rounding_dropped_triangles,
                s->rounding_split_triangles, s->rounding_flat_triangles);
     if (s->rounding_dropped_shells)
         printf("  rounding to doubles: %zu flat or inside-out shells removed\n",
