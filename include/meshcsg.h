@@ -451,8 +451,9 @@ typedef struct mcsg_eval_stats {
     size_t copied_primitives;   /* primitives that are the same mesh as an earlier one
                                    (same arrays): the earlier one is evaluated for both */
     size_t output_vertices, output_triangles;
-    size_t rounding_joined_vertices;   /* distinct exact vertices that round to the same
-                                          doubles, joined into one (each counted once) */
+    size_t rounding_joined_vertices;   /* exact vertices joined into another one that
+                                          rounds to the same doubles (the one kept is
+                                          not counted) */
     size_t rounding_dropped_triangles; /* collapsed (two corners joined) or folded onto an
                                           opposite twin when distinct exact vertices that
                                           round to the same doubles were joined */
