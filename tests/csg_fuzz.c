@@ -33,9 +33,10 @@
  * where two parts of it can touch exactly along an edge: in grid and tilted trees, and in
  * trees with two copies of a leaf ((A | B) - (A & B) touches itself along the curve where
  * the surfaces of A and B cross), or, in any tree, where rounding joined distinct exact
- * vertices (and dropped the triangles that collapsed), which can bring two parts together
- * along an edge; there the output must still be manifold by vertex index. Then every edge
- * must still be used as often in each direction (closed and oriented).
+ * vertices (rounding_joined_vertices; or dropped triangles, after cancelling twins), which
+ * can bring two parts together along an edge; there the output must still be manifold by
+ * vertex index. Then every edge must still be used as often in each direction (closed
+ * and oriented).
  *
  * A failing case is shrunk (a subtree as the whole tree, a child removed, an operation
  * replaced by one of its children) while it still fails, and printed as a CSG file.
