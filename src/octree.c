@@ -672,7 +672,18 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree)
 typedef struct cell_face {
     float box[6];
     uint32_t face, run_end; /* run_end: the first later face of another leaf */
+    uint32_t cells;         /* where the face's critical leaves start in face_cells.cell */
+    uint32_t first_cell;    /* the first of them */
 } cell_face;
+
+/* Each face's critical leaf cells (their positions among the critical leaves, in
+ * increasing order): a pair of faces that share several cells is collected in the first
+ * of them only. Collected once per shared cell, ring-800's 762K pairs were 1.5M, and the
+ * sort that joined the copies ran on all of them. */
+typedef struct face_cells {
+    uint32_t *start; /* per face: its range [start[f], start[f + 1]) of cell */
+    uint32_t *cell;
+} face_cells;
 
 /* Pairs are collected in parallel, in chunks of critical leaf cells fixed in advance
  * (not by the thread count); the chunks' lists are joined and then sorted, so the
@@ -694,10 +705,33 @@ static bool cell_faces_overlap(const cell_face *a, const cell_face *b)
     return true;
 }
 
+/* Whether critical leaf `cell`, which lists both faces, may be the first that does: a
+ * and b are the faces' cell lists (increasing), a merge walk up to `cell`. The walk
+ * gives up (true: the sort drops the copy) after a few steps, so that two long faces
+ * sharing m cells (a cylinder's sides) cost a bounded walk in each, not O(m). */
+enum { SHARED_CELL_STEPS = 8 };
+
+static bool first_shared_cell(const uint32_t *a, const uint32_t *b, uint32_t cell)
+{
+    for (int step = 0; *a < cell && *b < cell; step++) {
+        if (*a == *b)
+            return false;
+        if (step == SHARED_CELL_STEPS)
+            return true;
+        if (*a < *b)
+            a++;
+        else
+            b++;
+    }
+    return true;
+}
+
 /* A cell lists its faces in increasing id order, so each leaf's faces form one run: a
- * face is paired with the faces after its run only. */
+ * face is paired with the faces after its run only. `k`: the cell's position among the
+ * critical leaves. */
 static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const float *box,
-                               const mci_cell *cell, pair_chunk_list *out)
+                               const face_cells *fc, const mci_cell *cell, uint32_t k,
+                               pair_chunk_list *out)
 {
     const uint32_t *ids = t->face_ids + cell->first;
     uint32_t n = cell->count;
@@ -707,6 +741,8 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
     for (uint32_t i = n; i-- > 0;) {
         cell_face *c = &out->faces[i];
         c->face = ids[i];
+        c->cells = fc->start[ids[i]];
+        c->first_cell = fc->cell[c->cells];
         memcpy(c->box, box + 6 * (size_t)ids[i], sizeof c->box);
         c->run_end = i + 1 < n && t->face_leaf[ids[i + 1]] == t->face_leaf[ids[i]]
                          ? out->faces[i + 1].run_end
@@ -718,7 +754,9 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
                             out->count + (n - a->run_end), sizeof *out->pairs, 64))
             return false;
         for (uint32_t j = a->run_end; j < n; j++)
-            if (cell_faces_overlap(a, &out->faces[j]))
+            if (cell_faces_overlap(a, &out->faces[j]) &&
+                (a->first_cell == k || out->faces[j].first_cell == k ||
+                 first_shared_cell(fc->cell + a->cells, fc->cell + out->faces[j].cells, k)))
                 out->pairs[out->count++] = (uint64_t)a->face << 32 | out->faces[j].face;
     }
     return true;
@@ -730,6 +768,7 @@ typedef struct pair_job {
     float *box;
     uint32_t *cells; /* the critical leaf cells */
     size_t cell_count;
+    face_cells fc;
     pair_chunk_list *chunks;
 } pair_job;
 
@@ -740,7 +779,8 @@ static mcsg_status collect_chunk(void *user, size_t chunk, mcsg_error *err)
     size_t end = (chunk + 1) * PAIR_CELLS_PER_CHUNK;
     bool ok = true;
     for (size_t k = chunk * PAIR_CELLS_PER_CHUNK; ok && k < end && k < j->cell_count; k++)
-        ok = collect_cell_pairs(j->ctx, j->tree, j->box, &j->tree->cells[j->cells[k]], out);
+        ok = collect_cell_pairs(j->ctx, j->tree, j->box, &j->fc, &j->tree->cells[j->cells[k]],
+                                (uint32_t)k, out);
     mci_free(j->ctx, out->faces);
     out->faces = NULL;
     return ok ? MCSG_OK : mci_fail_nomem(err, "collecting candidate pairs");
@@ -757,11 +797,39 @@ static uint32_t *critical_leaves(const mci_ctx *ctx, const mci_octree *tree, siz
     return cells;
 }
 
+/* face_cells of the critical leaves (cells[0..count)), in counting-sort order. */
+static bool list_face_cells(const mci_ctx *ctx, const mci_octree *tree, const uint32_t *cells,
+                            size_t count, face_cells *fc)
+{
+    uint32_t faces = tree->face_base[tree->leaf_count];
+    size_t total = 0;
+    fc->start = mci_calloc_array(ctx, (size_t)faces + 2, sizeof *fc->start);
+    for (size_t k = 0; k < count; k++)
+        total += tree->cells[cells[k]].count;
+    fc->cell = fc->start ? mci_malloc_array(ctx, total + 1, sizeof *fc->cell) : NULL;
+    if (!fc->cell)
+        return false;
+    /* Counts at f + 2, so that the fill leaves each range at [start[f], start[f + 1]). */
+    for (size_t k = 0; k < count; k++) {
+        const mci_cell *c = &tree->cells[cells[k]];
+        for (uint32_t i = 0; i < c->count; i++)
+            fc->start[tree->face_ids[c->first + i] + 2]++;
+    }
+    for (uint32_t f = 0; f < faces; f++)
+        fc->start[f + 2] += fc->start[f + 1];
+    for (size_t k = 0; k < count; k++) {
+        const mci_cell *c = &tree->cells[cells[k]];
+        for (uint32_t i = 0; i < c->count; i++)
+            fc->cell[fc->start[tree->face_ids[c->first + i] + 1]++] = (uint32_t)k;
+    }
+    return true;
+}
+
 /* The chunks' pairs sorted and unique, without one sort over all of them: a pass puts
  * each pair in the bucket of its first face's range (contiguous ranges, so bucket order
  * is key order), then each bucket is sorted on its own, on the threads, and its repeats
- * (a pair shared by several cells) dropped. One radix sort over all 1.5M pairs of
- * ring-800 ran on one thread: 22 ms of the step's 47 on two threads (now 34). */
+ * (pairs whose first shared cell was not decided: see first_shared_cell) dropped. One
+ * radix sort over all pairs ran on one thread: 22 ms of the step's 47 on two threads. */
 enum { PAIRS_PER_BUCKET = 2048 };
 
 typedef struct bucket_job {
@@ -860,23 +928,25 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
     /* Contiguous boxes: a pair's test reads 48 bytes instead of 12 vertices. The build's
      * when the tree still has them, else computed again (a pass over the faces). */
     pair_job job = {ctx, tree, tree->face_box ? tree->face_box : face_boxes(ctx, tree), NULL,
-                    0, NULL};
+                    0, {NULL, NULL}, NULL};
     mcsg_status st = MCSG_OK;
     *pairs = NULL;
     *count = 0;
     if (job.box)
         job.cells = critical_leaves(ctx, tree, &job.cell_count);
     chunk_count = (job.cell_count + PAIR_CELLS_PER_CHUNK - 1) / PAIR_CELLS_PER_CHUNK;
-    if (job.cells)
+    if (job.cells && list_face_cells(ctx, tree, job.cells, job.cell_count, &job.fc))
         job.chunks = mci_calloc_array(ctx, chunk_count + 1, sizeof *job.chunks);
     if (!job.box || !job.cells || !job.chunks)
         st = mci_fail_nomem(err, "collecting candidate pairs");
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, chunk_count, collect_chunk, &job, err);
     mci_free(ctx, job.cells);
+    mci_free(ctx, job.fc.start);
+    mci_free(ctx, job.fc.cell);
     if (job.box != tree->face_box)
         mci_free(ctx, job.box);
-    /* A pair sharing several cells was collected once per cell: keep one. */
+    /* A pair sharing several cells may have been collected in more than one: keep one. */
     if (st == MCSG_OK)
         st = sorted_unique_pairs(ctx, tree, job.chunks, chunk_count, pairs, count, err);
     for (size_t c = 0; job.chunks && c < chunk_count; c++)
