@@ -134,13 +134,17 @@ static bool cache_planes(const mci_ctx *ctx, const mci_scene *s, const uint64_t 
     c->slot = mci_malloc_array(ctx, s->face_count + 1, sizeof *c->slot);
     if (!c->slot)
         return false;
+    /* Slots in face order: faces in pairs are marked, then numbered (a numbering in
+     * order of first appearance branched on every one of the 1.5M face ids). */
     for (size_t f = 0; f < s->face_count; f++)
         c->slot[f] = MCI_NONE;
-    for (size_t i = 0; i < 2 * count; i++) {
-        uint32_t f = (uint32_t)(i % 2 ? pairs[i / 2] : pairs[i / 2] >> 32);
-        if (c->slot[f] == MCI_NONE)
-            c->slot[f] = (uint32_t)used++;
+    for (size_t i = 0; i < count; i++) {
+        c->slot[pairs[i] >> 32] = 0;
+        c->slot[(uint32_t)pairs[i]] = 0;
     }
+    for (size_t f = 0; f < s->face_count; f++)
+        if (c->slot[f] != MCI_NONE)
+            c->slot[f] = (uint32_t)used++;
     c->planes = mci_malloc_array(ctx, used + 1, sizeof *c->planes);
     if (!c->planes)
         return false;
