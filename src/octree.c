@@ -859,28 +859,75 @@ static int bucket_shift(uint32_t faces, size_t pairs)
     return shift;
 }
 
-/* Moves the chunks' pairs into their buckets (each chunk's list freed once moved);
- * false when out of memory (the lists not moved stay with the chunks). */
+/* Moving the chunks' pairs into their buckets, on the threads: the chunks are taken in
+ * FILL_GROUPS groups of consecutive chunks; each group counts its pairs per bucket, the
+ * counts give each group its place in each bucket (groups in order within a bucket: the
+ * order of one pass over the chunks), then each group moves its pairs and frees its
+ * chunks' lists. One pass on one thread was a serial 6 ms of ring-800's step. */
+enum { FILL_GROUPS = 16 };
+
+typedef struct fill_job {
+    const mci_ctx *ctx;
+    pair_chunk_list *chunks;
+    size_t chunk_count, buckets;
+    int shift;
+    size_t *at; /* group g, bucket b: at[g * buckets + b] */
+    uint64_t *keys;
+} fill_job;
+
+static size_t group_first_chunk(const fill_job *j, size_t g)
+{
+    return g * j->chunk_count / FILL_GROUPS;
+}
+
+static mcsg_status count_group(void *user, size_t g, mcsg_error *err)
+{
+    const fill_job *j = user;
+    size_t *at = j->at + g * j->buckets;
+    (void)err;
+    for (size_t c = group_first_chunk(j, g); c < group_first_chunk(j, g + 1); c++)
+        for (size_t i = 0; i < j->chunks[c].count; i++)
+            at[j->chunks[c].pairs[i] >> 32 >> j->shift]++;
+    return MCSG_OK;
+}
+
+static mcsg_status move_group(void *user, size_t g, mcsg_error *err)
+{
+    const fill_job *j = user;
+    size_t *at = j->at + g * j->buckets;
+    (void)err;
+    for (size_t c = group_first_chunk(j, g); c < group_first_chunk(j, g + 1); c++) {
+        for (size_t i = 0; i < j->chunks[c].count; i++)
+            j->keys[at[j->chunks[c].pairs[i] >> 32 >> j->shift]++] = j->chunks[c].pairs[i];
+        mci_free(j->ctx, j->chunks[c].pairs);
+        j->chunks[c].pairs = NULL;
+    }
+    return MCSG_OK;
+}
+
+/* Moves the chunks' pairs into their buckets (each chunk's list freed once moved; bucket
+ * b gets [start[b], start[b + 1]) of keys); false when out of memory (the lists not moved
+ * stay with the chunks). */
 static bool fill_buckets(const mci_ctx *ctx, pair_chunk_list *chunks, size_t n, int shift,
                          uint64_t *keys, size_t *start, size_t buckets)
 {
-    size_t *at = mci_malloc_array(ctx, buckets + 1, sizeof *at);
-    if (!at)
+    fill_job j = {ctx, chunks, n, buckets, shift,
+                  mci_calloc_array(ctx, FILL_GROUPS * buckets + 1, sizeof *j.at), keys};
+    if (!j.at)
         return false;
-    for (size_t c = 0; c < n; c++)
-        for (size_t i = 0; i < chunks[c].count; i++)
-            start[(chunks[c].pairs[i] >> 32 >> shift) + 1]++;
+    (void)mci_parallel_for(ctx, FILL_GROUPS, count_group, &j, NULL);
+    start[0] = 0;
     for (size_t b = 0; b < buckets; b++) {
-        start[b + 1] += start[b];
-        at[b] = start[b];
+        size_t place = start[b];
+        for (size_t g = 0; g < FILL_GROUPS; g++) {
+            size_t count = j.at[g * buckets + b];
+            j.at[g * buckets + b] = place;
+            place += count;
+        }
+        start[b + 1] = place;
     }
-    for (size_t c = 0; c < n; c++) {
-        for (size_t i = 0; i < chunks[c].count; i++)
-            keys[at[chunks[c].pairs[i] >> 32 >> shift]++] = chunks[c].pairs[i];
-        mci_free(ctx, chunks[c].pairs);
-        chunks[c].pairs = NULL;
-    }
-    mci_free(ctx, at);
+    (void)mci_parallel_for(ctx, FILL_GROUPS, move_group, &j, NULL);
+    mci_free(ctx, j.at);
     return true;
 }
 
