@@ -673,7 +673,6 @@ typedef struct cell_face {
     float box[6];
     uint32_t face, run_end; /* run_end: the first later face of another leaf */
     uint32_t cells;         /* where the face's critical leaves start in face_cells.cell */
-    uint32_t first_cell;    /* the first of them */
 } cell_face;
 
 /* Each face's critical leaf cells (their positions among the critical leaves, in
@@ -742,7 +741,6 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
         cell_face *c = &out->faces[i];
         c->face = ids[i];
         c->cells = fc->start[ids[i]];
-        c->first_cell = fc->cell[c->cells];
         memcpy(c->box, box + 6 * (size_t)ids[i], sizeof c->box);
         c->run_end = i + 1 < n && t->face_leaf[ids[i + 1]] == t->face_leaf[ids[i]]
                          ? out->faces[i + 1].run_end
@@ -755,8 +753,7 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
             return false;
         for (uint32_t j = a->run_end; j < n; j++)
             if (cell_faces_overlap(a, &out->faces[j]) &&
-                (a->first_cell == k || out->faces[j].first_cell == k ||
-                 first_shared_cell(fc->cell + a->cells, fc->cell + out->faces[j].cells, k)))
+                first_shared_cell(fc->cell + a->cells, fc->cell + out->faces[j].cells, k))
                 out->pairs[out->count++] = (uint64_t)a->face << 32 | out->faces[j].face;
     }
     return true;
