@@ -145,6 +145,21 @@ static bool index_faces(const mci_ctx *ctx, mci_octree *t, const uint8_t *skip_l
     return true;
 }
 
+/* The root is a cube (its box grown along the shorter axes), so that cells stay cubes at
+ * every depth. Splitting a flat scene's box in all three axes made flat cells that faces
+ * cross many at a time: on a ring eight times as long (bench's constant-density ring,
+ * 800 spheres) the tree had 48K cells and the octree step grew 14x for 8x the faces; as a
+ * cube 31K cells, -6% instructions in all (cylinder minus 28 -7%, ring-800 -0.4%; flat
+ * small scenes up to +1.7%). A side that overflows keeps the box as it is. */
+static void make_cube(mci_cell *root)
+{
+    double side = 0;
+    for (int k = 0; k < 3; k++)
+        side = mci_max(side, root->hi[k] - root->lo[k]);
+    for (int k = 0; side < INFINITY && k < 3; k++)
+        root->hi[k] = mci_max(root->hi[k], root->lo[k] + side);
+}
+
 static void root_bounds(const mci_octree *t, mci_cell *root)
 {
     for (int k = 0; k < 3; k++) {
@@ -162,6 +177,7 @@ static void root_bounds(const mci_octree *t, mci_cell *root)
             }
         }
     }
+    make_cube(root);
 }
 
 static bool cell_is_critical(const mci_octree *t, const mci_cell *cell)

@@ -176,8 +176,21 @@ static void check_structure(const mci_octree *t)
     }
 }
 
-/* Every face touching a leaf cell is listed in it, and only those. */
-static void check_completeness(const mci_octree *t)
+/* Whether the face's box, as the octree stores it (rounded outward to floats), meets the
+ * cell's box. */
+static bool float_box_meets_cell(const mci_octree *t, uint32_t f, const mci_cell *cell)
+{
+    const float *box = t->face_box + 6 * (size_t)f;
+    for (int k = 0; k < 3; k++)
+        if (box[3 + k] < cell->lo[k] || box[k] > cell->hi[k])
+            return false;
+    return true;
+}
+
+/* Every face touching a leaf cell is listed in it. Only those, when `exact`; otherwise
+ * (coordinates beyond the float range) a face may also be listed where its float box,
+ * which picks the children a face goes to without a test, meets the cell. */
+static void check_completeness(const mci_octree *t, bool exact)
 {
     uint32_t faces = t->face_base[t->leaf_count];
     for (size_t c = 0; c < t->cell_count; c++) {
@@ -190,7 +203,10 @@ static void check_completeness(const mci_octree *t)
             /* The root holds every face, touching or not, when it is a leaf itself. */
             if (c == 0)
                 touches = true;
-            CHECK_MSG(face_listed(t, cell, f) == touches, "cell %zu face %u", c, f);
+            bool listed = face_listed(t, cell, f);
+            CHECK_MSG(listed == touches ||
+                          (!exact && listed && float_box_meets_cell(t, f, cell)),
+                      "cell %zu face %u", c, f);
         }
     }
 }
@@ -287,8 +303,8 @@ static void check_pairs(const mci_octree *t)
     mci_free(&ctx, pairs);
 }
 
-static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_faces,
-                        size_t min_pairs)
+static void check_scene_lists(const mcsg_mesh *const *leaves, size_t n, uint32_t max_faces,
+                              size_t min_pairs, bool exact_lists)
 {
     mci_ctx ctx;
     mci_octree tree;
@@ -299,7 +315,7 @@ static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_f
     mci_ctx_init(&ctx, NULL);
     CHECK_OK(mci_octree_build(&ctx, leaves, n, &params, &tree, &err), &err);
     check_structure(&tree);
-    check_completeness(&tree);
+    check_completeness(&tree, exact_lists);
     check_pairs(&tree);
     CHECK_OK(mci_octree_candidate_pairs(&ctx, &tree, &pairs, &count, &err), &err);
     CHECK_MSG(count >= min_pairs, "only %zu candidate pairs", count);
@@ -308,6 +324,12 @@ static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_f
            count);
     mci_free(&ctx, pairs);
     mci_octree_free(&ctx, &tree);
+}
+
+static void check_scene(const mcsg_mesh *const *leaves, size_t n, uint32_t max_faces,
+                        size_t min_pairs)
+{
+    check_scene_lists(leaves, n, max_faces, min_pairs, true);
 }
 
 /* Two unit spheres of `segments` segments, the second moved by (dx, dy, dz): the scene
@@ -365,7 +387,9 @@ TEST(coplanar_cubes_and_identical_spheres)
 
 /* Coordinates beyond the float range (their boxes round to the largest float or an
  * infinity) and below its normal range (boxes of a few float units around zero): the
- * face lists and the pairs stay exact and complete. */
+ * face lists and the pairs stay complete. Such coarse float boxes send a face to a lone
+ * candidate child without a test, so a list may also hold faces whose float box meets
+ * the cell (with a tight root box this happened not to occur on these two scenes). */
 TEST(scaled_beyond_float_range)
 {
     static const double scales[2] = {0x1p130, 0x1p-140};
@@ -381,7 +405,7 @@ TEST(scaled_beyond_float_range)
         mcsg_mesh_transform(&a, scale);
         mcsg_mesh_transform(&b, shift);
         const mcsg_mesh *leaves[2] = {&a, &b};
-        check_scene(leaves, 2, 8, 50);
+        check_scene_lists(leaves, 2, 8, 50, false);
         mcsg_mesh_free(&a, NULL);
         mcsg_mesh_free(&b, NULL);
     }
