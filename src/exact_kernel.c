@@ -107,10 +107,25 @@ int mci_point_vertex_count(const mci_point *p)
     return p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 5 : 9;
 }
 
+/* The axis k when an LPI's plane is x_k = const (its three vertices share coordinate k),
+ * else -1. Such a plane's normal is (0, 0, n_k) up to order, and n_k cancels from
+ * Y / W: W = (q - p)_k, Y = (q - p) (a - p)_k, of degrees 1 and 2 instead of 3 and 4.
+ * Axis-aligned input (CAD plates, grids of holes) is full of these, and the lower
+ * degree keeps their exact zeros within 128-bit integers. */
+static int lpi_plane_axis(const mci_point *p)
+{
+    for (int k = 0; k < 3; k++)
+        if (p->v[2][k] == p->v[3][k] && p->v[2][k] == p->v[4][k])
+            return k;
+    return -1;
+}
+
 /* Degrees of a point's X (offset from an origin vertex) and W in the coordinates. */
 static int x_degree(const mci_point *p)
 {
-    return p->kind == MCI_POINT_EXPLICIT ? 1 : p->kind == MCI_POINT_LPI ? 4 : 7;
+    if (p->kind == MCI_POINT_LPI)
+        return lpi_plane_axis(p) >= 0 ? 2 : 4;
+    return p->kind == MCI_POINT_EXPLICIT ? 1 : 7;
 }
 
 static int w_degree(const mci_point *p)
@@ -317,8 +332,9 @@ static int aligned_axis(const mci_plane *plane)
 static int exact_w_sign(const mci_point *p)
 {
     input_scale s = scale_of(&p, 1, NULL, 0);
-    /* The degree bound is X's, as for the other predicates (W alone is of lower degree). */
-    if (fits_i128(s, x_degree(p)))
+    /* The degree bound is X's, as for the other predicates (W alone is of lower degree);
+     * an LPI's W is the general formula's here (see EVAL(lpi)). */
+    if (fits_i128(s, p->kind == MCI_POINT_LPI ? 4 : x_degree(p)))
         return i128_w_sign(p, s.e0);
     return big_w_sign(p, s.e0);
 }

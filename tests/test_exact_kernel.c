@@ -1761,6 +1761,68 @@ static void scenario_parallel(scenario *s, const lattice *L)
     sc_line_edge(s, ve0, ve1);
 }
 
+/* ---------------------------------------------------------------- axis-aligned grids */
+
+/* A grid coordinate: a multiple of 1/4 in [-64, 64] (a plate's holes and bars). */
+static double grid_coord(void)
+{
+    return rng_int(-256, 256) / 4.0;
+}
+
+/* A vertex on the grid with coordinate k set to c. */
+static int grid_vertex_at(scenario *s, int k, double c)
+{
+    double x[3] = {grid_coord(), grid_coord(), grid_coord()};
+    x[k] = c;
+    return sc_vertex(s, x);
+}
+
+/* What a plate with a grid of holes is made of: planes x_k = c (three vertices sharing
+ * coordinate k; now and then collinear, so that the constructors must say no), lines
+ * that are translates of one another along the plane (the holes' wall diagonals), and
+ * their LPIs, which lie on one line of the plane: exact zeros in the orientations, on
+ * inputs short enough for 128-bit integers once the plane's normal cancels (EVAL(lpi)).
+ * A second aligned plane, a general one and TPIs through the aligned ones besides. */
+static void scenario_axis_grid(scenario *s)
+{
+    int k = rng_int(0, 2), i = (k + 1) % 3, j = (k + 2) % 3, pl[3], lines[4][2];
+    double c = grid_coord(), d[3], t[3] = {0, 0, 0};
+    memset(s, 0, sizeof *s);
+    s->cls = class_id("axisgrid", "");
+    int a = grid_vertex_at(s, k, c), b = grid_vertex_at(s, k, c);
+    int e = rng_chance(0.05) ? a : grid_vertex_at(s, k, c);
+    pl[0] = sc_plane_rotated(s, a, b, e);
+    pl[1] = sc_plane_rotated(s, grid_vertex_at(s, i, c), grid_vertex_at(s, i, c),
+                             grid_vertex_at(s, i, c));
+    pl[2] = sc_plane(s, random_vertex(s, R_INT), random_vertex(s, R_INT),
+                     grid_vertex_at(s, k, c));
+    for (int m = 0; m < 3; m++)
+        d[m] = rng_int(-8, 8) / 4.0;
+    if (d[k] == 0)
+        d[k] = 0.75;
+    t[i] = rng_int(-8, 8) / 4.0;
+    t[j] = rng_int(-8, 8) / 4.0;
+    double base[3] = {grid_coord() / 2, grid_coord() / 2, grid_coord() / 2};
+    for (int n = 0; n < 4; n++) {
+        double p0[3], p1[3];
+        for (int m = 0; m < 3; m++) {
+            p0[m] = base[m] + n * t[m];
+            p1[m] = p0[m] + d[m];
+        }
+        lines[n][0] = sc_vertex(s, p0);
+        lines[n][1] = sc_vertex(s, p1);
+    }
+    s->onpl[s->nonpl++] = pl[0];
+    for (int n = 0; n < 4; n++)
+        s->group[s->ngroup++] = sc_lpi(s, lines[n][rng_int(0, 1)], lines[n][0] ^ lines[n][1] ^
+                                       lines[n][rng_int(0, 1)], pl[0]);
+    s->group[s->ngroup++] = sc_explicit(s, a);
+    s->group[s->ngroup++] = sc_explicit(s, b);
+    sc_lpi(s, lines[0][0], lines[0][1], pl[1]);
+    sc_lpi(s, lines[1][0], lines[2][1], pl[2]);
+    sc_tpi(s, pl[0], pl[1], pl[2]);
+}
+
 /* ---------------------------------------------------------------- driver */
 
 static double test_scale(void)
@@ -1819,6 +1881,18 @@ TEST(kernel_adversarial)
             }
     }
     printf("  adversarial scenarios: %.1f s\n", seconds() - t);
+}
+
+TEST(kernel_axis_grid)
+{
+    scenario s;
+    double t = seconds();
+    int ulp_cls = class_id("axisgrid+ulp", "");
+    for (long n = scaled(400); n > 0; n--) {
+        scenario_axis_grid(&s);
+        run_with_perturbations(&s, 2, ulp_cls);
+    }
+    printf("  axis-aligned grid scenarios: %.1f s\n", seconds() - t);
 }
 
 /* mpq_set_d must be exact on the whole range (the reference relies on it). */
@@ -2099,6 +2173,7 @@ int main(void)
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);
     RUN(kernel_random);
+    RUN(kernel_axis_grid);
     print_class_table();
     print_predicate_table();
     /* The box filter's check was not vacuous: it decided some cases and left others. */
