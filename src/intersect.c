@@ -1637,7 +1637,7 @@ static uint32_t orderable_float(float x)
 typedef struct bounds_job {
     const numbering *nb;
     boxed_slot *items;
-    uint64_t *order; /* per item: its low x (orderable_float) << 32 | its index */
+    mci_keyed *order; /* per item: its low x, then its low y (orderable_float), and index */
     size_t n;
 } bounds_job;
 
@@ -1655,47 +1655,84 @@ static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
             item->lo[k] = isnan(lo[k]) ? -INFINITY : mci_float_below(lo[k]);
             item->hi[k] = isnan(hi[k]) ? INFINITY : mci_float_above(hi[k]);
         }
-        j->order[i] = (uint64_t)orderable_float(item->lo[0]) << 32 | i;
+        j->order[i].key =
+            (uint64_t)orderable_float(item->lo[0]) << 32 | orderable_float(item->lo[1]);
+        j->order[i].ref = (uint32_t)i;
     }
     return MCSG_OK;
 }
 
-/* Distinct definitions of one point: a sweep along x over the certified boxes (sorted by
- * their low x; equal lows in slot order), each pair whose boxes overlap tested exactly.
- * The joins do not depend on the order, only on the pairs. */
+static bool boxes_meet_in_yz(const boxed_slot *a, const boxed_slot *b)
+{
+    return !(a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
+             b->lo[2] > a->hi[2]);
+}
+
+/* Per position of the sorted order: the first later position with another low x. */
+static void low_x_run_ends(const mci_keyed *order, size_t n, uint32_t *run_end)
+{
+    for (size_t i = n; i-- > 0;)
+        run_end[i] = i + 1 < n && order[i + 1].key >> 32 == order[i].key >> 32
+                         ? run_end[i + 1]
+                         : (uint32_t)(i + 1);
+}
+
+/* Distinct definitions of one point: a sweep along x over the certified boxes, each
+ * pair whose boxes overlap tested exactly. Items are sorted by low x, then low y: within
+ * a run of equal low x every item overlaps the first in x, and the run is in y order, so
+ * its scan stops at the first item beyond the first's y range. Axis-aligned input puts
+ * hundreds of points on one x (a column of a grid of holes), which a sweep on x alone
+ * compared pairwise (box_grid_64: quadratic per column). The joins do not depend on the
+ * order, only on the pairs. */
+static void join_overlapping(numbering *nb, const boxed_slot *items, const mci_keyed *order,
+                             const uint32_t *run_end, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const boxed_slot *a = &items[order[i].ref];
+        size_t k = i + 1;
+        for (; k < run_end[i]; k++) {
+            const boxed_slot *b = &items[order[k].ref];
+            if (b->lo[1] > a->hi[1]) {
+                k = run_end[i];
+                break;
+            }
+            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                join(nb->parent, a->slot, b->slot);
+        }
+        for (; k < n && items[order[k].ref].lo[0] <= a->hi[0]; k++) {
+            const boxed_slot *b = &items[order[k].ref];
+            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                join(nb->parent, a->slot, b->slot);
+        }
+    }
+}
+
 static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
 {
     size_t roots = 0;
     bounds_job j = {nb, NULL, NULL, 0};
-    const boxed_slot *items;
-    const uint64_t *order;
+    uint32_t *run_end;
     mcsg_status st;
     /* Sized for the roots only: most slots are copies (ring-800: 797K slots). */
     for (uint32_t slot = 0; slot < nb->total; slot++)
         roots += nb->parent[slot] == slot;
-    items = j.items = mci_malloc_array(ctx, roots + 1, sizeof *j.items);
-    order = j.order = mci_malloc_array(ctx, roots + 1, sizeof *j.order);
-    st = j.items && j.order ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    j.items = mci_malloc_array(ctx, roots + 1, sizeof *j.items);
+    j.order = mci_malloc_array(ctx, roots + 1, sizeof *j.order);
+    run_end = mci_malloc_array(ctx, roots + 1, sizeof *run_end);
+    st = j.items && j.order && run_end ? MCSG_OK : mci_fail_nomem(err, "numbering points");
     for (uint32_t slot = 0; st == MCSG_OK && slot < nb->total; slot++)
         if (nb->parent[slot] == slot) /* not a copy of an earlier definition */
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
-    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
-        st = mci_fail_nomem(err, "numbering points");
-    for (size_t i = 0; st == MCSG_OK && i < j.n; i++) {
-        const boxed_slot *a = &items[(uint32_t)order[i]];
-        for (size_t k = i + 1; k < j.n && items[(uint32_t)order[k]].lo[0] <= a->hi[0]; k++) {
-            const boxed_slot *b = &items[(uint32_t)order[k]];
-            if (a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
-                b->lo[2] > a->hi[2])
-                continue;
-            if (mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
-                join(nb->parent, a->slot, b->slot);
-        }
+    if (st == MCSG_OK) {
+        mci_sort_keyed(j.order, j.n);
+        low_x_run_ends(j.order, j.n, run_end);
+        join_overlapping(nb, j.items, j.order, run_end, j.n);
     }
     mci_free(ctx, j.items);
     mci_free(ctx, j.order);
+    mci_free(ctx, run_end);
     return st;
 }
 
