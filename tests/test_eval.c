@@ -109,6 +109,38 @@ TEST(box_scenes_have_exact_volumes)
                  16, 1);
 }
 
+/* A plate minus an n x n grid of square holes, with n bars on top touching it (the
+ * bench's box_grid_n): volume 7 n^2 / 8 exactly. Its top and bottom faces carry every
+ * hole's outline, hundreds of points each, on lines shared by whole rows of holes: the
+ * triangulation's flipped insertion, the exact zeros of axis-aligned LPIs, and columns
+ * of points with one x in the point numbering. */
+static char *plate_with_holes(int n)
+{
+    size_t cap = 128 + (size_t)n * (size_t)(n + 1) * 96, len = 0;
+    char *text = malloc(cap);
+    len += (size_t)snprintf(text + len, cap - len,
+                            "union() { difference() { cube([%d, %d, 1]);", n, n);
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            len += (size_t)snprintf(text + len, cap - len,
+                                    " translate([%d.25, %d.25, -1]) cube([0.5, 0.5, 3]);", i, j);
+    len += (size_t)snprintf(text + len, cap - len, " }");
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(text + len, cap - len,
+                                " translate([%d, 0, 1]) cube([0.25, %d, 0.5]);", i, n);
+    snprintf(text + len, cap - len, " }");
+    return text;
+}
+
+TEST(plates_with_grids_of_holes)
+{
+    for (int n = 4; n <= 16; n += 12) {
+        char *text = plate_with_holes(n);
+        expect_solid(text, 0.875 * n * n, 1);
+        free(text);
+    }
+}
+
 TEST(identical_operands)
 {
     result r;
@@ -724,6 +756,7 @@ TEST(input_contract_is_checked)
 int main(void)
 {
     RUN(box_scenes_have_exact_volumes);
+    RUN(plates_with_grids_of_holes);
     RUN(identical_operands);
     RUN(buried_faces_are_dropped_whole);
     RUN(copies_are_evaluated_once);
