@@ -123,6 +123,27 @@ def ring_spheres_constant_density(ms, n, seed=1):
     return meshes, tree
 
 
+def drill_plate(ms, n, radius=0.3, segments=24):
+    """A CAD/CAM part: an n x n plate, 1 thick, drilled through by an n x n grid of
+    round holes (24-sided cylinders), all in one difference. Volume (volume_of below):
+    the plate minus the holes' polygons."""
+    meshes = [ms.box((0, 0, 0), (n, n, 1))]
+    for i in range(n):
+        for j in range(n):
+            meshes.append(ms.cylinder((i + 0.5, j + 0.5, 0.5), radius, 2.0, segments))
+    return meshes, ['difference'] + list(range(len(meshes)))
+
+
+# Exact volumes and shells of the generated scenes that reference.tsv does not list.
+def analytic_references():
+    ref = {}
+    for n in (32, 64):
+        ref['box_grid_%d' % n] = (0.875 * n * n, 1)  # plate - holes (n^2 / 4) + bars (n^2 / 8)
+        hole = 0.5 * 24 * 0.3 ** 2 * math.sin(2 * math.pi / 24)
+        ref['drill_plate_%d' % n] = (n * n * (1 - hole), 1)
+    return ref
+
+
 def scene_builders(ms, models):
     """(name, builder, note) in table order."""
     out = []
@@ -133,6 +154,11 @@ def scene_builders(ms, models):
                     lambda n=n: ring_spheres_constant_density(ms, n), 'Table 2, k/n constant'))
     out.append(('cylinder_28_holes', ms.cylinder_holes, 'Table 1 no. 5'))
     out.append(('box_grid_8', ms.box_grid, 'plate - holes + bars'))
+    for n in (32, 64):
+        out.append(('box_grid_%d' % n, lambda n=n: ms.box_grid(n), 'CAD plate, %d holes' % (n * n)))
+    for n in (32, 64):
+        out.append(('drill_plate_%d' % n, lambda n=n: drill_plate(ms, n),
+                    'CAD plate, %d round holes' % (n * n)))
     model = {}
 
     def from_models(name):
@@ -335,7 +361,8 @@ def main():
     os.makedirs(cache, exist_ok=True)
     tmp = os.path.join(cache, 'out')
     os.makedirs(tmp, exist_ok=True)
-    refs = references(shared)
+    refs = analytic_references()
+    refs.update(references(shared))
     rows = []
     for name, build, note in scene_builders(ms, os.path.join(shared, 'models')):
         if only and name not in only:
