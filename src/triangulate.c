@@ -257,17 +257,26 @@ static bool roughly_in_circle(const cdt *c, uint32_t p, uint32_t a, uint32_t b, 
     return c->in->sign * det > 0;
 }
 
+/* At most this many flips per inserted point. Inside a round hole the corners and the
+ * points where the walls' diagonals cross the plate lie on or just inside one circle,
+ * and every new corner flipped its way across the hole: 10.5 flips per point on
+ * drill_plate_32, against 2.8 on random points. Six keep the edges local where it
+ * matters (drill_plate_32 -10.7% instructions, box_grid_32 +2.4% against no limit). */
+enum { FLIPS_PER_POINT = 6 };
+
 /* After p was inserted: flip the edges opposite p while the point across lies in the
  * circle of p's triangle (Lawson), so that the triangulation stays close to Delaunay.
  * Without this, early points kept long edges across the whole face: a plate with
  * thousands of holes had every hole's edges crossed by dozens of them, and the walks
  * and constraint recovery went quadratic (box_grid_64, a perforated plate). Each flip
  * adds an edge at p, and edges at p are never flipped here, so the loop ends whatever
- * the rough test says; a flip is made only where the quadrilateral is strictly convex
- * (exact tests). No constraint exists yet while points are inserted. */
+ * the rough test says (and FLIPS_PER_POINT ends it sooner); a flip is made only where
+ * the quadrilateral is strictly convex (exact tests). No constraint exists yet while
+ * points are inserted. */
 static bool make_delaunayish(cdt *c, uint32_t p)
 {
-    while (c->queue_len > 0) {
+    int flips = 0;
+    while (c->queue_len > 0 && flips < FLIPS_PER_POINT) {
         queued_edge e = c->queue[c->queue_head + --c->queue_len];
         uint32_t t = e.t, s, a, b, d;
         int i = vertex_index(&c->t[t], p);
@@ -279,9 +288,11 @@ static bool make_delaunayish(cdt *c, uint32_t p)
         if (!roughly_in_circle(c, p, a, b, d) || orient(c, p, d, a) * orient(c, p, d, b) >= 0)
             continue;
         flip(c, t, i); /* t = (p, a, d), s = (d, b, p) */
+        flips++;
         if (!push_edge(c, p, d, t) || !push_edge(c, d, p, s))
             return false;
     }
+    c->queue_len = 0;
     return true;
 }
 
