@@ -1641,7 +1641,7 @@ static uint32_t orderable_float(float x)
 typedef struct bounds_job {
     const numbering *nb;
     boxed_slot *items;
-    mci_keyed *order; /* per item: its low x, then its low y (orderable_float), and index */
+    uint64_t *order; /* per item: its low x (orderable_float) << 32 | its index */
     size_t n;
 } bounds_job;
 
@@ -1659,26 +1659,33 @@ static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
             item->lo[k] = isnan(lo[k]) ? -INFINITY : mci_float_below(lo[k]);
             item->hi[k] = isnan(hi[k]) ? INFINITY : mci_float_above(hi[k]);
         }
-        j->order[i].key =
-            (uint64_t)orderable_float(item->lo[0]) << 32 | orderable_float(item->lo[1]);
-        j->order[i].ref = (uint32_t)i;
+        j->order[i] = (uint64_t)orderable_float(item->lo[0]) << 32 | i;
     }
     return MCSG_OK;
+}
+
+/* Sorted by low x (radix), then each run of equal low x by low y: the run's keys become
+ * low y << 32 | index. run_end[i] is the first later position with another low x. */
+static void sort_by_low_x_then_y(const boxed_slot *items, uint64_t *order, size_t n,
+                                 uint32_t *run_end)
+{
+    for (size_t i = n; i-- > 0;)
+        run_end[i] = i + 1 < n && order[i + 1] >> 32 == order[i] >> 32 ? run_end[i + 1]
+                                                                       : (uint32_t)(i + 1);
+    for (size_t i = 0; i < n; i = run_end[i]) {
+        if (run_end[i] - i < 2)
+            continue;
+        for (size_t k = i; k < run_end[i]; k++)
+            order[k] = (uint64_t)orderable_float(items[(uint32_t)order[k]].lo[1]) << 32 |
+                       (uint32_t)order[k];
+        mci_sort_u64(order + i, run_end[i] - i);
+    }
 }
 
 static bool boxes_meet_in_yz(const boxed_slot *a, const boxed_slot *b)
 {
     return !(a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
              b->lo[2] > a->hi[2]);
-}
-
-/* Per position of the sorted order: the first later position with another low x. */
-static void low_x_run_ends(const mci_keyed *order, size_t n, uint32_t *run_end)
-{
-    for (size_t i = n; i-- > 0;)
-        run_end[i] = i + 1 < n && order[i + 1].key >> 32 == order[i].key >> 32
-                         ? run_end[i + 1]
-                         : (uint32_t)(i + 1);
 }
 
 /* Distinct definitions of one point: a sweep along x over the certified boxes, each
@@ -1688,14 +1695,14 @@ static void low_x_run_ends(const mci_keyed *order, size_t n, uint32_t *run_end)
  * hundreds of points on one x (a column of a grid of holes), which a sweep on x alone
  * compared pairwise (box_grid_64: quadratic per column). The joins do not depend on the
  * order, only on the pairs. */
-static void join_overlapping(numbering *nb, const boxed_slot *items, const mci_keyed *order,
+static void join_overlapping(numbering *nb, const boxed_slot *items, const uint64_t *order,
                              const uint32_t *run_end, size_t n)
 {
     for (size_t i = 0; i < n; i++) {
-        const boxed_slot *a = &items[order[i].ref];
+        const boxed_slot *a = &items[(uint32_t)order[i]];
         size_t k = i + 1;
         for (; k < run_end[i]; k++) {
-            const boxed_slot *b = &items[order[k].ref];
+            const boxed_slot *b = &items[(uint32_t)order[k]];
             if (b->lo[1] > a->hi[1]) {
                 k = run_end[i];
                 break;
@@ -1703,8 +1710,8 @@ static void join_overlapping(numbering *nb, const boxed_slot *items, const mci_k
             if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
                 join(nb->parent, a->slot, b->slot);
         }
-        for (; k < n && items[order[k].ref].lo[0] <= a->hi[0]; k++) {
-            const boxed_slot *b = &items[order[k].ref];
+        for (; k < n && items[(uint32_t)order[k]].lo[0] <= a->hi[0]; k++) {
+            const boxed_slot *b = &items[(uint32_t)order[k]];
             if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
                 join(nb->parent, a->slot, b->slot);
         }
@@ -1729,9 +1736,10 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
+    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
+        st = mci_fail_nomem(err, "numbering points");
     if (st == MCSG_OK) {
-        mci_sort_keyed(j.order, j.n);
-        low_x_run_ends(j.order, j.n, run_end);
+        sort_by_low_x_then_y(j.items, j.order, j.n, run_end);
         join_overlapping(nb, j.items, j.order, run_end, j.n);
     }
     mci_free(ctx, j.items);
