@@ -341,6 +341,82 @@ void mci_leaf_box(const mcsg_mesh *m, double box[6])
         }
 }
 
+typedef struct box_end {
+    double lo;      /* the box's low x */
+    uint32_t index;
+} box_end;
+
+static inline bool box_end_less(const box_end *a, const box_end *b)
+{
+    return a->lo != b->lo ? a->lo < b->lo : a->index < b->index;
+}
+
+MCI_DEFINE_SORT(sort_box_ends, box_end, box_end_less)
+
+static bool yz_meet(const double a[6], const double b[6])
+{
+    return !(a[4] < b[1] || b[4] < a[1] || a[5] < b[2] || b[5] < a[2]);
+}
+
+/* A sweep along x over the boxes sorted by low x, each pair within the x range tested
+ * on y and z: `fill` false counts each box's overlaps into start[i + 1], true writes
+ * them where start[] (advanced) says. */
+static void sweep_box_pairs(const double (*box)[6], const box_end *order, size_t n,
+                            uint32_t *start, uint32_t *list, bool fill)
+{
+    for (size_t i = 0; i < n; i++) {
+        uint32_t a = order[i].index;
+        for (size_t k = i + 1; k < n && order[k].lo <= box[a][3]; k++) {
+            uint32_t b = order[k].index;
+            if (!yz_meet(box[a], box[b]))
+                continue;
+            if (fill) {
+                list[start[a]++] = b;
+                list[start[b]++] = a;
+            } else {
+                start[a + 1]++;
+                start[b + 1]++;
+            }
+        }
+    }
+}
+
+/* Once per evaluation instead of every box against every other per leaf: a plate minus
+ * 4,096 holes tested 16.8M pairs of boxes in each of two passes. */
+bool mci_box_overlaps(const mci_ctx *ctx, const double (*box)[6], size_t n, uint32_t **start,
+                      uint32_t **list)
+{
+    box_end *order = mci_malloc_array(ctx, n + 1, sizeof *order);
+    uint32_t *at = mci_calloc_array(ctx, n + 1, sizeof *at);
+    bool ok = order && at;
+    *start = mci_calloc_array(ctx, n + 1, sizeof **start);
+    *list = NULL;
+    ok = ok && *start;
+    for (size_t i = 0; ok && i < n; i++)
+        order[i] = (box_end){box[i][0], (uint32_t)i};
+    if (ok) {
+        sort_box_ends(order, n);
+        sweep_box_pairs(box, order, n, *start, NULL, false);
+        for (size_t i = 0; i < n; i++)
+            (*start)[i + 1] += (*start)[i];
+        ok = (*list = mci_malloc_array(ctx, (size_t)(*start)[n] + 1, sizeof **list)) != NULL;
+    }
+    if (ok) {
+        memcpy(at, *start, n * sizeof *at);
+        sweep_box_pairs(box, order, n, at, *list, true);
+        for (size_t i = 0; i < n; i++)
+            sort_u32(*list + (*start)[i], (*start)[i + 1] - (*start)[i]);
+    }
+    mci_free(ctx, order);
+    mci_free(ctx, at);
+    if (!ok) {
+        mci_free(ctx, *start);
+        mci_free(ctx, *list);
+        *start = *list = NULL;
+    }
+    return ok;
+}
+
 static bool assign_vertex_ids(const mci_ctx *ctx, mci_classifier *cl)
 {
     const mci_scene *s = cl->scene;
@@ -423,6 +499,11 @@ mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
     }
     for (size_t l = 0; l < scene->octree.leaf_count; l++)
         mci_leaf_box(scene->octree.leaves[l], cl->box[l]);
+    if (!mci_box_overlaps(ctx, (const double (*)[6])cl->box, scene->octree.leaf_count,
+                          &cl->overlap_start, &cl->overlap)) {
+        mci_classifier_free(ctx, cl);
+        return mci_fail_nomem(err, "classifying faces");
+    }
     return MCSG_OK;
 }
 
@@ -432,6 +513,8 @@ void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl)
     mci_free(ctx, cl->vertex_id);
     mci_free(ctx, cl->new_vertex);
     mci_free(ctx, cl->box);
+    mci_free(ctx, cl->overlap_start);
+    mci_free(ctx, cl->overlap);
     mci_free(ctx, cl->copy_start);
     mci_free(ctx, cl->copy_of);
     memset(cl, 0, sizeof *cl);
@@ -942,27 +1025,21 @@ static mcsg_status index_regions(leaf_work *w)
     return MCSG_OK;
 }
 
-static bool boxes_meet(const double a[6], const double b[6])
-{
-    for (int k = 0; k < 3; k++)
-        if (a[3 + k] < b[k] || b[3 + k] < a[k])
-            return false;
-    return true;
-}
-
+/* The candidates: the other leaves whose boxes meet this leaf's, in increasing index. */
 static mcsg_status find_candidates(leaf_work *w)
 {
     size_t n = w->s->octree.leaf_count;
-    w->cand = mci_malloc_array(w->ctx, n + 1, sizeof *w->cand);
+    const uint32_t *first = w->cl->overlap + w->cl->overlap_start[w->leaf];
+    size_t count = w->cl->overlap_start[w->leaf + 1] - w->cl->overlap_start[w->leaf];
+    w->cand = mci_malloc_array(w->ctx, count + 1, sizeof *w->cand);
     w->slot_of_leaf = mci_malloc_array(w->ctx, n + 1, sizeof *w->slot_of_leaf);
     if (!w->cand || !w->slot_of_leaf)
         return mci_fail_nomem(w->err, "classifying faces");
-    for (uint32_t l = 0; l < n; l++) {
+    for (uint32_t l = 0; l < n; l++)
         w->slot_of_leaf[l] = MCI_NONE;
-        if (l != w->leaf && boxes_meet(w->cl->box[l], w->cl->box[w->leaf])) {
-            w->slot_of_leaf[l] = (uint32_t)w->ncand;
-            w->cand[w->ncand++] = l;
-        }
+    for (size_t c = 0; c < count; c++) {
+        w->slot_of_leaf[first[c]] = (uint32_t)w->ncand;
+        w->cand[w->ncand++] = first[c];
     }
     if (w->nreg > 0 && w->ncand > SIZE_MAX / w->nreg)
         return mci_fail(w->err, MCSG_ERR_LIMIT, "too many labels in one leaf");

@@ -34,6 +34,8 @@ typedef struct mci_classifier {
     const double **new_vertex;
     size_t new_vertex_count;
     double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
+    /* Per leaf: the other leaves whose boxes meet its box (mci_box_overlaps). */
+    uint32_t *overlap_start, *overlap;
     /* Copies (scene->alias): copy_of[copy_start[l] .. copy_start[l + 1]) are the leaves
      * that are copies of leaf l, in increasing order (NULL when there is none). */
     uint32_t *copy_start, *copy_of;
@@ -44,6 +46,12 @@ typedef struct mci_classifier {
 
 /* The bounding box of a mesh's vertices: lo[3], hi[3] (zeros for an empty mesh). */
 void mci_leaf_box(const mcsg_mesh *m, double box[6]);
+
+/* The boxes each of n closed boxes meets, itself excepted: those of box i are
+ * list[start[i] .. start[i + 1]), in increasing index. Both arrays are allocated with
+ * ctx (the caller frees them); false when out of memory (nothing allocated). */
+bool mci_box_overlaps(const mci_ctx *ctx, const double (*box)[6], size_t n, uint32_t **start,
+                      uint32_t **list);
 
 mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err);

@@ -29,6 +29,7 @@ typedef struct decide_job {
     mci_scene *s;
     const mci_ptree *t;
     const double (*box)[6]; /* per leaf */
+    const uint32_t *overlap_start, *overlap; /* per leaf: the leaves whose boxes meet it */
     size_t *dropped;        /* per leaf: faces flagged */
     uint8_t *copied;        /* per leaf: another leaf is a copy of it (NULL: none is) */
     mci_trimmed_list *keep; /* per leaf: where its trimmed list goes (NULL: nowhere) */
@@ -99,15 +100,16 @@ static void free_decision(leaf_decision *d)
 static bool trim_list(leaf_decision *d, bool *rejected)
 {
     const mci_ptree *t = d->j->t;
-    const double (*box)[6] = d->j->box;
+    const decide_job *j = d->j;
     d->list = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->list);
     d->scratch = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->scratch);
     d->leaf_labels = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
     if (!d->list || !d->scratch || !d->leaf_labels)
         return false;
     for (uint32_t l = 0; l < t->leaf_count; l++)
-        d->leaf_labels[l] = l != d->leaf && boxes_meet(box[l], box[d->leaf]) ? MCI_LABEL_UNKNOWN
-                                                                            : MCI_LABEL_OUT;
+        d->leaf_labels[l] = MCI_LABEL_OUT;
+    for (uint32_t i = j->overlap_start[d->leaf]; i < j->overlap_start[d->leaf + 1]; i++)
+        d->leaf_labels[j->overlap[i]] = MCI_LABEL_UNKNOWN;
     d->nlist = mci_csglist_trim(t, d->leaf, d->leaf_labels, d->scratch, d->list, rejected);
     if (*rejected)
         return true;
@@ -398,7 +400,8 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
     size_t n = s->octree.leaf_count;
     double (*box)[6] = mci_malloc_array(ctx, n + 1, sizeof *box);
     size_t *dropped = mci_calloc_array(ctx, n + 1, sizeof *dropped);
-    decide_job job = {ctx, s, t, (const double (*)[6])box, dropped, NULL, keep};
+    decide_job job = {ctx, s, t, (const double (*)[6])box, NULL, NULL, dropped, NULL, keep};
+    uint32_t *overlap_start = NULL, *overlap = NULL;
     mcsg_status st = MCSG_OK;
     *count = 0;
     s->arr_dropped = mci_calloc_array(ctx, s->arr_count + 1, 1);
@@ -409,11 +412,17 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
         st = mci_fail_nomem(err, "deciding whole faces");
     for (size_t l = 0; st == MCSG_OK && l < n; l++)
         mci_leaf_box(s->octree.leaves[l], box[l]);
+    if (st == MCSG_OK && !mci_box_overlaps(ctx, job.box, n, &overlap_start, &overlap))
+        st = mci_fail_nomem(err, "deciding whole faces");
+    job.overlap_start = overlap_start;
+    job.overlap = overlap;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, n, decide_leaf, &job, err);
     for (size_t l = 0; st == MCSG_OK && l < n; l++)
         *count += dropped[l];
     mci_free(ctx, box);
+    mci_free(ctx, overlap_start);
+    mci_free(ctx, overlap);
     mci_free(ctx, dropped);
     mci_free(ctx, job.copied);
     return st;

@@ -3,12 +3,14 @@
  * label as the brute-force test over every face of the leaf, for points anywhere,
  * including points whose rays graze vertices and edges exactly (integer grids) and
  * points on the surface (UNKNOWN); and the labels must be right for boxes, where
- * membership is known.
+ * membership is known. Also the leaves' box overlaps (the candidates of every leaf's
+ * classification) against every pair of boxes.
  */
 #include "testlib.h"
 #include "classify.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static uint64_t rng = 0x7261797361u;
@@ -126,9 +128,51 @@ TEST(octree_rays_know_the_box)
     free_scene(&s, &ctx);
 }
 
+/* Boxes on a quarter-unit grid (shared and touching sides are frequent), some long in
+ * x as a plate under its holes: mci_box_overlaps must list exactly the pairs of closed
+ * boxes that meet, each row in increasing index. */
+TEST(box_overlaps_match_every_pair)
+{
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    for (int round = 0; round < 30; round++) {
+        size_t n = (size_t)test_random_int(&rng, 0, 120), listed = 0;
+        double (*box)[6] = malloc((n + 1) * sizeof *box);
+        uint32_t *start, *list;
+        for (size_t i = 0; i < n; i++)
+            for (int k = 0; k < 3; k++) {
+                double lo = test_random_int(&rng, 0, 40) / 4.0;
+                double len = test_random_int(&rng, 0, k == 0 && i % 7 == 0 ? 40 : 8) / 4.0;
+                box[i][k] = lo;
+                box[i][3 + k] = lo + len;
+            }
+        CHECK(mci_box_overlaps(&ctx, (const double (*)[6])box, n, &start, &list));
+        for (size_t i = 0; i < n; i++) {
+            uint32_t at = start[i];
+            for (size_t j = 0; j < n; j++) {
+                bool meet = j != i;
+                for (int k = 0; k < 3; k++)
+                    meet = meet && !(box[i][3 + k] < box[j][k] || box[j][3 + k] < box[i][k]);
+                if (!meet)
+                    continue;
+                CHECK_MSG(at < start[i + 1] && list[at] == j, "round %d: box %zu misses %zu",
+                          round, i, j);
+                at += at < start[i + 1] && list[at] == j;
+            }
+            CHECK_MSG(at == start[i + 1], "round %d: box %zu lists extra boxes", round, i);
+            listed += start[i + 1] - start[i];
+        }
+        CHECK(n == 0 || start[n] == listed);
+        mci_free(&ctx, start);
+        mci_free(&ctx, list);
+        free(box);
+    }
+}
+
 int main(void)
 {
     RUN(octree_rays_agree_with_brute_force);
     RUN(octree_rays_know_the_box);
+    RUN(box_overlaps_match_every_pair);
     return test_summary();
 }
