@@ -500,7 +500,8 @@ mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
     for (size_t l = 0; l < scene->octree.leaf_count; l++)
         mci_leaf_box(scene->octree.leaves[l], cl->box[l]);
     if (!mci_box_overlaps(ctx, (const double (*)[6])cl->box, scene->octree.leaf_count,
-                          &cl->overlap_start, &cl->overlap)) {
+                          &cl->overlap_start, &cl->overlap) ||
+        !mci_trim_base_init(ctx, tree, &cl->trim_base)) {
         mci_classifier_free(ctx, cl);
         return mci_fail_nomem(err, "classifying faces");
     }
@@ -515,6 +516,7 @@ void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl)
     mci_free(ctx, cl->box);
     mci_free(ctx, cl->overlap_start);
     mci_free(ctx, cl->overlap);
+    mci_trim_base_free(ctx, &cl->trim_base);
     mci_free(ctx, cl->copy_start);
     mci_free(ctx, cl->copy_of);
     memset(cl, 0, sizeof *cl);
@@ -1511,9 +1513,10 @@ static mcsg_status trim_csglist(leaf_work *w)
         memcpy(w->list, made->list, made->count * sizeof *w->list);
         w->nlist = made->count;
         w->rejected = made->rejected;
-    } else {
-        w->nlist = mci_csglist_trim(t, w->leaf, w->leaf_labels, w->scratch, w->list,
-                                    &w->rejected);
+    } else if (!mci_csglist_trim_sparse(w->ctx, t, &w->cl->trim_base, w->leaf, w->cand,
+                                        w->ncand, w->list, &w->nlist, &w->rejected)) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
     }
     if (!w->rejected)
         cover_entries(t, w->list, w->nlist, cover);

@@ -36,6 +36,7 @@ typedef struct mci_classifier {
     double (*box)[6];              /* per leaf: lo[3], hi[3] of its vertices */
     /* Per leaf: the other leaves whose boxes meet its box (mci_box_overlaps). */
     uint32_t *overlap_start, *overlap;
+    mci_trim_base trim_base; /* for the trimmed CSGlists */
     /* Copies (scene->alias): copy_of[copy_start[l] .. copy_start[l + 1]) are the leaves
      * that are copies of leaf l, in increasing order (NULL when there is none). */
     uint32_t *copy_start, *copy_of;

@@ -279,6 +279,202 @@ size_t mci_csglist_trim(const mci_ptree *t, uint32_t leaf, const mci_label *leaf
 }
 
 /* ---------------------------------------------------------------------------------- */
+/* Trimming when few primitives are unknown                                            */
+
+static mci_label absorbing_value(const mci_pnode *p)
+{
+    return p->kind == MCI_PNODE_UNION ? MCI_LABEL_IN : MCI_LABEL_OUT;
+}
+
+static bool is_operation(const mci_pnode *p)
+{
+    return p->kind == MCI_PNODE_UNION || p->kind == MCI_PNODE_INTERSECTION;
+}
+
+bool mci_trim_base_init(const mci_ctx *ctx, const mci_ptree *t, mci_trim_base *base)
+{
+    base->all_out = mci_malloc_array(ctx, t->node_count + 1, sizeof *base->all_out);
+    base->absorbing = mci_calloc_array(ctx, t->node_count + 1, sizeof *base->absorbing);
+    base->path_bad = mci_malloc_array(ctx, t->node_count + 1, sizeof *base->path_bad);
+    if (!base->all_out || !base->absorbing || !base->path_bad) {
+        mci_trim_base_free(ctx, base);
+        return false;
+    }
+    for (uint32_t i = 0; i < t->node_count; i++) { /* post-order: children first */
+        const mci_pnode *p = &t->nodes[i];
+        mci_label v;
+        if (p->kind == MCI_PNODE_LEAF)
+            v = p->complement ? MCI_LABEL_IN : MCI_LABEL_OUT;
+        else if (!is_operation(p))
+            v = p->kind == MCI_PNODE_FULL ? MCI_LABEL_IN : MCI_LABEL_OUT;
+        else {
+            for (uint32_t c = 0; c < p->count; c++)
+                base->absorbing[i] += base->all_out[t->child[p->first + c]] == absorbing_value(p);
+            v = base->absorbing[i] > 0 ? absorbing_value(p)
+                                       : absorbing_value(p) == MCI_LABEL_IN ? MCI_LABEL_OUT
+                                                                            : MCI_LABEL_IN;
+        }
+        base->all_out[i] = (uint8_t)v;
+    }
+    for (uint32_t i = (uint32_t)t->node_count; i-- > 0;) { /* parents first */
+        uint32_t a = t->nodes[i].parent;
+        base->path_bad[i] = a == NONE ? 0
+                                      : base->path_bad[a] + base->absorbing[a] -
+                                            (base->all_out[i] == absorbing_value(&t->nodes[a]));
+    }
+    return true;
+}
+
+void mci_trim_base_free(const mci_ctx *ctx, mci_trim_base *base)
+{
+    mci_free(ctx, base->all_out);
+    mci_free(ctx, base->absorbing);
+    mci_free(ctx, base->path_bad);
+    memset(base, 0, sizeof *base);
+}
+
+/* The subtrees hanging off the path of the primitive being trimmed (branches) that hold
+ * unknown primitives, and the nodes between those and the branch (marked). */
+typedef struct sparse_trim {
+    const mci_ptree *t;
+    const mci_trim_base *base;
+    uint32_t path_node;   /* the primitive's node: its ancestors are the path */
+    uint8_t *value;       /* per node: its value once known; 0xFF where not marked */
+    uint32_t *absorbing;  /* per marked operation: children holding its absorbing value */
+    uint32_t *unknowns;   /* per marked operation: children UNKNOWN */
+    uint32_t *pending;    /* per marked operation: marked children not evaluated yet */
+    uint32_t *ready;      /* marked nodes whose children are all evaluated (a stack) */
+    size_t nready;
+    uint64_t *branches;   /* parent << 32 | node */
+    size_t nbranches;
+} sparse_trim;
+
+/* Whether node a is an ancestor of the primitive's node (its subtree range holds it). */
+static bool on_path(const sparse_trim *st, uint32_t a)
+{
+    return a >= st->path_node && a + 1 - st->t->nodes[a].size <= st->path_node;
+}
+
+static void mark(sparse_trim *st, uint32_t x)
+{
+    st->value[x] = MCI_LABEL_UNKNOWN; /* until evaluated */
+    st->absorbing[x] = st->base->absorbing[x];
+}
+
+/* Marks each unknown primitive's node and its ancestors below the path (each once),
+ * counting marked children in their parents; the last one below the path is a branch. */
+static void mark_unknown_paths(sparse_trim *st, const uint32_t *unknown, size_t k)
+{
+    const mci_ptree *t = st->t;
+    for (size_t i = 0; i < k; i++) {
+        uint32_t x = t->leaf_node[unknown[i]], parent;
+        if (st->value[x] != 0xFF)
+            continue;
+        mark(st, x);
+        st->ready[st->nready++] = x;
+        for (;; x = parent) {
+            parent = t->nodes[x].parent;
+            if (on_path(st, parent)) { /* never NONE: the root is on every path */
+                st->branches[st->nbranches++] = (uint64_t)parent << 32 | x;
+                break;
+            }
+            st->pending[parent]++;
+            if (st->value[parent] != 0xFF)
+                break;
+            mark(st, parent);
+        }
+    }
+}
+
+/* The marked nodes' values, each once its marked children have theirs: an unknown
+ * primitive is UNKNOWN; an operation is absorbing when a child is, else UNKNOWN when a
+ * child is, else neutral; each value then corrects its parent's counts (which held the
+ * all-OUT values), up to the branches. */
+static void evaluate_marked(sparse_trim *st)
+{
+    const mci_ptree *t = st->t;
+    while (st->nready > 0) {
+        uint32_t x = st->ready[--st->nready], parent = t->nodes[x].parent;
+        const mci_pnode *p = &t->nodes[x];
+        mci_label v = MCI_LABEL_UNKNOWN;
+        if (is_operation(p))
+            v = st->absorbing[x] > 0 ? absorbing_value(p)
+                : st->unknowns[x] > 0 ? MCI_LABEL_UNKNOWN
+                : absorbing_value(p) == MCI_LABEL_IN ? MCI_LABEL_OUT : MCI_LABEL_IN;
+        st->value[x] = (uint8_t)v;
+        if (on_path(st, parent))
+            continue;
+        st->absorbing[parent] += (v == absorbing_value(&t->nodes[parent])) -
+                                 (st->base->all_out[x] == absorbing_value(&t->nodes[parent]));
+        st->unknowns[parent] += v == MCI_LABEL_UNKNOWN;
+        if (--st->pending[parent] == 0)
+            st->ready[st->nready++] = parent;
+    }
+}
+
+/* The entries from the branches, from the primitive upwards and in child order (post-
+ * order numbers: ancestors above their descendants, later children above earlier
+ * ones); false on a rejection: a sibling of the path with its parent's absorbing value
+ * (by the all-OUT counts along the path, corrected at the branches). */
+static bool entries_from_branches(sparse_trim *st, mci_csg_entry *list, size_t *n)
+{
+    const mci_ptree *t = st->t;
+    uint32_t bad = st->base->path_bad[st->path_node];
+    mci_sort_u64(st->branches, st->nbranches);
+    for (size_t i = 0; i < st->nbranches; i++) {
+        uint32_t a = (uint32_t)(st->branches[i] >> 32), s = (uint32_t)st->branches[i];
+        bad -= st->base->all_out[s] == absorbing_value(&t->nodes[a]);
+    }
+    if (bad > 0)
+        return false;
+    for (size_t i = 0; i < st->nbranches; i++) {
+        uint32_t a = (uint32_t)(st->branches[i] >> 32), s = (uint32_t)st->branches[i];
+        mci_label absorbing = absorbing_value(&t->nodes[a]);
+        /* the path's child of a: the one child of a whose range holds the primitive */
+        bool after = s > st->path_node;
+        if (st->value[s] == absorbing)
+            return false;
+        if (st->value[s] == MCI_LABEL_UNKNOWN) {
+            uint8_t base = MCI_LABEL_BIT(absorbing == MCI_LABEL_IN ? MCI_LABEL_OUT : MCI_LABEL_IN);
+            list[*n].node = s;
+            list[(*n)++].desired = (uint8_t)(base | (after ? MCI_LABEL_BIT(MCI_LABEL_SAME) : 0));
+        }
+    }
+    return true;
+}
+
+bool mci_csglist_trim_sparse(const mci_ctx *ctx, const mci_ptree *t, const mci_trim_base *base,
+                             uint32_t leaf, const uint32_t *unknown, size_t k,
+                             mci_csg_entry *list, size_t *count, bool *rejected)
+{
+    sparse_trim st = {t, base, t->leaf_node[leaf], NULL, NULL, NULL, NULL, NULL, 0, NULL, 0};
+    size_t nodes = t->node_count + 1;
+    bool ok;
+    st.value = mci_malloc_array(ctx, nodes, sizeof *st.value);
+    st.absorbing = mci_malloc_array(ctx, nodes, sizeof *st.absorbing);
+    st.unknowns = mci_calloc_array(ctx, nodes, sizeof *st.unknowns);
+    st.pending = mci_calloc_array(ctx, nodes, sizeof *st.pending);
+    st.ready = mci_malloc_array(ctx, k + 1, sizeof *st.ready);
+    st.branches = mci_malloc_array(ctx, k + 1, sizeof *st.branches);
+    ok = st.value && st.absorbing && st.unknowns && st.pending && st.ready && st.branches;
+    *count = 0;
+    *rejected = false;
+    if (ok) {
+        memset(st.value, 0xFF, nodes);
+        mark_unknown_paths(&st, unknown, k);
+        evaluate_marked(&st);
+        *rejected = !entries_from_branches(&st, list, count);
+    }
+    mci_free(ctx, st.value);
+    mci_free(ctx, st.absorbing);
+    mci_free(ctx, st.unknowns);
+    mci_free(ctx, st.pending);
+    mci_free(ctx, st.ready);
+    mci_free(ctx, st.branches);
+    return ok;
+}
+
+/* ---------------------------------------------------------------------------------- */
 /* Blist                                                                               */
 
 typedef struct blist_builder {

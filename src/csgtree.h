@@ -103,6 +103,31 @@ int mci_csglist_accepts(const mci_ptree *t, const mci_csg_entry *list, size_t n,
 size_t mci_csglist_trim(const mci_ptree *t, uint32_t leaf, const mci_label *leaf_labels,
                         mci_label *scratch, mci_csg_entry *list, bool *rejected);
 
+/* What mci_csglist_trim_sparse needs of a tree, computed once: every node's value when
+ * every primitive is OUT, and how many of its children then hold its absorbing value
+ * (IN under a union, OUT under an intersection; the value is that when any does). */
+typedef struct mci_trim_base {
+    uint8_t *all_out;    /* per node: MCI_LABEL_IN or MCI_LABEL_OUT */
+    uint32_t *absorbing; /* per operation node: children whose all_out is absorbing */
+    /* per node: siblings of its path to the root whose all_out is their parent's
+     * absorbing value (an entry that would reject the node's primitive) */
+    uint32_t *path_bad;
+} mci_trim_base;
+
+bool mci_trim_base_init(const mci_ctx *ctx, const mci_ptree *t, mci_trim_base *base);
+void mci_trim_base_free(const mci_ctx *ctx, mci_trim_base *base);
+
+/* mci_csglist_trim for the labels OUT everywhere but UNKNOWN at the k distinct
+ * primitives unknown[] (`leaf` not among them), the trimming labels of the whole-face
+ * decision and the classification: the same entries in the same order, or the same
+ * rejection. Costs the unknown primitives' paths up to `leaf`'s (and a few arrays of
+ * node_count set), instead of every sibling of the path evaluated: with thousands of
+ * primitives in one flat difference, the whole tree per primitive. False when out of
+ * memory. */
+bool mci_csglist_trim_sparse(const mci_ctx *ctx, const mci_ptree *t, const mci_trim_base *base,
+                             uint32_t leaf, const uint32_t *unknown, size_t k,
+                             mci_csg_entry *list, size_t *count, bool *rejected);
+
 /* Blist (Hable and Rossignac; paper §5.4): a trimmed CSGlist compiled into a walk over
  * its undecided primitives. Each step reads one primitive's label and jumps to the next
  * step (or accepts, or rejects) on IN or OUT, so a region is decided after reading a few

@@ -30,6 +30,7 @@ typedef struct decide_job {
     const mci_ptree *t;
     const double (*box)[6]; /* per leaf */
     const uint32_t *overlap_start, *overlap; /* per leaf: the leaves whose boxes meet it */
+    const mci_trim_base *trim_base;
     size_t *dropped;        /* per leaf: faces flagged */
     uint8_t *copied;        /* per leaf: another leaf is a copy of it (NULL: none is) */
     mci_trimmed_list *keep; /* per leaf: where its trimmed list goes (NULL: nowhere) */
@@ -110,7 +111,11 @@ static bool trim_list(leaf_decision *d, bool *rejected)
         d->leaf_labels[l] = MCI_LABEL_OUT;
     for (uint32_t i = j->overlap_start[d->leaf]; i < j->overlap_start[d->leaf + 1]; i++)
         d->leaf_labels[j->overlap[i]] = MCI_LABEL_UNKNOWN;
-    d->nlist = mci_csglist_trim(t, d->leaf, d->leaf_labels, d->scratch, d->list, rejected);
+    if (!mci_csglist_trim_sparse(j->ctx, t, j->trim_base, d->leaf,
+                                 j->overlap + j->overlap_start[d->leaf],
+                                 j->overlap_start[d->leaf + 1] - j->overlap_start[d->leaf],
+                                 d->list, &d->nlist, rejected))
+        return false;
     if (*rejected)
         return true;
     if (!mci_blist_build(d->j->ctx, t, d->list, d->nlist, d->leaf_labels, &d->blist))
@@ -400,8 +405,9 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
     size_t n = s->octree.leaf_count;
     double (*box)[6] = mci_malloc_array(ctx, n + 1, sizeof *box);
     size_t *dropped = mci_calloc_array(ctx, n + 1, sizeof *dropped);
-    decide_job job = {ctx, s, t, (const double (*)[6])box, NULL, NULL, dropped, NULL, keep};
+    decide_job job = {ctx, s, t, (const double (*)[6])box, NULL, NULL, NULL, dropped, NULL, keep};
     uint32_t *overlap_start = NULL, *overlap = NULL;
+    mci_trim_base trim_base = {NULL, NULL, NULL};
     mcsg_status st = MCSG_OK;
     *count = 0;
     s->arr_dropped = mci_calloc_array(ctx, s->arr_count + 1, 1);
@@ -412,10 +418,12 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
         st = mci_fail_nomem(err, "deciding whole faces");
     for (size_t l = 0; st == MCSG_OK && l < n; l++)
         mci_leaf_box(s->octree.leaves[l], box[l]);
-    if (st == MCSG_OK && !mci_box_overlaps(ctx, job.box, n, &overlap_start, &overlap))
+    if (st == MCSG_OK && (!mci_box_overlaps(ctx, job.box, n, &overlap_start, &overlap) ||
+                          !mci_trim_base_init(ctx, t, &trim_base)))
         st = mci_fail_nomem(err, "deciding whole faces");
     job.overlap_start = overlap_start;
     job.overlap = overlap;
+    job.trim_base = &trim_base;
     if (st == MCSG_OK)
         st = mci_parallel_for(ctx, n, decide_leaf, &job, err);
     for (size_t l = 0; st == MCSG_OK && l < n; l++)
@@ -423,6 +431,7 @@ mcsg_status mci_decide_whole_faces(const mci_ctx *ctx, mci_scene *s, const mci_p
     mci_free(ctx, box);
     mci_free(ctx, overlap_start);
     mci_free(ctx, overlap);
+    mci_trim_base_free(ctx, &trim_base);
     mci_free(ctx, dropped);
     mci_free(ctx, job.copied);
     return st;

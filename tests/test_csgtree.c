@@ -249,6 +249,110 @@ TEST(blists_agree_with_csglists)
     for_random_trees(check_blists);
 }
 
+/* The sparse trimming must give mci_csglist_trim's answer: the same rejection, and when
+ * not rejected the same entries with the same desired labels in the same order, for the
+ * labels OUT everywhere but UNKNOWN at the given primitives. */
+static void check_sparse_trim(const mci_ptree *t, const mci_trim_base *base, uint32_t m,
+                              const uint32_t *unknown, size_t k, const mci_ctx *ctx)
+{
+    mci_csg_entry *want = malloc((t->node_count + 1) * sizeof *want);
+    mci_csg_entry *got = malloc((t->node_count + 1) * sizeof *got);
+    mci_label *labels = malloc((t->leaf_count + 1) * sizeof *labels);
+    mci_label *scratch = malloc((t->node_count + 1) * sizeof *scratch);
+    size_t n_want, n_got;
+    bool rej_want, rej_got;
+    for (uint32_t l = 0; l < t->leaf_count; l++)
+        labels[l] = MCI_LABEL_OUT;
+    for (size_t i = 0; i < k; i++)
+        labels[unknown[i]] = MCI_LABEL_UNKNOWN;
+    n_want = mci_csglist_trim(t, m, labels, scratch, want, &rej_want);
+    CHECK(mci_csglist_trim_sparse(ctx, t, base, m, unknown, k, got, &n_got, &rej_got));
+    CHECK_MSG(rej_want == rej_got, "primitive %u: rejected %d, sparse %d", m, rej_want, rej_got);
+    if (!rej_want && rej_want == rej_got) {
+        CHECK_MSG(n_want == n_got, "primitive %u: %zu entries, sparse %zu", m, n_want, n_got);
+        for (size_t i = 0; i < n_want && n_want == n_got; i++)
+            CHECK_MSG(want[i].node == got[i].node && want[i].desired == got[i].desired,
+                      "primitive %u entry %zu: node %u/%u desired %u/%u", m, i, want[i].node,
+                      got[i].node, want[i].desired, got[i].desired);
+    }
+    free(want);
+    free(got);
+    free(labels);
+    free(scratch);
+}
+
+/* Every primitive of the tree with random unknown sets (each other primitive unknown
+ * with probability `p` in 1/8ths). */
+static void check_sparse_trims(const mci_ptree *t, const mci_ctx *ctx, int p, int rounds)
+{
+    mci_trim_base base;
+    uint32_t *unknown = malloc((t->leaf_count + 1) * sizeof *unknown);
+    CHECK(mci_trim_base_init(ctx, t, &base));
+    for (uint32_t m = 0; m < t->leaf_count; m++)
+        for (int round = 0; round < rounds; round++) {
+            size_t k = 0;
+            for (uint32_t l = 0; l < t->leaf_count; l++)
+                if (l != m && test_random_int(&rng, 0, 7) < p)
+                    unknown[k++] = l;
+            check_sparse_trim(t, &base, m, unknown, k, ctx);
+        }
+    mci_trim_base_free(ctx, &base);
+    free(unknown);
+}
+
+static void check_sparse_trims_random(const random_tree *r, const mci_ptree *t,
+                                      const mci_ctx *ctx)
+{
+    (void)r;
+    check_sparse_trims(t, ctx, test_random_int(&rng, 0, 8), 4);
+}
+
+TEST(sparse_trimming_agrees_with_trimming)
+{
+    for_random_trees(check_sparse_trims_random);
+}
+
+/* A plate minus 300 holes, some holes a union of two (so that unions sit under the
+ * difference), then unioned with bars: a flat tree like a CAD part's, where the sparse
+ * trimming skips the unknown-free siblings by their counts. */
+TEST(sparse_trimming_on_flat_trees)
+{
+    mcsg_mesh cube;
+    double size[3] = {1, 1, 1};
+    mcsg_error err;
+    mcsg_tree *tree;
+    mcsg_node_id ops[302], bars[4], pair[2];
+    size_t nops = 0;
+    mci_ptree t;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mcsg_make_cube(size, 0, NULL, &cube, &err), &err);
+    CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, &cube, NULL, NULL, &ops[nops++], &err), &err);
+    for (int i = 0; i < 300; i++) {
+        CHECK_OK(mcsg_tree_add_leaf(tree, &cube, NULL, NULL, &pair[0], &err), &err);
+        if (i % 10 == 3) {
+            CHECK_OK(mcsg_tree_add_leaf(tree, &cube, NULL, NULL, &pair[1], &err), &err);
+            CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, pair, 2, NULL, &pair[0], &err),
+                     &err);
+        }
+        ops[nops++] = pair[0];
+    }
+    CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_DIFFERENCE, ops, nops, NULL, &bars[0], &err),
+             &err);
+    for (int i = 1; i < 4; i++)
+        CHECK_OK(mcsg_tree_add_leaf(tree, &cube, NULL, NULL, &bars[i], &err), &err);
+    CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, bars, 4, NULL, &pair[0], &err), &err);
+    CHECK_OK(mcsg_tree_set_root(tree, pair[0], &err), &err);
+    CHECK_OK(mci_ptree_build(&ctx, tree, &t, &err), &err);
+    CHECK_EQ_SIZE(t.leaf_count, 334);
+    for (int p = 0; p <= 2; p++)
+        check_sparse_trims(&t, &ctx, p, 3);
+    mci_ptree_free(&ctx, &t);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&cube, NULL);
+}
+
 TEST(difference_becomes_intersection_with_complements)
 {
     mcsg_mesh cube;
@@ -311,6 +415,8 @@ int main(void)
     RUN(label_rules);
     RUN(csglists_keep_exactly_the_result_faces);
     RUN(blists_agree_with_csglists);
+    RUN(sparse_trimming_agrees_with_trimming);
+    RUN(sparse_trimming_on_flat_trees);
     RUN(difference_becomes_intersection_with_complements);
     RUN(deep_trees_build);
     return test_summary();
