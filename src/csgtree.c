@@ -286,6 +286,12 @@ static mci_label absorbing_value(const mci_pnode *p)
     return p->kind == MCI_PNODE_UNION ? MCI_LABEL_IN : MCI_LABEL_OUT;
 }
 
+/* The value of an operation none of whose children has the absorbing value. */
+static mci_label neutral_value(const mci_pnode *p)
+{
+    return p->kind == MCI_PNODE_UNION ? MCI_LABEL_OUT : MCI_LABEL_IN;
+}
+
 static bool is_operation(const mci_pnode *p)
 {
     return p->kind == MCI_PNODE_UNION || p->kind == MCI_PNODE_INTERSECTION;
@@ -310,9 +316,7 @@ bool mci_trim_base_init(const mci_ctx *ctx, const mci_ptree *t, mci_trim_base *b
         else {
             for (uint32_t c = 0; c < p->count; c++)
                 base->absorbing[i] += base->all_out[t->child[p->first + c]] == absorbing_value(p);
-            v = base->absorbing[i] > 0 ? absorbing_value(p)
-                                       : absorbing_value(p) == MCI_LABEL_IN ? MCI_LABEL_OUT
-                                                                            : MCI_LABEL_IN;
+            v = base->absorbing[i] > 0 ? absorbing_value(p) : neutral_value(p);
         }
         base->all_out[i] = (uint8_t)v;
     }
@@ -398,9 +402,9 @@ static void evaluate_marked(sparse_trim *st)
         const mci_pnode *p = &t->nodes[x];
         mci_label v = MCI_LABEL_UNKNOWN;
         if (is_operation(p))
-            v = st->absorbing[x] > 0 ? absorbing_value(p)
+            v = st->absorbing[x] > 0   ? absorbing_value(p)
                 : st->unknowns[x] > 0 ? MCI_LABEL_UNKNOWN
-                : absorbing_value(p) == MCI_LABEL_IN ? MCI_LABEL_OUT : MCI_LABEL_IN;
+                                      : neutral_value(p);
         st->value[x] = (uint8_t)v;
         if (on_path(st, parent))
             continue;
@@ -429,15 +433,15 @@ static bool entries_from_branches(sparse_trim *st, mci_csg_entry *list, size_t *
         return false;
     for (size_t i = 0; i < st->nbranches; i++) {
         uint32_t a = (uint32_t)(st->branches[i] >> 32), s = (uint32_t)st->branches[i];
-        mci_label absorbing = absorbing_value(&t->nodes[a]);
-        /* the path's child of a: the one child of a whose range holds the primitive */
+        /* s comes after the path's child of a (the child whose range holds the
+         * primitive) exactly when s is numbered after the primitive */
         bool after = s > st->path_node;
-        if (st->value[s] == absorbing)
+        if (st->value[s] == absorbing_value(&t->nodes[a]))
             return false;
         if (st->value[s] == MCI_LABEL_UNKNOWN) {
-            uint8_t base = MCI_LABEL_BIT(absorbing == MCI_LABEL_IN ? MCI_LABEL_OUT : MCI_LABEL_IN);
             list[*n].node = s;
-            list[(*n)++].desired = (uint8_t)(base | (after ? MCI_LABEL_BIT(MCI_LABEL_SAME) : 0));
+            list[(*n)++].desired = (uint8_t)(MCI_LABEL_BIT(neutral_value(&t->nodes[a])) |
+                                             (after ? MCI_LABEL_BIT(MCI_LABEL_SAME) : 0));
         }
     }
     return true;

@@ -45,7 +45,7 @@ typedef struct leaf_decision {
     size_t nfaces;
     mci_csg_entry *list;
     size_t nlist;
-    mci_label *leaf_labels, *scratch;
+    mci_label *leaf_labels;
     mci_blist blist;         /* each step reads one leaf, no two the same leaf */
     uint32_t *reached, sweep; /* per step: the last sweep (face) that reached it */
     double (*face_box)[6];   /* per touched face */
@@ -88,7 +88,7 @@ static bool outside_box(const double *x, const double box[6])
 static void free_decision(leaf_decision *d)
 {
     const mci_ctx *ctx = d->j->ctx;
-    void *all[] = {d->faces, d->list, d->leaf_labels, d->scratch, d->reached, d->face_box,
+    void *all[] = {d->faces, d->list, d->leaf_labels, d->reached, d->face_box,
                    d->vf_start, d->vf_face, d->seen, d->memo, d->queue};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(ctx, all[i]);
@@ -102,10 +102,9 @@ static bool trim_list(leaf_decision *d, bool *rejected)
 {
     const mci_ptree *t = d->j->t;
     const decide_job *j = d->j;
-    d->list = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->list);
-    d->scratch = mci_malloc_array(d->j->ctx, t->node_count + 1, sizeof *d->scratch);
-    d->leaf_labels = mci_malloc_array(d->j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
-    if (!d->list || !d->scratch || !d->leaf_labels)
+    d->list = mci_malloc_array(j->ctx, t->node_count + 1, sizeof *d->list);
+    d->leaf_labels = mci_malloc_array(j->ctx, t->leaf_count + 1, sizeof *d->leaf_labels);
+    if (!d->list || !d->leaf_labels)
         return false;
     for (uint32_t l = 0; l < t->leaf_count; l++)
         d->leaf_labels[l] = MCI_LABEL_OUT;
@@ -118,9 +117,9 @@ static bool trim_list(leaf_decision *d, bool *rejected)
         return false;
     if (*rejected)
         return true;
-    if (!mci_blist_build(d->j->ctx, t, d->list, d->nlist, d->leaf_labels, &d->blist))
+    if (!mci_blist_build(j->ctx, t, d->list, d->nlist, d->leaf_labels, &d->blist))
         return false;
-    d->reached = mci_calloc_array(d->j->ctx, d->blist.count + 1, sizeof *d->reached);
+    d->reached = mci_calloc_array(j->ctx, d->blist.count + 1, sizeof *d->reached);
     return d->reached != NULL;
 }
 
