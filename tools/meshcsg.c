@@ -1,19 +1,14 @@
 /*
- * meshcsg command-line tool: a thin client of the public API (include/meshcsg.h).
- *
- *   meshcsg check [--self-intersections] [-o FIXED] FILE...
- *                                        validate meshes (or every leaf of a .scad file)
- *   meshcsg tree FILE.scad               print the parsed CSG tree
- *   meshcsg convert IN OUT [--format F]  convert between mesh formats
- *   meshcsg intersect FILE.scad [-o C]   intersection curves of all leaves, as OBJ lines
- *   meshcsg eval FILE.scad [-o OUT]      evaluate the CSG tree exactly, write the result
- *   meshcsg demo [-n N] [-o OUT]         evaluate the built-in ring scene, print timings
+ * meshcsg command-line tool: a thin client of the public API (include/meshcsg.h). The
+ * commands and their options are the tables at the end of this file (`commands`), which
+ * `meshcsg --help` and `meshcsg CMD --help` print; tools/cli_options.c parses them.
  *
  * Exit status: 0 on success (check: every mesh valid), 1 when a check finds a problem
  * or an operation fails, 2 on a usage error.
  */
 #define _POSIX_C_SOURCE 200809L
 
+#include "cli_options.h"
 #include "meshcsg.h"
 #include "scenes.h"
 
@@ -30,8 +25,9 @@
 #include <malloc.h>
 #endif
 
-#define EXIT_PROBLEM 1
-#define EXIT_USAGE 2
+#define EXIT_PROBLEM CLI_EXIT_PROBLEM
+#define EXIT_USAGE CLI_EXIT_USAGE
+#define DEMO_SPHERES 200
 
 static void log_to_stderr(void *user, mcsg_log_level level, const char *message)
 {
@@ -227,37 +223,19 @@ static int check_mesh_file(const char *path, const char *fixed_out, const mcsg_o
     return valid;
 }
 
-static int cmd_check(int argc, char **argv)
+static int cmd_check(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
-    const char *fixed_out = NULL;
-    int files = 0, all_valid = 1, self = 0;
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
-            fixed_out = argv[++i];
-            continue;
-        }
-        if (strcmp(argv[i], "--self-intersections") == 0) {
-            self = 1;
-            continue;
-        }
-        files++;
-    }
-    if (files == 0 || (fixed_out && files != 1)) {
-        fprintf(stderr, "usage: meshcsg check [--self-intersections] [-o FIXED] FILE...  "
-                "(-o takes one input)\n");
+    int all_valid = 1;
+    if (v->output && argc != 1) {
+        fprintf(stderr, "meshcsg check: -o writes one fixed mesh: give exactly one FILE "
+                "(see meshcsg check --help)\n");
         return EXIT_USAGE;
     }
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "-o") == 0) {
-            i++;
-            continue;
-        }
-        if (strcmp(argv[i], "--self-intersections") == 0)
-            continue;
-        all_valid &= is_csg_file(argv[i]) ? check_csg_file(argv[i], &opts, self)
-                                          : check_mesh_file(argv[i], fixed_out, &opts, self);
-    }
+    for (int i = 0; i < argc; i++)
+        all_valid &= is_csg_file(argv[i])
+                         ? check_csg_file(argv[i], &opts, v->self_intersections)
+                         : check_mesh_file(argv[i], v->output, &opts, v->self_intersections);
     return all_valid ? 0 : EXIT_PROBLEM;
 }
 
@@ -319,16 +297,13 @@ static int print_tree(const mcsg_tree *tree, tree_stats *stats)
     return 1;
 }
 
-static int cmd_tree(int argc, char **argv)
+static int cmd_tree(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     tree_stats stats = {0, 0, SIZE_MAX, 0, 0};
     mcsg_tree *tree;
     mcsg_error err;
-    if (argc != 1) {
-        fprintf(stderr, "usage: meshcsg tree FILE.scad\n");
-        return EXIT_USAGE;
-    }
+    (void)v, (void)argc;
     if (mcsg_scad_read(argv[0], &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
         return EXIT_PROBLEM;
@@ -374,29 +349,17 @@ static int parse_format(const char *name, mcsg_format *out)
     return 0;
 }
 
-static int cmd_convert(int argc, char **argv)
+static int cmd_convert(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
     mcsg_format format = MCSG_FORMAT_AUTO;
-    const char *paths[2];
-    int npaths = 0;
+    const char *paths[2] = {argv[0], argv[1]};
     mcsg_mesh mesh;
     mcsg_error err;
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "--format") == 0 && i + 1 < argc) {
-            if (!parse_format(argv[++i], &format)) {
-                fprintf(stderr, "meshcsg: unknown format '%s' (off, obj, stl, stl-ascii, "
-                        "stl-binary, ply, ply-ascii, ply-binary, ply-binary-be)\n", argv[i]);
-                return EXIT_USAGE;
-            }
-        } else if (npaths < 2) {
-            paths[npaths++] = argv[i];
-        } else {
-            npaths = 3;
-        }
-    }
-    if (npaths != 2) {
-        fprintf(stderr, "usage: meshcsg convert IN OUT [--format FORMAT]\n");
+    (void)argc;
+    if (v->format && !parse_format(v->format, &format)) {
+        fprintf(stderr, "meshcsg convert: unknown format '%s' (off, obj, stl, stl-ascii, "
+                "stl-binary, ply, ply-ascii, ply-binary, ply-binary-be)\n", v->format);
         return EXIT_USAGE;
     }
     if (format == MCSG_FORMAT_AUTO && mcsg_format_from_path(paths[1]) == MCSG_FORMAT_AUTO) {
@@ -469,25 +432,16 @@ static void print_intersect_stats(const mcsg_intersect_stats *s, const mcsg_curv
            s->seconds_arrange, s->seconds_merge);
 }
 
-static int cmd_intersect(int argc, char **argv)
+static int cmd_intersect(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
-    const char *in = NULL, *out = NULL;
+    const char *in = argv[0], *out = v->output;
     mcsg_tree *tree;
     mcsg_curves curves;
     mcsg_intersect_stats stats;
     mcsg_error err;
     int ok;
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc)
-            out = argv[++i];
-        else
-            in = in ? NULL : argv[i];
-    }
-    if (!in) {
-        fprintf(stderr, "usage: meshcsg intersect FILE.scad [-o CURVES.obj]\n");
-        return EXIT_USAGE;
-    }
+    (void)argc;
     if (mcsg_scad_read(in, &opts, &tree, &err) != MCSG_OK) {
         fail_line(&err);
         return EXIT_PROBLEM;
@@ -683,35 +637,20 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
     return ok ? 0 : EXIT_PROBLEM;
 }
 
-static int cmd_eval(int argc, char **argv)
+static int cmd_eval(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
-    const char *in = NULL, *out = NULL;
-    int show_stats = 0, code;
+    int code;
     mcsg_pool *pool = NULL;
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "-o") == 0 && i + 1 < argc)
-            out = argv[++i];
-        else if (strcmp(argv[i], "--stats") == 0)
-            show_stats = 1;
-        else if (strcmp(argv[i], "--check-inputs") == 0)
-            opts.check_self_intersections = 1;
-        else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc && atoi(argv[i + 1]) > 0)
-            opts.threads = atoi(argv[++i]);
-        else
-            in = in || argv[i][0] == '-' ? NULL : argv[i];
-    }
-    if (!in) {
-        fprintf(stderr, "usage: meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N] "
-                "[--check-inputs]\n");
-        return EXIT_USAGE;
-    }
+    (void)argc;
+    opts.threads = (int)v->threads;
+    opts.check_self_intersections = v->check_inputs;
     /* One set of workers for reading, evaluating and writing: each call would start its
      * own, and a new thread took up to milliseconds to get going. Without the pool (no
      * threads to spare) every call runs as before. */
     if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK)
         opts.pool = pool;
-    code = eval_file(&opts, in, out, show_stats);
+    code = eval_file(&opts, argv[0], v->output, v->stats);
     mcsg_pool_free(pool);
     return code;
 }
@@ -740,26 +679,6 @@ static int demo_check_leaves(const mcsg_tree *tree, const mcsg_options *opts,
     return valid;
 }
 
-/* The reference volume of ring_spheres_N from $MCSG_SHARED_DIR/scenes/reference.tsv or
- * ../shared/scenes/reference.tsv, if there (0 otherwise). */
-static double reference_volume(int spheres)
-{
-    char want[64], name[128], path[4096], line[512];
-    double faces, volume, found = 0;
-    const char *shared = getenv("MCSG_SHARED_DIR");
-    FILE *f;
-    snprintf(path, sizeof path, "%s/scenes/reference.tsv", shared ? shared : "../shared");
-    if (!(f = fopen(path, "r")))
-        return 0;
-    snprintf(want, sizeof want, "ring_spheres_%d", spheres);
-    while (fgets(line, sizeof line, f))
-        if (sscanf(line, "%127s %lf %lf", name, &faces, &volume) == 3 &&
-            strcmp(name, want) == 0)
-            found = volume;
-    fclose(f);
-    return found;
-}
-
 static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const char *out,
                          int spheres)
 {
@@ -767,7 +686,7 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
     mcsg_eval_stats st;
     mcsg_check_report rep;
     mcsg_error err;
-    double ref = reference_volume(spheres);
+    double ref = scene_ring_spheres_reference_volume(spheres);
     int ok;
     mcsg_options with_progress = *opts;
     mcsg_status status;
@@ -786,7 +705,7 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
            result.vertex_count, result.triangle_count, rep.components, rep.volume,
            ok ? "closed, oriented, manifold" : "INVALID");
     if (ref > 0)
-        printf("reference volume %.15g (../shared/scenes/reference.tsv): %s\n", ref,
+        printf("reference volume %.15g (the scene generator's exact reference): %s\n", ref,
                fabs(rep.volume - ref) <= 1e-10 * ref ? "matches" : "DIFFERS");
     if (out && mcsg_mesh_write(out, MCSG_FORMAT_AUTO, &result, opts, &err) != MCSG_OK) {
         fail_line(&err);
@@ -798,26 +717,18 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
     return ok;
 }
 
-static int cmd_demo(int argc, char **argv)
+static int cmd_demo(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
-    int spheres = 200, valid;
+    int spheres = v->spheres ? (int)v->spheres : DEMO_SPHERES, valid;
     size_t faces = 0;
-    const char *out = NULL;
+    const char *out = v->output;
     mcsg_tree *tree;
     mcsg_pool *pool = NULL;
     mcsg_error err;
     double t0, t1, t2;
-    for (int i = 0; i < argc; i++) {
-        if (strcmp(argv[i], "-n") == 0 && i + 1 < argc && atoi(argv[i + 1]) > 0) {
-            spheres = atoi(argv[++i]);
-        } else if (strcmp(argv[i], "-o") == 0 && i + 1 < argc) {
-            out = argv[++i];
-        } else {
-            fprintf(stderr, "usage: meshcsg demo [-n SPHERES] [-o OUT]\n");
-            return EXIT_USAGE;
-        }
-    }
+    (void)argc, (void)argv;
+    opts.threads = (int)v->threads;
     if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK) /* shared by the calls below */
         opts.pool = pool;
     t0 = now_seconds();
@@ -844,29 +755,6 @@ static int cmd_demo(int argc, char **argv)
 
 /* ---------------------------------------------------------------------------------- */
 
-static void usage(FILE *out)
-{
-    fprintf(out,
-            "meshcsg %d.%d.%d - exact CSG on closed triangle meshes\n"
-            "usage:\n"
-            "  meshcsg check [--self-intersections] [-o FIXED] FILE...\n"
-            "                                      validate meshes (.off .obj .stl .ply) or\n"
-            "                                      every leaf of a CSG file (.scad .csg);\n"
-            "                                      -o writes the (re-oriented) mesh;\n"
-            "                                      --self-intersections: exact test too\n"
-            "  meshcsg tree FILE.scad              print the parsed CSG tree\n"
-            "  meshcsg convert IN OUT [--format F] convert between mesh formats\n"
-            "  meshcsg intersect FILE.scad [-o C.obj] intersection curves of the leaves\n"
-            "  meshcsg eval FILE.scad [-o OUT] [--stats] [--threads N] [--check-inputs]\n"
-            "                                      evaluate the CSG tree, write the result;\n"
-            "                                      --check-inputs: first test every leaf\n"
-            "                                      for self-intersections (exact)\n"
-            "  meshcsg demo [-n SPHERES] [-o OUT]  evaluate the built-in scene (the paper's\n"
-            "                                      ring with 200 spheres), print timings\n"
-            "exit status: 0 ok, 1 a problem was found or an operation failed, 2 usage error\n",
-            MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
-}
-
 /* A run allocates and frees arrays of tens to hundreds of megabytes, step after step.
  * glibc hands blocks over 32 MiB straight back to the kernel and trims the heap's top:
  * the next step then faults the same amount in again, zeroed by the kernel (a fifth of
@@ -881,35 +769,109 @@ static void keep_freed_memory(void)
 #endif
 }
 
+/* ---------------------------------------------------------------------------------- */
+/* Commands and options: the one source of the usage text                             */
+
+#define VALUE(field) offsetof(cli_values, field)
+#define OUTPUT(help) {"output", 'o', CLI_STRING, "FILE", 0, 0, VALUE(output), help}
+#define THREADS                                                                           \
+    {"threads", 't', CLI_NUMBER, "N", 1, 1024, VALUE(threads),                           \
+     "worker threads, 1 to 1024; the output is the same for any number (default: one "   \
+     "per processor)"}
+#define END_OF_OPTIONS {NULL, 0, CLI_FLAG, NULL, 0, 0, 0, NULL}
+
+static const cli_option check_options[] = {
+    {"self-intersections", 0, CLI_FLAG, NULL, 0, 0, VALUE(self_intersections),
+     "also test exactly whether triangles cross each other (off by default)"},
+    OUTPUT("write the mesh, flipped if it was inside out, to FILE (one input only; "
+           "default: none)"),
+    END_OF_OPTIONS};
+static const cli_option no_options[] = {END_OF_OPTIONS};
+static const cli_option convert_options[] = {
+    {"format", 'f', CLI_STRING, "F", 0, 0, VALUE(format),
+     "output format: off, obj, stl (binary), stl-ascii, stl-binary, ply (binary, little "
+     "endian), ply-ascii, ply-binary, ply-binary-be (default: from OUT's extension)"},
+    END_OF_OPTIONS};
+static const cli_option intersect_options[] = {
+    OUTPUT("write the curves as OBJ points and lines to FILE (default: none)"),
+    END_OF_OPTIONS};
+static const cli_option eval_options[] = {
+    OUTPUT("write the result to FILE, format from its extension: .off .obj .stl .ply "
+           "(default: none, only counts are printed)"),
+    {"stats", 0, CLI_FLAG, NULL, 0, 0, VALUE(stats),
+     "print the paper's Table 1 columns: faces, primitives, time per step, peak memory"},
+    THREADS,
+    {"check-inputs", 0, CLI_FLAG, NULL, 0, 0, VALUE(check_inputs),
+     "first test every leaf for self-intersections, exactly (about the cost of an "
+     "evaluation; off by default)"},
+    END_OF_OPTIONS};
+static const cli_option demo_options[] = {
+    {"spheres", 'n', CLI_NUMBER, "N", 1, 10000, VALUE(spheres),
+     "spheres on the ring, 1 to 10000 (default: 200)"},
+    OUTPUT("write the result to FILE (default: none)"),
+    THREADS,
+    END_OF_OPTIONS};
+
+static const cli_command commands[] = {
+    {"check", "FILE...", "validate meshes (.off .obj .stl .ply) or every leaf of a CSG file "
+     "(.scad .csg)",
+     "Prints one line per file when the mesh is a closed, consistently oriented,\n"
+     "edge-manifold mesh, and one line per kind of problem otherwise.",
+     check_options, 1, -1, cmd_check},
+    {"tree", "FILE", "print the parsed CSG tree: operations, leaves, face counts", NULL,
+     no_options, 1, 1, cmd_tree},
+    {"convert", "IN OUT", "convert a mesh between formats", NULL, convert_options, 2, 2,
+     cmd_convert},
+    {"intersect", "FILE", "intersection curves between the leaves of a CSG file: counts, "
+     "per-step times", NULL, intersect_options, 1, 1, cmd_intersect},
+    {"eval", "FILE", "evaluate a CSG file (.scad .csg) exactly and write the result",
+     "Every leaf must be closed, oriented and manifold (checked, with a message naming\n"
+     "the leaf).",
+     eval_options, 1, 1, cmd_eval},
+    {"demo", "", "evaluate the built-in scene (the paper's ring with spheres), print the "
+     "step timings and compare with the reference volume", NULL, demo_options, 0, 0,
+     cmd_demo},
+};
+#define COMMAND_COUNT (sizeof commands / sizeof commands[0])
+
+static void print_version(void)
+{
+    printf("meshcsg %d.%d.%d\n", MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
+}
+
+static const char *version_text(void)
+{
+    static char text[32];
+    snprintf(text, sizeof text, "%d.%d.%d", MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR,
+             MCSG_VERSION_PATCH);
+    return text;
+}
+
 int main(int argc, char **argv)
 {
+    cli_values values;
     keep_freed_memory();
     if (argc < 2) {
-        usage(stderr);
+        cli_print_help(stderr, version_text(), commands, COMMAND_COUNT);
         return EXIT_USAGE;
     }
-    if (strcmp(argv[1], "check") == 0)
-        return cmd_check(argc - 2, argv + 2);
-    if (strcmp(argv[1], "tree") == 0)
-        return cmd_tree(argc - 2, argv + 2);
-    if (strcmp(argv[1], "convert") == 0)
-        return cmd_convert(argc - 2, argv + 2);
-    if (strcmp(argv[1], "demo") == 0)
-        return cmd_demo(argc - 2, argv + 2);
-    if (strcmp(argv[1], "intersect") == 0)
-        return cmd_intersect(argc - 2, argv + 2);
-    if (strcmp(argv[1], "eval") == 0)
-        return cmd_eval(argc - 2, argv + 2);
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-        usage(stdout);
+        cli_print_help(stdout, version_text(), commands, COMMAND_COUNT);
         return 0;
     }
     if (strcmp(argv[1], "--version") == 0) {
-        printf("meshcsg %d.%d.%d\n", MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR,
-               MCSG_VERSION_PATCH);
+        print_version();
         return 0;
     }
-    fprintf(stderr, "meshcsg: unknown command '%s'\n", argv[1]);
-    usage(stderr);
+    for (size_t i = 0; i < COMMAND_COUNT; i++) {
+        int operands;
+        if (strcmp(argv[1], commands[i].name) != 0)
+            continue;
+        operands = cli_parse(&commands[i], argc - 2, argv + 2, &values);
+        if (operands < 0)
+            return operands == -2 ? 0 : EXIT_USAGE;
+        return commands[i].run(&values, operands, argv + 2);
+    }
+    fprintf(stderr, "meshcsg: unknown command '%s' (see meshcsg --help)\n", argv[1]);
     return EXIT_USAGE;
 }

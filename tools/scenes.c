@@ -244,3 +244,16 @@ mcsg_status scene_ring_spheres(int n, unsigned seed, const mcsg_options *opts,
     *out = tree;
     return MCSG_OK;
 }
+
+double scene_ring_spheres_reference_volume(int n)
+{
+    static const struct {
+        int spheres;
+        double volume;
+    } known[] = {{100, 1218.25668328392}, {200, 1228.83061615465},
+                 {400, 1268.90811032719}, {800, 1267.12846189024}};
+    for (size_t i = 0; i < sizeof known / sizeof known[0]; i++)
+        if (known[i].spheres == n)
+            return known[i].volume;
+    return 0;
+}

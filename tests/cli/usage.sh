@@ -1,0 +1,67 @@
+# The option parser: `meshcsg --help` and `meshcsg CMD --help` list every command and
+# option (with defaults); unknown options, missing or malformed values and numbers out of
+# range are usage errors (exit 2, one line naming the option, nothing else done).
+. "$(dirname "$0")/common.bash"
+
+run 0 --help
+for cmd in check tree convert intersect eval demo; do contains "  $cmd "; done
+contains "--version"
+run 0 --version
+contains "meshcsg "
+run 2
+contains "usage: meshcsg COMMAND"
+run 2 nosuchcommand
+contains "unknown command 'nosuchcommand'"
+
+# help CMD OPTION... : CMD --help (and -h) exits 0 and lists every OPTION.
+help() {
+  local cmd=$1 opt; shift
+  run 0 "$cmd" -h
+  run 0 "$cmd" --help || return
+  contains "usage: meshcsg $cmd [OPTIONS]"
+  for opt in "$@" --help; do contains "$opt"; done
+}
+help check --self-intersections "-o, --output FILE"
+help tree
+help convert "-f, --format F" "ply-binary-be" "default: from OUT's"
+help intersect "-o, --output FILE"
+help eval "-o, --output FILE" --stats "-t, --threads N" --check-inputs "default: one per"
+help demo "-n, --spheres N" "default: 200" "-o, --output FILE" "-t, --threads N"
+# --help wins over operands and other options: nothing is read.
+run 0 tree "$WORK/missing.scad" --help
+lacks "cannot open"
+
+# usage_error MESSAGE ARGS... : exit 2 and exactly one line containing MESSAGE.
+usage_error() {
+  local message=$1; shift
+  run 2 "$@" || return
+  contains "$message"
+  [ "$(printf '%s\n' "$OUT" | wc -l)" -eq 1 ] && passed=$((passed + 1)) ||
+    { echo "FAIL: more than one line: $OUT"; failed=$((failed + 1)); }
+}
+printf 'cube(1);\n' > "$WORK/c.scad"
+usage_error "unknown option: --bogus" check --bogus "$WORK/c.scad"
+usage_error "unknown option: -x" eval -x "$WORK/c.scad"
+usage_error "--threads takes a whole number from 1 to 1024: abc" eval "$WORK/c.scad" --threads abc
+usage_error "--threads takes a whole number from 1 to 1024: 0" eval "$WORK/c.scad" --threads 0
+usage_error "--threads takes a whole number from 1 to 1024: 2x" eval "$WORK/c.scad" --threads=2x
+usage_error "-t takes a whole number from 1 to 1024: 99999999999999999999" eval "$WORK/c.scad" -t 99999999999999999999
+usage_error "--threads needs a value" eval "$WORK/c.scad" --threads
+usage_error "-n takes a whole number from 1 to 10000: -3" demo -n -3
+usage_error "--stats takes no value" eval "$WORK/c.scad" --stats=1
+usage_error "missing operand" eval
+usage_error "too many operands" eval "$WORK/c.scad" "$WORK/c.scad"
+usage_error "too many operands" tree a b
+usage_error "missing operand" convert "$WORK/c.scad"
+usage_error "unknown format 'nope'" convert "$MODELS/cube.obj" "$WORK/x.off" --format nope
+usage_error "-o writes one fixed mesh" check -o "$WORK/x.off" "$MODELS/cube.obj" "$MODELS/cube.obj"
+
+# The accepted spellings: --name=value, -xVALUE, and -- before an operand that starts
+# with '-'.
+run 0 eval "$WORK/c.scad" --threads=2 -o"$WORK/c1.off"
+contains "8 vertices, 12 triangles"
+[ -s "$WORK/c1.off" ] && passed=$((passed + 1)) || { echo "FAIL: -oFILE wrote nothing"; failed=$((failed + 1)); }
+cp "$WORK/c.scad" "$WORK/-dash.scad"
+(cd "$WORK" && "$CLI" eval -t 1 -- -dash.scad >/dev/null 2>&1) && passed=$((passed + 1)) ||
+  { echo "FAIL: -- did not end the options"; failed=$((failed + 1)); }
+finish
