@@ -65,7 +65,7 @@ fuzz:
 fuzz-csg: deps
 	CC=gcc cmake -S . -B $(BUILD)/test -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_FLAGS) >/dev/null
 	cmake --build $(BUILD)/test -j $(JOBS) --target fuzz_csg
-	MCSG_SHARED_DIR="$$(cd .. && pwd)/shared" ./$(BUILD)/test/tests/fuzz_csg $(SECONDS)
+	MCSG_TEST_DATA="$$(pwd)/tests/data" ./$(BUILD)/test/tests/fuzz_csg $(SECONDS)
 
 clean:
 	rm -rf $(BUILD)

@@ -93,8 +93,8 @@ typedef struct model {
 } model;
 
 static model models[] = {{"cube.obj", {0}, {0}, 0},
-                         {"sphere1.obj", {0}, {0}, 0},
-                         {"cow.obj", {0}, {0}, 0}};
+                         {"sphere.obj", {0}, {0}, 0},
+                         {"spot.obj", {0}, {0}, 0}};
 #define MODEL_COUNT ((int)(sizeof models / sizeof models[0]))
 static bool models_loaded;
 
@@ -102,7 +102,7 @@ static bool load_model(model *md)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     mcsg_error err;
-    if (mcsg_mesh_read(test_shared_model(md->name), MCSG_FORMAT_AUTO, NULL, &md->mesh,
+    if (mcsg_mesh_read(test_model(md->name), MCSG_FORMAT_AUTO, NULL, &md->mesh,
                        &err) != MCSG_OK)
         return false;
     if (md->mesh.vertex_count == 0) {

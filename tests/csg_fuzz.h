@@ -68,8 +68,8 @@ typedef struct csg_result {
  * rounding to doubles may create them). */
 extern bool csg_self_check;
 
-/* Loads the shared models used by free trees (cube.obj, sphere1.obj, cow.obj); false if
- * one cannot be read (free trees then use primitives only). */
+/* Loads the models used by free trees (tests/data/models: cube.obj, sphere.obj,
+ * spot.obj); false if one cannot be read (free trees then use primitives only). */
 bool csg_load_models(void);
 void csg_free_models(void);
 const char *csg_model_name(int index);
@@ -98,7 +98,7 @@ void csg_shrink(csg_tree_spec *t, bool with_provenance, double budget);
 
 /* The case as a CSG file. The first line is a comment that csg_read_header parses:
  * "// fuzz-csg: seed 0x... family F touching T provenance P". Models are imported by
- * file name: parse with import paths relative to the shared models folder. */
+ * file name: parse with import paths relative to tests/data/models. */
 void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance);
 /* Parses that first line; false if it is not there. */
 bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance);

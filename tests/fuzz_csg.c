@@ -9,7 +9,8 @@
  *
  * usage: fuzz_csg SECONDS [DIR [FIRST_SEED]]; exit status 1 if anything failed.
  *        fuzz_csg print SEED   prints the tree of one seed as a CSG file (imports relative
- *                              to the shared models folder).
+ *                              to tests/data/models).
+ * The models are found through MCSG_TEST_DATA (tests/data), as under CTest.
  */
 #include "csg_fuzz.h"
 #include "testlib.h"
@@ -56,7 +57,8 @@ int main(int argc, char **argv)
     }
     long trees = 0, failures = 0, leaves = 0, self_intersecting[3] = {0}, families[3] = {0};
     if (!csg_load_models())
-        fprintf(stderr, "fuzz_csg: shared models missing: free trees use primitives only\n");
+        fprintf(stderr, "fuzz_csg: models of tests/data/models missing (set MCSG_TEST_DATA to tests/data): "
+                "free trees use primitives only\n");
     csg_self_check = true;
     printf("fuzz_csg: %.0f s from seed number %" PRIu64 ", failures saved in %s\n", seconds,
            first, dir);

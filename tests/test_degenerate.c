@@ -226,10 +226,10 @@ TEST(models_minus_nearly_identical_copies)
     static const char *const moves[] = {
         "rotate(a=5.729577951308232e-6, v=[1,2,3])", "translate([1e-16, 2e-16, -1e-16])"};
     char model[4300], moved[4500], diff[9000], inter[9000];
-    const char *names[] = {"cow.obj", "bunny.obj"};
+    const char *names[] = {"spot.obj", "sphere.obj"};
     for (int m = 0; m < 2; m++) {
         double va, vd, vi;
-        snprintf(model, sizeof model, "import(\"%s\");", test_shared_model(names[m]));
+        snprintf(model, sizeof model, "import(\"%s\");", test_model(names[m]));
         snprintf(moved, sizeof moved, "%s %s", moves[m], model);
         snprintf(diff, sizeof diff, "difference() { %s %s }", model, moved);
         snprintf(inter, sizeof inter, "intersection() { %s %s }", model, moved);

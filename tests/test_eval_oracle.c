@@ -8,8 +8,8 @@
  *   minutes; MCSG_ORACLE_VERBOSE=1 prints a line per tree). Up to three failures are
  *   shrunk for 5 s each and printed as CSG files.
  * - saved_regressions: every .scad file in tests/data/csg-regressions (written by `make
- *   fuzz-csg` when it finds a failure, or by hand), parsed with imports relative to the
- *   shared models and checked the same way, with the flags of its first line.
+ *   fuzz-csg` when it finds a failure, or by hand), parsed with imports relative to
+ *   tests/data/models and checked the same way, with the flags of its first line.
  * - oracle_notices_a_wrong_result: the oracle is not vacuous.
  * Every output is also tested for self-intersections after rounding; their number is
  * printed (rounding to doubles may create some; they are not failures).
@@ -159,7 +159,7 @@ TEST(saved_regressions)
     totals s = {0};
     double start = csg_now();
     snprintf(dir_copy, sizeof dir_copy, "%s", dir);
-    snprintf(models, sizeof models, "%s", test_shared_model(""));
+    snprintf(models, sizeof models, "%s", test_model(""));
     d = opendir(dir_copy);
     CHECK_MSG(d != NULL, "cannot open %s", dir_copy);
     while (d && (entry = readdir(d)) != NULL) {
@@ -209,7 +209,7 @@ TEST(oracle_notices_a_wrong_result)
 
 int main(void)
 {
-    csg_load_models();
+    CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
     csg_self_check = true;
     RUN(oracle_notices_a_wrong_result);
     RUN(saved_regressions);

@@ -110,11 +110,11 @@ TEST(identical_spheres_are_coplanar_everywhere)
     mcsg_curves c;
     mcsg_intersect_stats s;
     mcsg_error err;
-    CHECK_OK(mcsg_mesh_read(test_shared_model("sphere1.obj"), MCSG_FORMAT_AUTO, NULL, &a, &err),
+    CHECK_OK(mcsg_mesh_read(test_model("sphere.obj"), MCSG_FORMAT_AUTO, NULL, &a, &err),
              &err);
-    CHECK_OK(mcsg_mesh_read(test_shared_model("sphere2.obj"), MCSG_FORMAT_AUTO, NULL, &b, &err),
+    CHECK_OK(mcsg_mesh_read(test_model("sphere.obj"), MCSG_FORMAT_AUTO, NULL, &b, &err),
              &err);
-    const mcsg_mesh *m[2] = {&a, &a};
+    const mcsg_mesh *m[2] = {&a, &b};
     mcsg_tree *tree = scene(m, NULL, 2);
     run(tree, &c, &s);
     /* Each face overlaps exactly its twin; neighbours touch along edges only. The

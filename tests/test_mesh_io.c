@@ -2,7 +2,7 @@
  * Tests of the mesh file readers and writers (src/mesh_io*.c): bit-exact round trips of
  * every format, the format-specific features (OFF variants, OBJ corner syntax and
  * continuation lines, STL detection and welding, PLY encodings, types and skipped
- * data), the shared models, one test per class of malformed input (status, file name
+ * data), the models of tests/data/models, one test per class of malformed input (status, file name
  * and line or byte offset in the message), hostile counts, and allocation failure at
  * every allocation (NOMEM, nothing leaked).
  *
@@ -678,23 +678,17 @@ TEST(ply_ascii_types)
     mcsg_mesh_free(&m, NULL);
 }
 
-/* The counts of models/README.md (which rounds the 25k/50k/100k variants: 12.5K / 25K /
- * 50K vertices and 25K / 50K / 100K triangles; the exact values are below). */
-TEST(shared_models)
+/* The models of tests/data/models, with their counts (tests/data/README.md). */
+TEST(project_models)
 {
     static const struct {
         const char *name;
         size_t vertices, triangles;
     } models[] = {
-        {"armadillo.obj", 49999, 99994}, {"bunny.obj", 14290, 28576},
-        {"bunny25k.obj", 12500, 24996},  {"bunny50k.obj", 25000, 49996},
-        {"bunny100k.obj", 50000, 99996}, {"cow.obj", 2930, 5856},
-        {"cow25k.obj", 12500, 24996},    {"cow50k.obj", 25000, 49996},
-        {"cow100K.obj", 50000, 99996},   {"sphere1.obj", 1442, 2880},
-        {"sphere2.obj", 1442, 2880},     {"cube.obj", 8, 12},
+        {"spot.obj", 2930, 5856}, {"sphere.obj", 1442, 2880}, {"cube.obj", 8, 12},
     };
     size_t count = sizeof models / sizeof models[0];
-    DIR *dir = opendir(test_shared_model(""));
+    DIR *dir = opendir(test_model(""));
     struct dirent *entry;
     CHECK(dir != NULL);
     /* Every OBJ in the folder must be listed above, so that none goes untested. */
@@ -711,8 +705,7 @@ TEST(shared_models)
     for (size_t i = 0; i < count; i++) {
         mcsg_mesh m;
         mcsg_error err;
-        CHECK_OK(mcsg_mesh_read(test_shared_model(models[i].name), MCSG_FORMAT_AUTO, NULL, &m,
-                                &err),
+        CHECK_OK(mcsg_mesh_read(test_model(models[i].name), MCSG_FORMAT_AUTO, NULL, &m, &err),
                  &err);
         CHECK_MSG(m.vertex_count == models[i].vertices && m.triangle_count ==
                                                                models[i].triangles,
@@ -1142,7 +1135,7 @@ int main(void)
     RUN(stl_ascii_features);
     RUN(ply_binary_encodings_and_types);
     RUN(ply_ascii_types);
-    RUN(shared_models);
+    RUN(project_models);
     RUN(format_names_and_detection);
     RUN(off_errors);
     RUN(obj_errors);

@@ -4,7 +4,7 @@
  * ways, random digit strings, exact midpoints between adjacent doubles (computed with
  * GMP), subnormals and the overflow threshold; it must respect the `end` bound and
  * ignore the locale. mci_format_double must write the shortest of %.15g/%.16g/%.17g
- * that reads back exactly, with '.' as decimal point in any locale.
+ * that reads back exactly. (Independence of the process locale: test_numparse_locale.c.)
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -13,7 +13,6 @@
 
 #include <float.h>
 #include <gmp.h>
-#include <locale.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -498,38 +497,6 @@ TEST(format_read_back_boundaries)
     }
 }
 
-TEST(locale_independence)
-{
-    char out[MCI_DOUBLE_TEXT_MAX];
-    double v = 0;
-    const char *next = NULL;
-    if (!setlocale(LC_NUMERIC, "de_DE.UTF-8")) {
-        printf("note: skipping the de_DE.UTF-8 check: setlocale(LC_NUMERIC, "
-               "\"de_DE.UTF-8\") failed (locale not installed)\n");
-        CHECK(mci_format_double(out, 0.5) == 3 && strcmp(out, "0.5") == 0);
-        return;
-    }
-    CHECK_MSG(mci_format_double(out, 0.5) == 3 && strcmp(out, "0.5") == 0, "got %s", out);
-    CHECK_MSG(mci_format_double(out, -1.25e-7) && strcmp(out, "-1.25e-07") == 0, "got %s",
-              out);
-    {
-        static const char two_and_a_half[] = "2.5", comma[] = "2,5";
-        CHECK(parse_prefix(two_and_a_half, 3, &v, &next) && v == 2.5 &&
-              next == two_and_a_half + 3);
-        CHECK(parse_prefix(comma, 3, &v, &next) && v == 2.0 && next == comma + 1);
-    }
-    for (int i = 0; i < 20000; i++) {
-        double d = double_from_bits(next_random()), back = 0;
-        size_t len;
-        if (!isfinite(d))
-            continue;
-        len = mci_format_double(out, d);
-        CHECK_MSG(mci_parse_double(out, out + len, &back, &next) && test_same_double(back, d),
-                  "%a -> %s", d, out);
-    }
-    setlocale(LC_NUMERIC, "C");
-}
-
 int main(void)
 {
     RUN(fixed_strings);
@@ -545,6 +512,5 @@ int main(void)
     RUN(format_short_decimals);
     RUN(format_typical_range);
     RUN(format_read_back_boundaries);
-    RUN(locale_independence);
     return test_summary();
 }

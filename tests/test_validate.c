@@ -1,6 +1,6 @@
 /*
  * Validation and the basic exact predicates: every class of mesh problem is caught and
- * counted, valid meshes (including all shared models) pass, and the exact predicates
+ * counted, valid meshes (including the models of tests/data/models) pass, and the exact predicates
  * agree with GMP rationals on random and constructed-degenerate inputs.
  */
 #include "testlib.h"
@@ -330,17 +330,16 @@ TEST(det3_random_and_coplanar_match_rationals)
     }
 }
 
-/* ---- shared models ---- */
+/* ---- the project's models ---- */
 
-TEST(shared_models_validate_clean)
+TEST(models_validate_clean)
 {
-    const char *models[] = {"cube.obj", "cow.obj", "bunny.obj", "sphere1.obj",
-                            "sphere2.obj", "armadillo.obj", "bunny25k.obj", "cow100K.obj"};
+    const char *models[] = {"cube.obj", "spot.obj", "sphere.obj"};
     for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) {
         mcsg_mesh mesh;
         mcsg_error err;
         mcsg_check_report r;
-        if (mcsg_mesh_read(test_shared_model(models[i]), MCSG_FORMAT_AUTO, NULL, &mesh, &err) !=
+        if (mcsg_mesh_read(test_model(models[i]), MCSG_FORMAT_AUTO, NULL, &mesh, &err) !=
             MCSG_OK) {
             CHECK_MSG(0, "%s", err.message);
             continue;
@@ -396,7 +395,7 @@ int main(void)
     RUN(orient2d_random_matches_rationals);
     RUN(orient2d_constructed_collinear);
     RUN(det3_random_and_coplanar_match_rationals);
-    RUN(shared_models_validate_clean);
+    RUN(models_validate_clean);
     RUN(check_survives_every_allocation_failure);
     return test_summary();
 }

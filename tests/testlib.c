@@ -1,9 +1,12 @@
+#define _POSIX_C_SOURCE 200809L /* stat */
+
 #include "testlib.h"
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 int test_failures;
 int test_checks;
@@ -21,8 +24,20 @@ void test_fail(const char *file, int line, const char *fmt, ...)
     fputc('\n', stderr);
 }
 
+static bool skipped;
+
+void test_skip(const char *why)
+{
+    printf("skipped: %s\n", why);
+    skipped = true;
+}
+
 int test_summary(void)
 {
+    if (skipped && test_failures == 0) {
+        printf("%d checks; skipped\n", test_checks);
+        return TEST_SKIPPED;
+    }
     if (test_checks == 0) {
         fprintf(stderr, "no check ran: a test that checks nothing fails\n");
         return 1;
@@ -47,11 +62,22 @@ static const char *env_path(const char *var, const char *name)
     return out;
 }
 
-const char *test_shared_model(const char *name)
+const char *test_model(const char *name)
 {
     char rel[512];
     snprintf(rel, sizeof rel, "models/%s", name);
-    return env_path("MCSG_SHARED_DIR", rel);
+    return env_path("MCSG_TEST_DATA", rel);
+}
+
+const char *test_shared_models_dir(void)
+{
+    static char path[4096];
+    const char *dir = getenv("MCSG_SHARED_DIR");
+    struct stat st;
+    if (!dir || !*dir)
+        return NULL;
+    snprintf(path, sizeof path, "%s/models", dir);
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? path : NULL;
 }
 
 const char *test_data(const char *name) { return env_path("MCSG_TEST_DATA", name); }

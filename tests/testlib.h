@@ -79,13 +79,23 @@ void test_fail(const char *file, int line, const char *fmt, ...);
 extern int test_cases;
 extern int test_cases_failed;
 
+/* Exit status of a test binary that skipped its checks (CTest's SKIP_RETURN_CODE). */
+#define TEST_SKIPPED 77
+
 /* Prints "N passed, M failed" and returns the process exit code. A test binary that ran
- * no check at all fails: a test that checks nothing must not pass. */
+ * no check at all fails (a test that checks nothing must not pass), unless test_skip was
+ * called: then it returns TEST_SKIPPED, which CTest reports as skipped, never as passed. */
 int test_summary(void);
 
-/* Path of a shared model (../shared/models/NAME); the test fails if the folder is
- * missing, since CI always has it. Returns a static buffer. */
-const char *test_shared_model(const char *name);
+/* Marks the binary as skipped, printing why (e.g. optional data missing). Checks that
+ * still fail make it fail. */
+void test_skip(const char *why);
+
+/* Path of a model under tests/data/models (part of the project). Static buffer. */
+const char *test_model(const char *name);
+/* The optional folder of larger models, $MCSG_SHARED_DIR/models (../shared/models next
+ * to a checkout), or NULL when it does not exist. Static buffer. */
+const char *test_shared_models_dir(void);
 /* Path of a file under tests/data. Static buffer. */
 const char *test_data(const char *name);
 /* Path of a scratch file in the build tree. Static buffer. */

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
-#   tools/ensure-deps.sh          gcc, make, cmake, GMP headers, python3 (for the tests)
+#   tools/ensure-deps.sh          gcc, make, cmake, GMP headers, python3 (benchmark scenes),
+#                                 and the de_DE.UTF-8 locale (test_numparse_locale checks
+#                                 that numbers ignore a decimal comma)
 #   tools/ensure-deps.sh clang    also clang (compile check; libFuzzer runtime for make fuzz)
 set -euo pipefail
 
@@ -10,7 +12,11 @@ have() { command -v "$1" >/dev/null 2>&1; }
 have gcc   || missing+=(gcc)
 have make  || missing+=(make)
 have cmake || missing+=(cmake)
-have python3 || missing+=(python3) # the tests generate ../shared/scenes with it
+have python3 || missing+=(python3) # make bench and the optional shared-scene test
+has_german_locale() { locale -a 2>/dev/null | grep -qix 'de_DE.utf-\{0,1\}8'; }
+# Optional (installed when root, otherwise the test that needs it is skipped):
+optional=()
+[ -e /usr/share/i18n/locales/de_DE ] || optional+=(locales)
 if ! have gcc || ! echo '#include <gmp.h>' | gcc -E -x c - >/dev/null 2>&1; then
   missing+=(libgmp-dev)
 fi
@@ -23,12 +29,26 @@ if [ "${1:-}" = clang ]; then
   fi
 fi
 
-[ ${#missing[@]} -eq 0 ] && exit 0
+# The locale is generated from the `locales` package's sources (localedef, in libc-bin).
+make_german_locale() {
+  has_german_locale && return 0
+  if [ "$(id -u)" = 0 ]; then
+    echo "generating the de_DE.UTF-8 locale (for test_numparse_locale)"
+    localedef -i de_DE -f UTF-8 de_DE.UTF-8 || echo "warning: localedef failed: test_numparse_locale will be skipped" >&2
+  else
+    echo "note: the de_DE.UTF-8 locale is missing: test_numparse_locale will be skipped" >&2
+    echo "      (generate it with: sudo localedef -i de_DE -f UTF-8 de_DE.UTF-8)" >&2
+  fi
+}
 
-if [ "$(id -u)" = 0 ] && have apt-get; then
-  echo "installing: ${missing[*]}"
+if [ "$(id -u)" = 0 ] && have apt-get && [ ${#missing[@]} -gt 0 -o ${#optional[@]} -gt 0 ]; then
+  echo "installing: ${missing[*]} ${optional[*]}"
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" "${optional[@]}" >/dev/null
+  missing=()
+fi
+if [ ${#missing[@]} -eq 0 ]; then
+  make_german_locale
   exit 0
 fi
 echo "missing build dependencies: ${missing[*]}" >&2

@@ -1,9 +1,10 @@
 # meshcsg check: valid models pass, each problem class is named, exit codes are right.
 . "$(dirname "$0")/common.bash"
 
-run 0 check "$MODELS/cube.obj" "$MODELS/bunny.obj" "$MODELS/cow.obj"
-contains "cube.obj: ok: 8 vertices, 12 triangles, 1 component, volume"
-contains "bunny.obj: ok: 14290 vertices, 28576 triangles"
+run 0 check "$MODELS/cube.obj" "$MODELS/spot.obj" "$MODELS/sphere.obj"
+contains "cube.obj: ok: 8 vertices, 12 triangles, 1 component, volume 1"
+contains "spot.obj: ok: 2930 vertices, 5856 triangles, 1 component, volume"
+contains "sphere.obj: ok: 1442 vertices, 2880 triangles, 1 component, volume"
 
 cube_off 1 > "$WORK/open.off"
 run 1 check "$WORK/open.off"

@@ -1,16 +1,16 @@
-# meshcsg convert: every format round-trips the bunny with its counts and stays valid.
+# meshcsg convert: every format round-trips Spot (tests/data/models/spot.obj) with its counts and stays valid.
 . "$(dirname "$0")/common.bash"
 
 for fmt in off obj stl-ascii stl-binary ply-ascii ply-binary ply-binary-be; do
   ext=${fmt%%-*}
-  run 0 convert "$MODELS/bunny.obj" "$WORK/bunny-$fmt.$ext" --format "$fmt"
-  contains "14290 vertices, 28576 triangles"
-  run 0 check "$WORK/bunny-$fmt.$ext"
-  contains "ok: 14290 vertices, 28576 triangles, 1 component"
-  run 0 convert "$WORK/bunny-$fmt.$ext" "$WORK/back-$fmt.off"
+  run 0 convert "$MODELS/spot.obj" "$WORK/spot-$fmt.$ext" --format "$fmt"
+  contains "2930 vertices, 5856 triangles"
+  run 0 check "$WORK/spot-$fmt.$ext"
+  contains "ok: 2930 vertices, 5856 triangles, 1 component"
+  run 0 convert "$WORK/spot-$fmt.$ext" "$WORK/back-$fmt.off"
 done
 # OFF, OBJ and PLY keep doubles exactly: converting back gives the same OFF text.
-run 0 convert "$MODELS/bunny.obj" "$WORK/ref.off"
+run 0 convert "$MODELS/spot.obj" "$WORK/ref.off"
 for fmt in obj ply-ascii ply-binary ply-binary-be; do
   if cmp -s "$WORK/ref.off" "$WORK/back-$fmt.off"; then passed=$((passed + 1))
   else echo "FAIL: $fmt round trip changed the mesh"; failed=$((failed + 1)); fi

@@ -25,7 +25,7 @@ run 0 intersect "$WORK/coplanar.scad"
 contains "points of odd degree 0"
 lacks "coplanar overlapping pairs 0"
 
-cp "$MODELS/cow.obj" "$WORK/cow.obj"
+cp "$MODELS/spot.obj" "$WORK/cow.obj"
 printf 'union() { import("cow.obj"); translate([0.05, 0.03, 0.02]) rotate([0, 0, 3]) import("cow.obj"); }\n' > "$WORK/cows.scad"
 run 0 intersect "$WORK/cows.scad"
 contains "points of odd degree 0"
