@@ -29,9 +29,14 @@
 extern "C" {
 #endif
 
+/* The version, kept here only: CMake reads it from these lines. */
 #define MCSG_VERSION_MAJOR 0
 #define MCSG_VERSION_MINOR 1
 #define MCSG_VERSION_PATCH 0
+
+/* The version of the library linked at run time, "MAJOR.MINOR.PATCH" (compare with the
+ * MCSG_VERSION_* of the header compiled against). Never NULL. */
+const char *mcsg_version(void);
 
 /* ------------------------------------------------------------------------------------ */
 /* Status and errors                                                                     */
@@ -46,7 +51,8 @@ typedef enum mcsg_status {
     MCSG_ERR_INVALID_ARG,  /* the caller passed an invalid argument */
     MCSG_ERR_INVALID_MESH, /* a mesh is not usable (e.g. indices out of range) */
     MCSG_ERR_LIMIT,        /* the input exceeds a hard limit (e.g. 2^32-1 vertices) */
-    MCSG_ERR_INTERNAL      /* an internal consistency check failed: a bug, please report */
+    MCSG_ERR_INTERNAL,     /* an internal consistency check failed: a bug, please report */
+    MCSG_ERR_CANCELLED     /* the progress callback asked to stop (mcsg_progress_fn) */
 } mcsg_status;
 
 /* A short English description of a status code ("out of memory", ...). Never NULL. */
@@ -84,9 +90,17 @@ typedef enum mcsg_log_level {
  * the call. Called from the thread that called the library function. */
 typedef void (*mcsg_log_fn)(void *user, mcsg_log_level level, const char *message);
 
-/* Progress callback: called with done = 0 when a step of a long operation (e.g. "intersect",
- * "classify") starts and done = 1 when it ends, from the thread that called the library. */
-typedef void (*mcsg_progress_fn)(void *user, const char *step, int done);
+/* Progress callback: called with done = 0 when a step of a long operation starts and
+ * done = 1 when it ends, from the thread that called the library. Return 0 to go on;
+ * any other value stops the operation at that point: it frees what it built and
+ * returns MCSG_ERR_CANCELLED (a step under way finishes first, so stopping takes at most
+ * one step). The steps, in order:
+ *   mcsg_eval:      "check" (the input contract), "intersect" (octree, pair tests,
+ *                   per-face arrangements, point numbering), "triangulate", "classify",
+ *                   "assemble" (rounding and the output mesh)
+ *   mcsg_intersect: "intersect"
+ * `step` is a static string. */
+typedef int (*mcsg_progress_fn)(void *user, const char *step, int done);
 
 /* Worker threads that several calls share (mcsg_pool_create). */
 typedef struct mcsg_pool mcsg_pool;
@@ -349,6 +363,14 @@ void mcsg_tree_free(mcsg_tree *tree);
 mcsg_status mcsg_tree_add_leaf(mcsg_tree *tree, const mcsg_mesh *mesh, const double matrix[12],
                                const char *label, mcsg_node_id *out, mcsg_error *err);
 
+/* The same without a copy: the tree takes *mesh's arrays, which must come from the
+ * tree's allocator (a mesh returned by mcsg_mesh_read, mcsg_make_cube, mcsg_eval, ...
+ * called with the options the tree was created with), and transforms them in place.
+ * On success and on failure alike the arrays are the tree's (freed on failure) and *mesh
+ * is zeroed; only with a NULL tree or mesh (MCSG_ERR_INVALID_ARG) is nothing taken. */
+mcsg_status mcsg_tree_add_leaf_take(mcsg_tree *tree, mcsg_mesh *mesh, const double matrix[12],
+                                    const char *label, mcsg_node_id *out, mcsg_error *err);
+
 /* Add an operation over existing nodes. Each node can be the child of one parent only
  * (MCSG_ERR_INVALID_ARG otherwise, also for an id listed twice). `label` may be NULL.
  * The new node's id (MCSG_NO_NODE on failure) is stored in *out (which may be NULL, or
@@ -368,6 +390,10 @@ mcsg_node_kind mcsg_tree_node_kind(const mcsg_tree *tree, mcsg_node_id node);
 size_t mcsg_tree_child_count(const mcsg_tree *tree, mcsg_node_id node);
 mcsg_node_id mcsg_tree_child(const mcsg_tree *tree, mcsg_node_id node, size_t index);
 const char *mcsg_tree_node_label(const mcsg_tree *tree, mcsg_node_id node); /* never NULL */
+/* The mesh of a leaf (NULL for an operation). The tree owns it. The returned pointer is
+ * valid until the next node is added to the tree (the node array may move) or the tree
+ * is freed; the vertex and triangle arrays it points to stay valid, unchanged, until
+ * mcsg_tree_free. The label pointer above follows the same rule as the mesh arrays. */
 const mcsg_mesh *mcsg_tree_leaf_mesh(const mcsg_tree *tree, mcsg_node_id node);
 
 /* ------------------------------------------------------------------------------------ */

@@ -276,6 +276,7 @@ const char *mcsg_status_string(mcsg_status status)
     case MCSG_ERR_INVALID_MESH: return "invalid mesh";
     case MCSG_ERR_LIMIT: return "size limit exceeded";
     case MCSG_ERR_INTERNAL: return "internal error";
+    case MCSG_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }
@@ -386,10 +387,20 @@ uint64_t mci_coordinate_hash(const double *x)
     return h;
 }
 
-void mci_progress(const mci_ctx *ctx, const char *step, int done)
+mcsg_status mci_progress(const mci_ctx *ctx, const char *step, int done, mcsg_error *err)
 {
-    if (ctx->progress)
-        ctx->progress(ctx->progress_user, step, done);
+    if (!ctx->progress || ctx->progress(ctx->progress_user, step, done) == 0)
+        return MCSG_OK;
+    return mci_fail(err, MCSG_ERR_CANCELLED, "cancelled by the progress callback at the %s of "
+                    "step \"%s\"", done ? "end" : "start", step);
+}
+
+#define MCI_STRINGIFY(x) #x
+#define MCI_VERSION_TEXT(a, b, c) MCI_STRINGIFY(a) "." MCI_STRINGIFY(b) "." MCI_STRINGIFY(c)
+
+const char *mcsg_version(void)
+{
+    return MCI_VERSION_TEXT(MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR, MCSG_VERSION_PATCH);
 }
 
 bool mci_first_equal_coordinates(const mci_ctx *ctx, const double *xyz, size_t n,

@@ -443,12 +443,14 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
 
 typedef mcsg_status (*step_fn)(eval_state *e, mcsg_error *err);
 
+/* A step between the progress reports that may cancel it (docs of mcsg_progress_fn). */
 static mcsg_status step(eval_state *e, const char *name, step_fn fn, mcsg_error *err)
 {
-    mcsg_status st;
-    mci_progress(&e->ctx, name, 0);
-    st = fn(e, err);
-    mci_progress(&e->ctx, name, 1);
+    mcsg_status st = mci_progress(&e->ctx, name, 0, err);
+    if (st == MCSG_OK)
+        st = fn(e, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, name, 1, err);
     return st;
 }
 
@@ -638,16 +640,23 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     if (e->tree.leaf_count == 0)
         return mci_mesh_alloc(&e->ctx, out, 0, 0, err);
     t0 = mci_seconds_now();
-    st = mci_check_leaves(&e->ctx, tree, &e->tree, err);
+    st = mci_progress(&e->ctx, "check", 0, err);
+    if (st == MCSG_OK)
+        st = mci_check_leaves(&e->ctx, tree, &e->tree, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "check", 1, err);
     e->stats.seconds_check = mci_seconds_now() - t0;
     if (st != MCSG_OK)
         return st;
     st = evaluate_faces_safely(e, err);
-    if (st == MCSG_OK) {
-        mci_progress(&e->ctx, "assemble", 0);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "assemble", 0, err);
+    if (st == MCSG_OK)
         st = assemble(e, out, provenance, err);
-        mci_progress(&e->ctx, "assemble", 1);
-    }
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "assemble", 1, err);
+    if (st != MCSG_OK)
+        mci_mesh_free(&e->ctx, out);
     if (st == MCSG_ERR_INTERNAL)
         st = mci_explain_internal_error(&e->ctx, tree, &e->tree, err);
     return st;

@@ -34,8 +34,9 @@ typedef struct mci_ctx {
     bool owns_pool; /* started by mci_pool_start, stopped by mci_pool_stop */
 } mci_ctx;
 
-/* Report the start (done = 0) or end (done = 1) of a step, if asked to. */
-void mci_progress(const mci_ctx *ctx, const char *step, int done);
+/* Report the start (done = 0) or end (done = 1) of a step, if asked to. MCSG_OK to go
+ * on; MCSG_ERR_CANCELLED (with the message in *err) when the callback asks to stop. */
+mcsg_status mci_progress(const mci_ctx *ctx, const char *step, int done, mcsg_error *err);
 
 /* Fill *ctx from opts (NULL or zero fields mean defaults). */
 void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts);

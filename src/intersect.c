@@ -1987,9 +1987,13 @@ mcsg_status mcsg_intersect(const mcsg_tree *tree, const mcsg_options *opts, mcsg
     if (!leaves)
         return mci_fail_nomem(err, "intersecting faces");
     mci_pool_start(&ctx);
-    st = mci_scene_build(&ctx, leaves, collect_leaves(tree, leaves), &scene, err);
+    st = mci_progress(&ctx, "intersect", 0, err);
+    if (st == MCSG_OK)
+        st = mci_scene_build(&ctx, leaves, collect_leaves(tree, leaves), &scene, err);
     if (st == MCSG_OK)
         st = mci_scene_number_points(&ctx, &scene, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&ctx, "intersect", 1, err);
     if (st == MCSG_OK)
         st = export_curves(&ctx, &scene, out, err);
     if (stats)

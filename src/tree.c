@@ -202,6 +202,24 @@ mcsg_status mcsg_tree_add_leaf(mcsg_tree *tree, const mcsg_mesh *mesh, const dou
     return mci_tree_add_leaf_owned(tree, &copy, label, out, err);
 }
 
+mcsg_status mcsg_tree_add_leaf_take(mcsg_tree *tree, mcsg_mesh *mesh, const double matrix[12],
+                                    const char *label, mcsg_node_id *out, mcsg_error *err)
+{
+    mcsg_status st;
+    if (!tree || !mesh)
+        return report(out, MCSG_NO_NODE, mci_fail(err, MCSG_ERR_INVALID_ARG,
+                                                  "mcsg_tree_add_leaf_take: NULL argument"));
+    /* Checked before the transform, which reads the vertices the indices name. */
+    st = check_leaf_mesh(mesh, err);
+    if (st != MCSG_OK) {
+        mci_mesh_free(&tree->ctx, mesh);
+        return report(out, MCSG_NO_NODE, st);
+    }
+    if (matrix)
+        mcsg_mesh_transform(mesh, matrix);
+    return mci_tree_add_leaf_owned(tree, mesh, label, out, err);
+}
+
 /* Every child must exist, have no parent yet, and appear once. Marks the children as
  * having a parent (in O(child_count), however many there are); on failure every mark
  * made here is undone. */

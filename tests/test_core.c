@@ -5,7 +5,7 @@
  * inputs of many sizes, and the key lookup on the sorted result; the
  * parallel loop (every task once, the first failing position reported whatever the
  * thread count, with threads per loop or a pool), the pool's short and nested loops and
- * the heaviest-first order.
+ * the heaviest-first order; mcsg_version against the header.
  */
 #include "testlib.h"
 #include "internal.h"
@@ -332,6 +332,15 @@ TEST(heaviest_first_moves_only_heavy_tasks)
     mci_free(&ctx, order);
 }
 
+TEST(version_matches_the_header)
+{
+    char expected[32];
+    snprintf(expected, sizeof expected, "%d.%d.%d", MCSG_VERSION_MAJOR, MCSG_VERSION_MINOR,
+             MCSG_VERSION_PATCH);
+    CHECK_MSG(strcmp(mcsg_version(), expected) == 0, "mcsg_version() %s, header %s",
+              mcsg_version(), expected);
+}
+
 int main(void)
 {
     RUN(keyed_sort_matches_qsort);
@@ -340,5 +349,6 @@ int main(void)
     RUN(parallel_loop_runs_every_task_once_and_reports_the_first_failure);
     RUN(pool_runs_short_and_nested_loops);
     RUN(heaviest_first_moves_only_heavy_tasks);
+    RUN(version_matches_the_header);
     return test_summary();
 }

@@ -658,6 +658,89 @@ TEST(allocation_failures_leak_nothing)
     mcsg_tree_free(tree);
 }
 
+/* Progress: the steps mcsg_progress_fn documents, in order, each started and ended; a
+ * callback returning non-zero stops the evaluation there, cleanly. */
+typedef struct progress_log {
+    char steps[16][16];
+    int done[16];
+    int count;
+    int stop_at; /* the report (0-based) that returns non-zero; -1: never */
+} progress_log;
+
+static int log_progress(void *user, const char *step, int done)
+{
+    progress_log *p = user;
+    if (p->count < 16) {
+        snprintf(p->steps[p->count], sizeof p->steps[0], "%s", step);
+        p->done[p->count] = done;
+    }
+    return p->count++ == p->stop_at;
+}
+
+static mcsg_status eval_reporting(const mcsg_tree *tree, progress_log *p, test_allocator *a,
+                                  mcsg_mesh *out, mcsg_error *err)
+{
+    mcsg_options opts = test_allocator_options(a);
+    opts.progress = log_progress;
+    opts.progress_user = p;
+    return mcsg_eval(tree, &opts, out, NULL, NULL, err);
+}
+
+TEST(progress_reports_steps_and_can_cancel)
+{
+    static const char *const order[] = {"check", "intersect", "triangulate", "classify",
+                                        "assemble"};
+    mcsg_tree *tree = parse("difference() { cube(2); translate([1,1,1]) sphere(1, $fn=12); }");
+    progress_log p = {.stop_at = -1};
+    test_allocator a = {0};
+    mcsg_mesh out;
+    mcsg_error err;
+    if (!tree)
+        return;
+    CHECK_OK(eval_reporting(tree, &p, &a, &out, &err), &err);
+    CHECK(out.triangle_count > 0);
+    mcsg_mesh_free(&out, &(mcsg_options){.allocator = test_allocator_options(&a).allocator});
+    CHECK_EQ_SIZE(p.count, 10);
+    for (int i = 0; i < 10 && i < p.count; i++)
+        CHECK_MSG(strcmp(p.steps[i], order[i / 2]) == 0 && p.done[i] == i % 2,
+                  "report %d: %s %d", i, p.steps[i], p.done[i]);
+    /* Stopped at every report: MCSG_ERR_CANCELLED naming the step, no mesh, no leak. */
+    for (int stop = 0; stop < 10; stop++) {
+        progress_log q = {.stop_at = stop};
+        test_allocator b = {0};
+        mcsg_status st = eval_reporting(tree, &q, &b, &out, &err);
+        CHECK_MSG(st == MCSG_ERR_CANCELLED, "stopping at report %d: status %s", stop,
+                  mcsg_status_string(st));
+        CHECK_EQ_SIZE(q.count, stop + 1);
+        CHECK_CONTAINS(err.message, order[stop / 2]);
+        CHECK(out.triangle_count == 0 && out.vertices == NULL && out.triangles == NULL);
+        CHECK_EQ_SIZE(b.live, 0);
+    }
+    CHECK(strcmp(mcsg_status_string(MCSG_ERR_CANCELLED), "cancelled") == 0);
+    mcsg_tree_free(tree);
+}
+
+TEST(intersect_reports_progress_and_can_cancel)
+{
+    mcsg_tree *tree = parse("union() { cube(2); translate([1,1,1]) cube(2); }");
+    progress_log p = {.stop_at = -1}, q = {.stop_at = 1};
+    mcsg_options opts = {0};
+    mcsg_curves c;
+    mcsg_error err;
+    if (!tree)
+        return;
+    opts.progress = log_progress;
+    opts.progress_user = &p;
+    CHECK_OK(mcsg_intersect(tree, &opts, &c, NULL, &err), &err);
+    CHECK(c.segment_count > 0);
+    mcsg_curves_free(&c, NULL);
+    CHECK(p.count == 2 && strcmp(p.steps[0], "intersect") == 0 && p.done[1] == 1);
+    opts.progress_user = &q;
+    CHECK(mcsg_intersect(tree, &opts, &c, NULL, &err) == MCSG_ERR_CANCELLED);
+    CHECK(c.points == NULL && c.segments == NULL);
+    mcsg_tree_free(tree);
+}
+
 /* A cube with one change: a triangle dropped, flipped, repeated, or a vertex moved. */
 static const double contract_cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
                                          0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
@@ -771,6 +854,8 @@ int main(void)
     RUN(empty_and_trivial_trees);
     RUN(output_is_independent_of_memory_layout_and_threads);
     RUN(allocation_failures_leak_nothing);
+    RUN(progress_reports_steps_and_can_cancel);
+    RUN(intersect_reports_progress_and_can_cancel);
     RUN(input_contract_is_checked);
     return test_summary();
 }

@@ -1,8 +1,8 @@
 /*
  * CSG trees: building leaves (copied and transformed) and operations, the queries,
  * every invalid use (bad child, second parent, duplicate child, bad kind, bad mesh),
- * deep and wide trees built and freed without recursion, the internal owning leaf,
- * and allocation failures at every step.
+ * deep and wide trees built and freed without recursion, the owning leaf (internal and
+ * public: mcsg_tree_add_leaf_take), and allocation failures at every step.
  */
 #include "testlib.h"
 #include "tree_internal.h"
@@ -202,6 +202,41 @@ TEST(owned_leaf_takes_the_mesh)
     mcsg_tree_free(tree);
 }
 
+TEST(public_take_moves_and_transforms)
+{
+    const double shift[12] = {1, 0, 0, 5, 0, 1, 0, 0, 0, 0, 1, 0};
+    mcsg_tree *tree;
+    mcsg_mesh m, bad;
+    mcsg_node_id id;
+    mcsg_error err;
+    CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
+    CHECK_OK(mcsg_mesh_copy(&(mcsg_mesh){(double *)tetra_vertices, (uint32_t *)tetra_triangles,
+                                         4, 4}, NULL, &m, &err), &err);
+    {
+        double *arrays = m.vertices;
+        const mcsg_mesh *leaf;
+        CHECK_OK(mcsg_tree_add_leaf_take(tree, &m, shift, "taken", &id, &err), &err);
+        CHECK(m.vertices == NULL && m.triangles == NULL && m.vertex_count == 0);
+        leaf = mcsg_tree_leaf_mesh(tree, id);
+        CHECK(leaf->vertices == arrays); /* no copy */
+        CHECK(leaf->vertices[0] == 5 && leaf->vertices[3] == 6 && leaf->vertex_count == 4);
+        CHECK(strcmp(mcsg_tree_node_label(tree, id), "taken") == 0);
+    }
+    /* A bad mesh is refused and released (LSan checks it); *mesh is zeroed. */
+    CHECK_OK(mcsg_mesh_copy(&(mcsg_mesh){(double *)tetra_vertices, (uint32_t *)tetra_triangles,
+                                         4, 4}, NULL, &bad, &err), &err);
+    bad.triangles[5] = 4;
+    CHECK(mcsg_tree_add_leaf_take(tree, &bad, shift, NULL, &id, &err) == MCSG_ERR_INVALID_MESH);
+    CHECK(id == MCSG_NO_NODE && bad.vertices == NULL && bad.triangles == NULL);
+    CHECK_EQ_SIZE(mcsg_tree_leaf_count(tree), 1);
+    /* Without a tree nothing is taken. */
+    m = tetra();
+    CHECK(mcsg_tree_add_leaf_take(NULL, &m, NULL, NULL, &id, &err) == MCSG_ERR_INVALID_ARG);
+    CHECK(m.vertices == tetra_vertices);
+    CHECK(mcsg_tree_add_leaf_take(tree, NULL, NULL, NULL, &id, &err) == MCSG_ERR_INVALID_ARG);
+    mcsg_tree_free(tree);
+}
+
 /* Depth of the tree below the root, by an explicit stack. */
 static size_t tree_depth(const mcsg_tree *tree)
 {
@@ -257,8 +292,14 @@ static mcsg_status build_small_tree(const void *ctx, const mcsg_options *opts, m
     mcsg_tree *tree = NULL;
     mcsg_status st = mcsg_tree_create(opts, &tree, err);
     (void)ctx;
-    for (int i = 0; i < 40 && st == MCSG_OK; i++)
-        st = mcsg_tree_add_leaf(tree, &m, i % 2 ? shift : NULL, "a leaf label", &ids[i], err);
+    for (int i = 0; i < 40 && st == MCSG_OK; i++) {
+        mcsg_mesh copy;
+        if (i % 3)
+            st = mcsg_tree_add_leaf(tree, &m, i % 2 ? shift : NULL, "a leaf label", &ids[i], err);
+        else if ((st = mcsg_mesh_copy(&m, opts, &copy, err)) == MCSG_OK)
+            st = mcsg_tree_add_leaf_take(tree, &copy, i % 2 ? shift : NULL, "taken", &ids[i],
+                                         err);
+    }
     for (int i = 0; i < 40 && st == MCSG_OK; i += 4)
         st = mcsg_tree_add_op(tree, MCSG_NODE_DIFFERENCE, ids + i, 4, "op", &ids[i / 4], err);
     if (st == MCSG_OK)
@@ -280,6 +321,7 @@ int main(void)
     RUN(invalid_operations_change_nothing);
     RUN(invalid_leaves);
     RUN(owned_leaf_takes_the_mesh);
+    RUN(public_take_moves_and_transforms);
     RUN(deep_and_wide_trees);
     RUN(every_allocation_failure_is_clean);
     return test_summary();

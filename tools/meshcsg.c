@@ -475,7 +475,7 @@ typedef struct progress_state {
 
 static progress_state progress;
 
-static void on_progress(void *user, const char *step, int done)
+static int on_progress(void *user, const char *step, int done)
 {
     (void)user;
     pthread_mutex_lock(&progress.lock);
@@ -485,6 +485,7 @@ static void on_progress(void *user, const char *step, int done)
     progress.step = done ? NULL : step;
     progress.started = now_seconds();
     pthread_mutex_unlock(&progress.lock);
+    return 0;
 }
 
 static void *progress_ticker(void *arg)
