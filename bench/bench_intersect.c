@@ -7,7 +7,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "scene.h"
+#include "csg/intersect.h"
 #include "benchlib.h"
 
 #include <stdio.h>

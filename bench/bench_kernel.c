@@ -24,7 +24,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "exact_kernel.h"
+#include "exact/kernel.h"
 
 #include <math.h>
 #include <stdint.h>

@@ -5,7 +5,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "octree.h"
+#include "csg/octree.h"
 #include "benchlib.h"
 
 #include <stdio.h>
@@ -14,7 +14,7 @@
 
 #define RUNS 5
 
-/* The library defaults (src/octree.c); MCSG_OCTREE_CELL_FACES overrides the cell size. */
+/* The library defaults (src/csg/octree.c); MCSG_OCTREE_CELL_FACES overrides the cell size. */
 static mci_octree_params params = {48, 14, NULL};
 
 static void run(const char *name, const mcsg_mesh *const *leaves, size_t n)

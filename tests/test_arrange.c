@@ -1,5 +1,5 @@
 /*
- * Per-face arrangements over whole scenes (src/arrange.c, src/intersect.c). For each
+ * Per-face arrangements over whole scenes (src/csg/arrange.c, src/csg/intersect.c). For each
  * scene every touched face is triangulated with all its constraints, and then checked
  * exactly:
  *   - tiling: every sub-triangle is positive in its face's orientation, and the count
@@ -15,7 +15,7 @@
  * points), the coplanar plate-and-bars grid.
  */
 #include "testlib.h"
-#include "scene.h"
+#include "csg/intersect.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /*
- * First-seed rays (src/classify.c): the ray test through the octree must give the same
+ * First-seed rays (src/csg/classify.c): the ray test through the octree must give the same
  * label as the brute-force test over every face of the leaf, for points anywhere,
  * including points whose rays graze vertices and edges exactly (integer grids) and
  * points on the surface (UNKNOWN); and the labels must be right for boxes, where
@@ -7,7 +7,7 @@
  * classification) against every pair of boxes.
  */
 #include "testlib.h"
-#include "classify.h"
+#include "csg/classify.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -8,8 +8,10 @@
  * the heaviest-first order; mcsg_version against the header.
  */
 #include "testlib.h"
-#include "internal.h"
-#include "sort_template.h"
+#include "base/parallel.h"
+#include "base/sort.h"
+#include "base/core.h"
+#include "base/sort_template.h"
 
 #include <stdatomic.h>
 #include <stdio.h>

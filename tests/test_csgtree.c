@@ -1,5 +1,5 @@
 /*
- * CSG tree machinery (src/csgtree.c): label algebra, positive trees, and CSGlists
+ * CSG tree machinery (src/csg/csgtree.c): label algebra, positive trees, and CSGlists
  * checked against an independent reference on random trees.
  *
  * The reference looks at one spot of space where some primitives' surfaces pass (each
@@ -12,7 +12,7 @@
  * normal, or none.
  */
 #include "testlib.h"
-#include "csgtree.h"
+#include "csg/csgtree.h"
 
 #include <stdlib.h>
 #include <string.h>

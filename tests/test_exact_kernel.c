@@ -1,5 +1,5 @@
 /*
- * Tests of the exact plane-based kernel (src/exact_kernel.h) against an independent exact
+ * Tests of the exact plane-based kernel (src/exact/kernel.h) against an independent exact
  * reference written here with GMP from the geometric definitions: an LPI by solving
  * n.(p + t(q - p) - a) = 0 for t, a TPI by rational Gaussian elimination, and each
  * predicate as the sign of its defining expression on exact coordinates. The reference
@@ -24,8 +24,8 @@
  * MCSG_TEST_SCALE (default 1) multiplies the number of scenarios; MCSG_TEST_SEED sets the
  * random seed. The tables at the end count the cases and the filter's decisions.
  */
-#include "exact.h"
-#include "exact_kernel.h"
+#include "exact/big.h"
+#include "exact/kernel.h"
 #include "testlib.h"
 
 #include <float.h>

@@ -5,7 +5,7 @@
  * the three sub-triangle areas ((b-p) x (c-p)) . n etc., computed in GMP rationals.
  */
 #include "testlib.h"
-#include "exact_kernel.h"
+#include "exact/kernel.h"
 
 #include <gmp.h>
 #include <math.h>

@@ -7,7 +7,7 @@
  * and compared with the reference's ends.
  */
 #include "testlib.h"
-#include "intersect.h"
+#include "exact/tri_tri.h"
 
 #include <gmp.h>
 #include <math.h>

@@ -6,8 +6,8 @@
  * of u and v, so that the mesh is manifold by vertex index.
  */
 #include "testlib.h"
-#include "internal.h"
-#include "manifold_split.h"
+#include "base/core.h"
+#include "csg/manifold_split.h"
 
 #include <string.h>
 

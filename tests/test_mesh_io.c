@@ -1,5 +1,5 @@
 /*
- * Tests of the mesh file readers and writers (src/mesh_io*.c): bit-exact round trips of
+ * Tests of the mesh file readers and writers (src/io/): bit-exact round trips of
  * every format, the format-specific features (OFF variants, OBJ corner syntax and
  * continuation lines, STL detection and welding, PLY encodings, types and skipped
  * data), the models of tests/data/models, one test per class of malformed input (status, file name

@@ -1,5 +1,5 @@
 /*
- * Tests of src/numparse.c: mci_parse_double must agree bit for bit with glibc's strtod
+ * Tests of src/base/numparse.c: mci_parse_double must agree bit for bit with glibc's strtod
  * in the "C" locale (which is correctly rounded) on random doubles printed in several
  * ways, random digit strings, exact midpoints between adjacent doubles (computed with
  * GMP), subnormals and the overflow threshold; it must respect the `end` bound and
@@ -8,7 +8,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "numparse.h"
+#include "base/numparse.h"
 #include "testlib.h"
 
 #include <float.h>

@@ -1,5 +1,5 @@
 /*
- * Number parsing and formatting (src/numparse.c) ignore the process locale: in a German
+ * Number parsing and formatting (src/base/numparse.c) ignore the process locale: in a German
  * numeric locale, whose decimal point is a comma, "2.5" still reads as 2.5, "2,5" stops
  * at the comma, and doubles are written with '.' and read back exactly.
  *
@@ -8,7 +8,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "numparse.h"
+#include "base/numparse.h"
 #include "testlib.h"
 
 #include <locale.h>

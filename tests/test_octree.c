@@ -5,7 +5,7 @@
  * that makes candidate pairs complete), and the candidate pairs against brute force.
  */
 #include "testlib.h"
-#include "octree.h"
+#include "csg/octree.h"
 
 #include <gmp.h>
 #include <math.h>

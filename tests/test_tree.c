@@ -5,7 +5,7 @@
  * public: mcsg_tree_add_leaf_take), and allocation failures at every step.
  */
 #include "testlib.h"
-#include "tree_internal.h"
+#include "mesh/tree.h"
 
 #include <stdlib.h>
 #include <string.h>

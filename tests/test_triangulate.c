@@ -7,7 +7,7 @@
  * points + 1), every inserted point used, every constraint an edge.
  */
 #include "testlib.h"
-#include "triangulate.h"
+#include "csg/triangulate.h"
 
 #include <math.h>
 #include <stdlib.h>

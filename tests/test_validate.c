@@ -4,7 +4,8 @@
  * agree with GMP rationals on random and constructed-degenerate inputs.
  */
 #include "testlib.h"
-#include "exact.h"
+#include "exact/predicates.h"
+#include "exact/big.h"
 
 #include <float.h>
 #include <gmp.h>

@@ -7,8 +7,8 @@
  * keeps its order, and the per-triangle tags follow the triangles.
  */
 #include "testlib.h"
-#include "internal.h"
-#include "void_shells.h"
+#include "base/core.h"
+#include "csg/void_shells.h"
 
 #include <string.h>
 

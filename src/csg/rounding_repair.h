@@ -1,0 +1,33 @@
+/*
+ * Output repair after rounding to doubles, when distinct exact vertices were joined
+ * because they round to the same doubles: pairs of opposite triangles on the same
+ * corners cancel, and triangles that rounding made exactly flat (three collinear
+ * corners) are removed by splitting their neighbour across the long edge at the middle
+ * corner. See rounding_repair.c.
+ */
+#ifndef MESHCSG_CSG_ROUNDING_REPAIR_H
+#define MESHCSG_CSG_ROUNDING_REPAIR_H
+
+#include "base/core.h"
+
+typedef struct mci_flat_repair {
+    size_t split;     /* flat triangles removed (each by splitting a neighbour) */
+    size_t remaining; /* flat triangles left (their neighbour was flat as well) */
+} mci_flat_repair;
+
+/* tris: nt triangles over the vertices xyz (distinct coordinates per vertex id), closed
+ * and consistently oriented. Rewrites flat triangles and their neighbours in place;
+ * source[t] (optional) is a per-triangle tag copied from the neighbour into the
+ * triangle that replaces a flat one. Returns false only when out of memory. */
+bool mci_split_flat_triangles(const mci_ctx *ctx, const double *xyz, uint32_t *tris,
+                              uint32_t *source, size_t nt, mci_flat_repair *result);
+
+/* Remove pairs of triangles on the same three corners with opposite orientations (a
+ * sliver folded flat when its vertices were joined by rounding): their edges cancel, so
+ * the mesh stays closed and oriented. Compacts tris and source (optional) in place,
+ * updates *nt and sets *cancelled to the number of triangles removed. Returns false
+ * only when out of memory. */
+bool mci_cancel_opposite_triangles(const mci_ctx *ctx, uint32_t *tris, uint32_t *source,
+                                   size_t *nt, size_t *cancelled);
+
+#endif

@@ -1,0 +1,32 @@
+/*
+ * Mesh validation (mesh/validate.c): mcsg_mesh_check with the internal context, and the
+ * exact sign of a signed volume that it, the evaluator's input contract and the removal
+ * of void shells share.
+ */
+#ifndef MESHCSG_MESH_VALIDATE_H
+#define MESHCSG_MESH_VALIDATE_H
+
+#include "base/core.h"
+
+/* Six times a signed volume in double, summed a triangle at a time (det(a, b, c) each),
+ * with what its error bound needs. */
+typedef struct mci_volume_sum {
+    double sum, magnitude, amplified_underflow;
+    size_t triangles;
+} mci_volume_sum;
+void mci_volume_sum_add(mci_volume_sum *v, const double *a, const double *b, const double *c);
+/* +1 or -1 when the error bound proves the sum's sign, 0 when it cannot. */
+int mci_volume_sum_sign(const mci_volume_sum *v);
+
+/* Exact sign of the signed volume enclosed by the triangles tris[3 * which[k] ..] for
+ * k < n (tris[3 k ..] when which is NULL) over the vertices xyz (finite); the volume in
+ * double in *volume (optional). A floating-point sum decides when its error bound allows,
+ * big integers otherwise. */
+int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uint32_t *which,
+                              size_t n, double *volume);
+
+/* mcsg_mesh_check with the context's allocator; the mesh's counts must fit uint32_t. */
+mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
+                           mcsg_check_report *report, mcsg_error *err);
+
+#endif

@@ -1,0 +1,883 @@
+/*
+ * The built-in modules of the CSG language, following OpenSCAD's src/core/primitives.cc,
+ * TransformNode.cc, ImportNode.cc and Parameters.cc:
+ *  - arguments bind as in OpenSCAD's Parameters::parse: positional ones fill the
+ *    parameter list in order (named-only parameters such as sphere's d come last in that
+ *    list and can be reached positionally too), skipping those already given by name; a
+ *    later duplicate overrides with a warning; unknown names and surplus positional
+ *    arguments are ignored with a warning; $-arguments bind special variables for the
+ *    call and its children; undef counts as not given;
+ *  - where OpenSCAD warns about a value of the wrong type and falls back to a default,
+ *    meshcsg stops with an error at the argument's line and column;
+ *  - sphere r/d and cylinder r/d/r1/r2/d1/d2 follow OpenSCAD's precedence (a diameter
+ *    beats its radius, r1/r2 beat r); $fa and $fs below 0.01 are clamped with a warning;
+ *  - transforms: translate(v), rotate(a) with a about z or [x,y,z] as Rz*Ry*Rx,
+ *    rotate(a, v) about an axis, scale(v or s), mirror(v) (reflection through the plane
+ *    normal to v), multmatrix(m) padded with the identity and divided by m[3][3]; a
+ *    transform that flattens space (zero scale, singular matrix) makes its leaves empty;
+ *  - polyhedron faces are clockwise seen from outside, so each is reversed, then split
+ *    by a fan from its first (reversed) corner; import reads OFF/OBJ/STL/PLY relative to
+ *    the file's directory.
+ * The empty set is always a union node without children (e.g. cube(0), an empty mesh
+ * from import or polyhedron, a leaf under a flattening transform).
+ */
+#include "scad/degree_trig.h"
+#include "base/numparse.h"
+#include "scad/scad.h"
+#include "mesh/tree.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define MAX_PARAMS 14
+#define F_MINIMUM 0.01
+
+/* Each module's parameter list in OpenSCAD's order (required, then optional). */
+static const char *const module_params[MOD_COUNT][MAX_PARAMS] = {
+    [MOD_UNION] = {NULL},
+    [MOD_DIFFERENCE] = {NULL},
+    [MOD_INTERSECTION] = {NULL},
+    [MOD_GROUP] = {NULL},
+    [MOD_RENDER] = {"convexity", NULL},
+    [MOD_COLOR] = {"c", "alpha", NULL},
+    [MOD_TRANSLATE] = {"v", NULL},
+    [MOD_ROTATE] = {"a", "v", NULL},
+    [MOD_SCALE] = {"v", NULL},
+    [MOD_MIRROR] = {"v", NULL},
+    [MOD_MULTMATRIX] = {"m", NULL},
+    [MOD_CUBE] = {"size", "center", NULL},
+    [MOD_SPHERE] = {"r", "d", NULL},
+    [MOD_CYLINDER] = {"h", "r1", "r2", "center", "r", "d", "d1", "d2", NULL},
+    [MOD_POLYHEDRON] = {"points", "faces", "convexity", "triangles", NULL},
+    [MOD_IMPORT] = {"file", "layer", "convexity", "origin", "scale", "width", "height",
+                    "filename", "layername", "center", "dpi", "id", "timestamp", NULL},
+};
+
+enum { CUBE_SIZE, CUBE_CENTER };
+enum { SPHERE_R, SPHERE_D };
+enum { CYL_H, CYL_R1, CYL_R2, CYL_CENTER, CYL_R, CYL_D, CYL_D1, CYL_D2 };
+enum { POLY_POINTS, POLY_FACES, POLY_CONVEXITY, POLY_TRIANGLES };
+enum { IMPORT_FILE, IMPORT_FILENAME = 7 };
+
+typedef struct bound_arg {
+    scad_value value; /* undef when not given */
+    uint32_t line, col;
+    bool named;
+} bound_arg;
+
+/* A call's arguments bound to its module's parameters. */
+typedef struct call_args {
+    const scad_stmt *stmt;
+    const char *module;
+    bound_arg slot[MAX_PARAMS];
+} call_args;
+
+mcsg_status scad_fail_at(const char *name, uint32_t line, uint32_t col, mcsg_error *err,
+                         mcsg_status status, const char *fmt, ...)
+{
+    char what[MCSG_ERROR_MESSAGE_SIZE];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return mci_fail(err, status, "%s:%u:%u: %s", name, line, col, what);
+}
+
+void scad_warn_at(const mci_ctx *ctx, const char *name, uint32_t line, uint32_t col,
+                  const char *fmt, ...)
+{
+    char what[900];
+    va_list ap;
+    if (!ctx->log)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    mci_log(ctx, MCSG_LOG_WARNING, "%s:%u:%u: %s", name, line, col, what);
+}
+
+static int param_slot(scad_module module, const char *name, uint32_t len)
+{
+    for (int i = 0; module_params[module][i]; i++) {
+        if (strlen(module_params[module][i]) == len &&
+            memcmp(module_params[module][i], name, len) == 0)
+            return i;
+    }
+    return -1;
+}
+
+/* The next parameter a positional argument fills, or -1. */
+static int next_positional(const call_args *ca, scad_module module, int *position)
+{
+    while (*position < MAX_PARAMS && module_params[module][*position]) {
+        int slot = (*position)++;
+        if (!ca->slot[slot].named)
+            return slot;
+    }
+    return -1;
+}
+
+/* Put a named argument's value in its parameter slot (or warn that it has none). */
+static void bind_named(scad_context *sc, call_args *ca, const scad_arg *arg,
+                       const scad_value *value)
+{
+    const char *name = sc->prog->text + arg->name_start;
+    int slot = param_slot((scad_module)ca->stmt->module, name, arg->name_len);
+    if (slot < 0) {
+        scad_warn_at(sc->ev.ctx, sc->name, arg->line, arg->col, "%s(): ignoring unknown "
+                     "argument `%.*s`", ca->module, (int)arg->name_len, name);
+        return;
+    }
+    if (ca->slot[slot].named || ca->slot[slot].line)
+        scad_warn_at(sc->ev.ctx, sc->name, arg->line, arg->col, "%s(): argument `%.*s` %s",
+                     ca->module, (int)arg->name_len, name, ca->slot[slot].named
+                     ? "supplied more than once (the last one counts)"
+                     : "overrides a positional argument");
+    ca->slot[slot].value = *value;
+    ca->slot[slot].line = arg->line;
+    ca->slot[slot].col = arg->col;
+    ca->slot[slot].named = true;
+}
+
+/* Evaluate and bind every argument of the call; $-arguments are bound as special
+ * variables once all arguments are evaluated (they are evaluated in the caller's scope,
+ * like the others). */
+static mcsg_status bind_arguments(scad_context *sc, const scad_stmt *stmt, call_args *ca,
+                                  mcsg_error *err)
+{
+    const scad_arg *args = stmt->arg_count ? sc->prog->args + stmt->arg_begin : NULL;
+    scad_module module = (scad_module)stmt->module;
+    int position = 0;
+    bool warned_surplus = false;
+    uint32_t first_binding = sc->ev.binding_len;
+    mcsg_status st = MCSG_OK;
+    memset(ca, 0, sizeof *ca);
+    ca->stmt = stmt;
+    ca->module = scad_module_name(module);
+    for (uint32_t i = 0; i < stmt->arg_count && st == MCSG_OK; i++) {
+        const scad_arg *arg = &args[i];
+        scad_value value;
+        int slot;
+        if (arg->var != SCAD_NONE)
+            continue;
+        st = scad_eval_expr(&sc->ev, arg->expr_begin, arg->expr_end, &value, err);
+        if (st != MCSG_OK)
+            break;
+        if (arg->name_len) {
+            bind_named(sc, ca, arg, &value);
+        } else if ((slot = next_positional(ca, module, &position)) >= 0) {
+            ca->slot[slot].value = value;
+            ca->slot[slot].line = arg->line;
+            ca->slot[slot].col = arg->col;
+        } else if (!warned_surplus) {
+            scad_warn_at(sc->ev.ctx, sc->name, arg->line, arg->col, "%s(): ignoring surplus "
+                         "positional arguments", ca->module);
+            warned_surplus = true;
+        }
+    }
+    /* The special variables, all evaluated in the caller's scope before any of them
+     * takes effect. */
+    for (uint32_t i = 0; i < stmt->arg_count && st == MCSG_OK; i++) {
+        scad_value value;
+        if (args[i].var == SCAD_NONE)
+            continue;
+        st = scad_eval_expr(&sc->ev, args[i].expr_begin, args[i].expr_end, &value, err);
+        if (st == MCSG_OK)
+            st = scad_bind(&sc->ev, args[i].var, &value, false, err);
+    }
+    if (st == MCSG_OK)
+        scad_activate_bindings(&sc->ev, first_binding);
+    return st;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Argument access */
+
+static bool given(const call_args *ca, int slot) { return ca->slot[slot].value.type != VAL_UNDEF; }
+
+static const scad_value *element(const scad_context *sc, const scad_value *v, uint32_t i)
+{
+    return &sc->ev.heap[v->start + i];
+}
+
+static mcsg_status wrong_type(const scad_context *sc, const call_args *ca, int slot,
+                              const char *expected, mcsg_error *err)
+{
+    const bound_arg *a = &ca->slot[slot];
+    bool missing = a->line == 0; /* not given at all: point at the call */
+    return scad_fail_at(sc->name, missing ? ca->stmt->line : a->line,
+                        missing ? ca->stmt->col : a->col, err, MCSG_ERR_PARSE,
+                        "%s(): `%s` must be %s, not %s", ca->module,
+                        module_params[ca->stmt->module][slot], expected,
+                        scad_type_name((scad_type)a->value.type));
+}
+
+/* A number, if given (else *x is left alone). */
+static mcsg_status arg_number(const scad_context *sc, const call_args *ca, int slot, double *x,
+                              mcsg_error *err)
+{
+    if (!given(ca, slot))
+        return MCSG_OK;
+    if (ca->slot[slot].value.type != VAL_NUMBER)
+        return wrong_type(sc, ca, slot, "a number", err);
+    *x = ca->slot[slot].value.number;
+    return MCSG_OK;
+}
+
+static mcsg_status arg_bool(const scad_context *sc, const call_args *ca, int slot, bool *b,
+                            mcsg_error *err)
+{
+    if (!given(ca, slot))
+        return MCSG_OK;
+    if (ca->slot[slot].value.type != VAL_BOOL)
+        return wrong_type(sc, ca, slot, "true or false", err);
+    *b = ca->slot[slot].value.number != 0;
+    return MCSG_OK;
+}
+
+/* A vector of 3 numbers, or of 2 when two_ok (the third is then `z`). */
+static bool get_vec3(const scad_context *sc, const scad_value *v, bool two_ok, double z,
+                     double out[3])
+{
+    if (v->type != VAL_VECTOR || !(v->count == 3 || (two_ok && v->count == 2)))
+        return false;
+    for (uint32_t i = 0; i < v->count; i++) {
+        if (element(sc, v, i)->type != VAL_NUMBER)
+            return false;
+    }
+    for (uint32_t i = 0; i < 3; i++)
+        out[i] = i < v->count ? element(sc, v, i)->number : z;
+    return true;
+}
+
+static mcsg_status arg_finite_vec3(const scad_context *sc, const call_args *ca, int slot,
+                                   double z, double out[3], mcsg_error *err)
+{
+    if (!get_vec3(sc, &ca->slot[slot].value, true, z, out))
+        return wrong_type(sc, ca, slot, "a vector of 2 or 3 numbers", err);
+    if (!isfinite(out[0]) || !isfinite(out[1]) || !isfinite(out[2]))
+        return scad_fail_at(sc->name, ca->slot[slot].line, ca->slot[slot].col, err,
+                            MCSG_ERR_PARSE, "%s(): `%s` must be finite", ca->module,
+                            module_params[ca->stmt->module][slot]);
+    return MCSG_OK;
+}
+
+/* OpenSCAD's lookup_radius: the diameter, halved, if given; else the radius. */
+static mcsg_status arg_radius(const scad_context *sc, const call_args *ca, int d_slot,
+                              int r_slot, double *r, bool *defined, mcsg_error *err)
+{
+    double d = 0;
+    mcsg_status st = arg_number(sc, ca, d_slot, &d, err);
+    if (st == MCSG_OK)
+        st = arg_number(sc, ca, r_slot, r, err);
+    *defined = given(ca, d_slot) || given(ca, r_slot);
+    if (st != MCSG_OK || !given(ca, d_slot))
+        return st;
+    if (given(ca, r_slot))
+        scad_warn_at(sc->ev.ctx, sc->name, ca->slot[r_slot].line, ca->slot[r_slot].col,
+                     "%s(): ignoring `%s` as `%s` is given too", ca->module,
+                     module_params[ca->stmt->module][r_slot],
+                     module_params[ca->stmt->module][d_slot]);
+    *r = d / 2.0;
+    return MCSG_OK;
+}
+
+/* $fn, $fa, $fs in scope, with OpenSCAD's clamping of $fa and $fs. */
+static mcsg_status get_resolution(scad_context *sc, const call_args *ca, mcsg_resolution *res,
+                                  mcsg_error *err)
+{
+    static const uint32_t vars[3] = {VAR_FN, VAR_FA, VAR_FS};
+    static const char *const names[3] = {"$fn", "$fa", "$fs"};
+    double v[3];
+    for (int i = 0; i < 3; i++) {
+        scad_value value = scad_lookup(&sc->ev, vars[i]);
+        if (value.type != VAL_NUMBER)
+            return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, MCSG_ERR_PARSE,
+                                "%s(): %s must be a number, not %s", ca->module, names[i],
+                                scad_type_name((scad_type)value.type));
+        v[i] = value.number;
+        if (i > 0 && v[i] < F_MINIMUM) {
+            scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                         "%s(): %s too small, clamping to 0.01", ca->module, names[i]);
+            v[i] = F_MINIMUM;
+        }
+    }
+    res->fn = v[0];
+    res->fa = v[1];
+    res->fs = v[2];
+    return MCSG_OK;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Labels and leaves */
+
+static bool put_number(const mci_ctx *ctx, mci_buf *buf, const char *prefix, double x)
+{
+    char text[MCI_DOUBLE_TEXT_MAX];
+    mci_format_double(text, x);
+    return mci_buf_printf(ctx, buf, "%s%s", prefix, text);
+}
+
+static bool put_resolution(const mci_ctx *ctx, mci_buf *buf, const mcsg_resolution *res)
+{
+    if (res->fn > 0)
+        return put_number(ctx, buf, ", $fn=", res->fn);
+    return put_number(ctx, buf, ", $fa=", res->fa) && put_number(ctx, buf, ", $fs=", res->fs);
+}
+
+static bool is_identity(const double m[12])
+{
+    static const double id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    for (int i = 0; i < 12; i++) {
+        if (m[i] != id[i])
+            return false;
+    }
+    return true;
+}
+
+/* Give a failure from a library call (a size limit, say) the call's position; an
+ * allocation failure keeps its plain message. */
+static mcsg_status at_call(const scad_context *sc, const call_args *ca, mcsg_status st,
+                           mcsg_error *err)
+{
+    char message[MCSG_ERROR_MESSAGE_SIZE];
+    if (st == MCSG_OK || st == MCSG_ERR_NOMEM || !err)
+        return st;
+    memcpy(message, err->message, sizeof message);
+    message[sizeof message - 1] = 0;
+    return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st, "%s(): %s",
+                        ca->module, message);
+}
+
+/* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
+ * an empty mesh or a flattening transform gives the empty set instead. */
+static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_transform *t,
+                            mcsg_mesh *mesh, mci_buf *label, mcsg_node_id *node,
+                            mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    bool empty = t->degenerate || mesh->triangle_count == 0;
+    int call_len = (int)label->len; /* the call as written, e.g. import("a.off") */
+    mcsg_status st;
+    if (!mci_buf_printf(ctx, label, " at %s:%u:%u%s", sc->name, ca->stmt->line, ca->stmt->col,
+                        !empty ? "" : t->degenerate ? " (empty: flattened by a transform)"
+                                                    : " (empty)")) {
+        mci_mesh_free(ctx, mesh);
+        return mci_fail_nomem(err, "reading CSG text");
+    }
+    if (!empty) {
+        if (!is_identity(t->m))
+            mcsg_mesh_transform(mesh, t->m);
+        for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
+            if (!isfinite(mesh->vertices[i])) {
+                mci_mesh_free(ctx, mesh);
+                return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err,
+                                    MCSG_ERR_PARSE, "%.*s: vertex %zu is not finite%s",
+                                    call_len, (const char *)label->data, i / 3,
+                                    is_identity(t->m) ? ""
+                                    : " after the transforms above it");
+            }
+        }
+        return at_call(sc, ca, mci_tree_add_leaf_owned(sc->tree, mesh,
+                                                        (const char *)label->data, node, err),
+                       err);
+    }
+    if (!t->degenerate)
+        scad_warn_at(ctx, sc->name, ca->stmt->line, ca->stmt->col, "%s() is empty",
+                     ca->module);
+    mci_mesh_free(ctx, mesh);
+    st = mcsg_tree_add_op(sc->tree, MCSG_NODE_UNION, NULL, 0, (const char *)label->data, node,
+                          err);
+    return at_call(sc, ca, st, err);
+}
+
+static mcsg_status nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *err)
+{
+    mci_mesh_free(ctx, mesh);
+    return mci_fail_nomem(err, "reading CSG text");
+}
+
+static mcsg_status make_cube(scad_context *sc, const call_args *ca, const scad_transform *t,
+                             mci_buf *label, mcsg_node_id *node, mcsg_error *err)
+{
+    const scad_value *size = &ca->slot[CUBE_SIZE].value;
+    double s[3] = {1, 1, 1};
+    bool center = false;
+    mcsg_mesh mesh;
+    mcsg_status st = MCSG_OK;
+    if (size->type == VAL_NUMBER)
+        s[0] = s[1] = s[2] = size->number;
+    else if (given(ca, CUBE_SIZE) && !get_vec3(sc, size, false, 0, s))
+        st = wrong_type(sc, ca, CUBE_SIZE, "a number or a vector of 3 numbers", err);
+    if (st == MCSG_OK)
+        st = arg_bool(sc, ca, CUBE_CENTER, &center, err);
+    if (st == MCSG_OK)
+        st = at_call(sc, ca, mcsg_make_cube(s, center, sc->opts, &mesh, err), err);
+    if (st != MCSG_OK)
+        return st;
+    if (!put_number(sc->ev.ctx, label, "cube(size=[", s[0]) ||
+        !put_number(sc->ev.ctx, label, ", ", s[1]) || !put_number(sc->ev.ctx, label, ", ", s[2]) ||
+        !mci_buf_printf(sc->ev.ctx, label, "], center=%s)", center ? "true" : "false"))
+        return nomem_label(&mesh, sc->ev.ctx, err);
+    return add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
+static mcsg_status make_sphere(scad_context *sc, const call_args *ca, const scad_transform *t,
+                               mci_buf *label, mcsg_node_id *node, mcsg_error *err)
+{
+    double r = 1;
+    bool defined;
+    mcsg_resolution res;
+    mcsg_mesh mesh;
+    mcsg_status st = arg_radius(sc, ca, SPHERE_D, SPHERE_R, &r, &defined, err);
+    if (st == MCSG_OK)
+        st = get_resolution(sc, ca, &res, err);
+    if (st == MCSG_OK)
+        st = at_call(sc, ca, mcsg_make_sphere(r, res, sc->opts, &mesh, err), err);
+    if (st != MCSG_OK)
+        return st;
+    if (!put_number(sc->ev.ctx, label, "sphere(r=", r) ||
+        !put_resolution(sc->ev.ctx, label, &res) || !mci_buf_printf(sc->ev.ctx, label, ")"))
+        return nomem_label(&mesh, sc->ev.ctx, err);
+    return add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
+/* OpenSCAD's cylinder radii: r sets both, r1/d1 and r2/d2 override it. */
+static mcsg_status cylinder_radii(scad_context *sc, const call_args *ca, double *r1,
+                                  double *r2, mcsg_error *err)
+{
+    double r = 1, one = 1, two = 1;
+    bool has_r, has_r1, has_r2;
+    mcsg_status st = arg_radius(sc, ca, CYL_D, CYL_R, &r, &has_r, err);
+    if (st == MCSG_OK)
+        st = arg_radius(sc, ca, CYL_D1, CYL_R1, &one, &has_r1, err);
+    if (st == MCSG_OK)
+        st = arg_radius(sc, ca, CYL_D2, CYL_R2, &two, &has_r2, err);
+    if (st != MCSG_OK)
+        return st;
+    if (has_r && (has_r1 || has_r2))
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "cylinder(): parameters ambiguous (r or d together with r1, r2, d1 or d2)");
+    *r1 = has_r1 ? one : has_r ? r : 1;
+    *r2 = has_r2 ? two : has_r ? r : 1;
+    return MCSG_OK;
+}
+
+static mcsg_status make_cylinder(scad_context *sc, const call_args *ca,
+                                 const scad_transform *t, mci_buf *label, mcsg_node_id *node,
+                                 mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    double h = 1, r1, r2;
+    bool center = false;
+    mcsg_resolution res;
+    mcsg_mesh mesh;
+    mcsg_status st = arg_number(sc, ca, CYL_H, &h, err);
+    if (st == MCSG_OK)
+        st = cylinder_radii(sc, ca, &r1, &r2, err);
+    if (st == MCSG_OK)
+        st = arg_bool(sc, ca, CYL_CENTER, &center, err);
+    if (st == MCSG_OK)
+        st = get_resolution(sc, ca, &res, err);
+    if (st == MCSG_OK)
+        st = at_call(sc, ca, mcsg_make_cylinder(h, r1, r2, center, res, sc->opts, &mesh, err),
+                     err);
+    if (st != MCSG_OK)
+        return st;
+    if (!put_number(ctx, label, "cylinder(h=", h) || !put_number(ctx, label, ", r1=", r1) ||
+        !put_number(ctx, label, ", r2=", r2) ||
+        !mci_buf_printf(ctx, label, ", center=%s", center ? "true" : "false") ||
+        !put_resolution(ctx, label, &res) || !mci_buf_printf(ctx, label, ")"))
+        return nomem_label(&mesh, ctx, err);
+    return add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* polyhedron and import */
+
+static mcsg_status polyhedron_points(scad_context *sc, const call_args *ca, mcsg_mesh *mesh,
+                                     mcsg_error *err)
+{
+    const bound_arg *a = &ca->slot[POLY_POINTS];
+    for (uint32_t i = 0; i < a->value.count; i++) {
+        double *p = mesh->vertices + 3 * (size_t)i;
+        if (!get_vec3(sc, element(sc, &a->value, i), true, 0.0, p) || !isfinite(p[0]) ||
+            !isfinite(p[1]) || !isfinite(p[2]))
+            return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE,
+                                "polyhedron(): points[%u] is not a vector of 2 or 3 finite "
+                                "numbers", i);
+    }
+    return MCSG_OK;
+}
+
+/* Check one face's indices; *corners receives its size. */
+static mcsg_status polyhedron_face(scad_context *sc, const bound_arg *a, uint32_t f,
+                                   uint32_t points, uint32_t *corners, mcsg_error *err)
+{
+    const scad_value *face = element(sc, &a->value, f);
+    if (face->type != VAL_VECTOR)
+        return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE, "polyhedron(): "
+                            "faces[%u] is %s, not a vector of point indices", f,
+                            scad_type_name((scad_type)face->type));
+    for (uint32_t k = 0; k < face->count; k++) {
+        const scad_value *index = element(sc, face, k);
+        double x = index->number;
+        if (index->type != VAL_NUMBER || !(x >= 0 && x < points) || x != floor(x)) {
+            char text[MCI_DOUBLE_TEXT_MAX] = "";
+            if (index->type == VAL_NUMBER)
+                mci_format_double(text, x);
+            return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE,
+                                "polyhedron(): faces[%u][%u] = %s is not a point index "
+                                "(the polyhedron has %u points)", f, k,
+                                index->type == VAL_NUMBER ? text
+                                : scad_type_name((scad_type)index->type), points);
+        }
+    }
+    *corners = face->count;
+    return MCSG_OK;
+}
+
+/* Fan-triangulate the reversed faces (OpenSCAD's faces are clockwise from outside). */
+static void polyhedron_triangles(scad_context *sc, const bound_arg *a, mcsg_mesh *mesh)
+{
+    uint32_t *t = mesh->triangles;
+    for (uint32_t f = 0; f < a->value.count; f++) {
+        const scad_value *face = element(sc, &a->value, f);
+        uint32_t n = face->count;
+        for (uint32_t k = 1; n >= 3 && k + 1 < n; k++) {
+            t[0] = (uint32_t)element(sc, face, n - 1)->number;
+            t[1] = (uint32_t)element(sc, face, n - 1 - k)->number;
+            t[2] = (uint32_t)element(sc, face, n - 2 - k)->number;
+            t += 3;
+        }
+    }
+}
+
+static const bound_arg *polyhedron_faces_arg(scad_context *sc, const call_args *ca)
+{
+    if (!given(ca, POLY_FACES) && given(ca, POLY_TRIANGLES)) {
+        scad_warn_at(sc->ev.ctx, sc->name, ca->slot[POLY_TRIANGLES].line,
+                     ca->slot[POLY_TRIANGLES].col, "polyhedron(): `triangles` is deprecated, "
+                     "use `faces`");
+        return &ca->slot[POLY_TRIANGLES];
+    }
+    return &ca->slot[POLY_FACES];
+}
+
+static mcsg_status make_polyhedron(scad_context *sc, const call_args *ca,
+                                   const scad_transform *t, mci_buf *label, mcsg_node_id *node,
+                                   mcsg_error *err)
+{
+    const bound_arg *faces = polyhedron_faces_arg(sc, ca);
+    uint64_t triangles = 0;
+    mcsg_mesh mesh;
+    mcsg_status st = MCSG_OK;
+    if (ca->slot[POLY_POINTS].value.type != VAL_VECTOR)
+        return wrong_type(sc, ca, POLY_POINTS, "a vector of points", err);
+    if (faces->value.type != VAL_VECTOR)
+        return wrong_type(sc, ca, (int)(faces - ca->slot), "a vector of faces", err);
+    for (uint32_t f = 0; f < faces->value.count && st == MCSG_OK; f++) {
+        uint32_t corners = 0;
+        st = polyhedron_face(sc, faces, f, ca->slot[POLY_POINTS].value.count, &corners, err);
+        if (st == MCSG_OK && corners < 3)
+            scad_warn_at(sc->ev.ctx, sc->name, faces->line, faces->col, "polyhedron(): "
+                         "ignoring faces[%u], which has fewer than 3 points", f);
+        triangles += corners >= 3 ? corners - 2 : 0;
+    }
+    if (st == MCSG_OK && triangles > UINT32_MAX)
+        st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, MCSG_ERR_LIMIT,
+                          "polyhedron(): more than %u triangles", UINT32_MAX);
+    if (st == MCSG_OK)
+        st = at_call(sc, ca, mci_mesh_alloc(sc->ev.ctx, &mesh, ca->slot[POLY_POINTS].value.count,
+                                            (size_t)triangles, err), err);
+    if (st != MCSG_OK)
+        return st;
+    st = polyhedron_points(sc, ca, &mesh, err);
+    if (st != MCSG_OK) {
+        mci_mesh_free(sc->ev.ctx, &mesh);
+        return st;
+    }
+    polyhedron_triangles(sc, faces, &mesh);
+    if (!mci_buf_printf(sc->ev.ctx, label, "polyhedron(%zu points, %u faces)",
+                        mesh.vertex_count, faces->value.count))
+        return nomem_label(&mesh, sc->ev.ctx, err);
+    return add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
+/* The file to import, resolved against the base directory, into `path`. */
+static mcsg_status import_path(scad_context *sc, const call_args *ca, const char **file,
+                               uint32_t *file_len, mci_buf *path, mcsg_error *err)
+{
+    int slot = !given(ca, IMPORT_FILE) && given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
+                                                                      : IMPORT_FILE;
+    const scad_value *v = &ca->slot[slot].value;
+    const char *dir = sc->base_dir;
+    size_t dir_len = dir ? strlen(dir) : 0;
+    if (v->type != VAL_STRING)
+        return wrong_type(sc, ca, slot, "a file name (a string)", err);
+    *file = scad_string(sc->prog, v);
+    *file_len = v->count;
+    if (v->count == 0 || memchr(*file, 0, v->count))
+        return scad_fail_at(sc->name, ca->slot[slot].line, ca->slot[slot].col, err,
+                            MCSG_ERR_PARSE, "import(): invalid file name");
+    if ((*file)[0] == '/' || dir_len == 0)
+        dir_len = 0;
+    if (!mci_buf_append(sc->ev.ctx, path, dir, dir_len) ||
+        (dir_len && dir[dir_len - 1] != '/' && !mci_buf_append(sc->ev.ctx, path, "/", 1)) ||
+        !mci_buf_append(sc->ev.ctx, path, *file, *file_len) ||
+        !mci_buf_append(sc->ev.ctx, path, "", 1))
+        return mci_fail_nomem(err, "reading CSG text");
+    return MCSG_OK;
+}
+
+static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad_transform *t,
+                               mci_buf *label, mcsg_node_id *node, mcsg_error *err)
+{
+    mci_buf path = {0};
+    const char *file = "";
+    uint32_t file_len = 0;
+    mcsg_error read_err = {MCSG_OK, ""};
+    mcsg_mesh mesh;
+    bool prefetched = false;
+    mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
+    if (st == MCSG_OK)
+        st = scad_prefetch_take(sc, (const char *)path.data, &mesh, &prefetched, err);
+    if (st == MCSG_OK && !prefetched) {
+        st = mcsg_mesh_read((const char *)path.data, MCSG_FORMAT_AUTO, sc->opts, &mesh,
+                            &read_err);
+        if (st != MCSG_OK)
+            st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                              "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+    }
+    mci_buf_free(sc->ev.ctx, &path);
+    if (st != MCSG_OK)
+        return st;
+    if (!mci_buf_printf(sc->ev.ctx, label, "import(\"%.*s\")", (int)file_len, file))
+        return nomem_label(&mesh, sc->ev.ctx, err);
+    return add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Transforms, as row-major 3x4 matrices */
+
+static void set_linear(double m[12], const double l[9], const double t[3])
+{
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            m[4 * r + c] = l[3 * r + c];
+        m[4 * r + 3] = t ? t[r] : 0.0;
+    }
+}
+
+static mcsg_status translate_matrix(scad_context *sc, const call_args *ca, double m[12],
+                                    mcsg_error *err)
+{
+    static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    double v[3] = {0, 0, 0};
+    mcsg_status st = MCSG_OK;
+    if (given(ca, 0))
+        st = arg_finite_vec3(sc, ca, 0, 0.0, v, err);
+    else
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "translate(): no vector given");
+    set_linear(m, id, v);
+    return st;
+}
+
+/* rotate(a=[x, y, z]): OpenSCAD's Rz * Ry * Rx, written out term by term. */
+static mcsg_status rotate_euler(scad_context *sc, const call_args *ca, double l[9],
+                                mcsg_error *err)
+{
+    const scad_value *a = &ca->slot[0].value;
+    double s[3] = {0, 0, 0}, c[3] = {1, 1, 1};
+    if (a->count > 3)
+        return wrong_type(sc, ca, 0, "a number or a vector of up to 3 numbers", err);
+    for (uint32_t i = 0; i < a->count; i++) {
+        const scad_value *angle = element(sc, a, i);
+        if (angle->type != VAL_NUMBER || !isfinite(angle->number))
+            return wrong_type(sc, ca, 0, "a number or a vector of up to 3 finite numbers", err);
+        s[i] = mci_sin_degrees(angle->number);
+        c[i] = mci_cos_degrees(angle->number);
+    }
+    if (given(ca, 1))
+        scad_warn_at(sc->ev.ctx, sc->name, ca->slot[1].line, ca->slot[1].col,
+                     "rotate(): `v` is ignored when `a` is a vector");
+    l[0] = c[1] * c[2];
+    l[1] = c[2] * s[0] * s[1] - c[0] * s[2];
+    l[2] = c[0] * c[2] * s[1] + s[0] * s[2];
+    l[3] = c[1] * s[2];
+    l[4] = c[0] * c[2] + s[0] * s[1] * s[2];
+    l[5] = -c[2] * s[0] + c[0] * s[1] * s[2];
+    l[6] = -s[1];
+    l[7] = c[1] * s[0];
+    l[8] = c[0] * c[1];
+    return MCSG_OK;
+}
+
+static mcsg_status rotate_matrix(scad_context *sc, const call_args *ca, double m[12],
+                                 mcsg_error *err)
+{
+    double l[9], a = 0, axis[3] = {0, 0, 1};
+    mcsg_status st = MCSG_OK;
+    if (ca->slot[0].value.type == VAL_VECTOR) {
+        st = rotate_euler(sc, ca, l, err);
+    } else {
+        if (!given(ca, 0))
+            scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                         "rotate(): no angle given");
+        st = arg_number(sc, ca, 0, &a, err);
+        if (st == MCSG_OK && !isfinite(a))
+            st = wrong_type(sc, ca, 0, "a finite number", err);
+        if (st == MCSG_OK && given(ca, 1))
+            st = arg_finite_vec3(sc, ca, 1, 0.0, axis, err);
+        mci_angle_axis_degrees(a, axis, l);
+    }
+    set_linear(m, l, NULL);
+    return st;
+}
+
+static mcsg_status scale_matrix(scad_context *sc, const call_args *ca, double m[12],
+                                mcsg_error *err)
+{
+    double v[3] = {1, 1, 1}, l[9] = {0};
+    mcsg_status st = MCSG_OK;
+    if (ca->slot[0].value.type == VAL_NUMBER)
+        v[0] = v[1] = v[2] = ca->slot[0].value.number;
+    else if (given(ca, 0))
+        st = arg_finite_vec3(sc, ca, 0, 1.0, v, err);
+    else
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "scale(): no factor given");
+    if (st == MCSG_OK && !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])))
+        st = wrong_type(sc, ca, 0, "finite", err);
+    l[0] = v[0];
+    l[4] = v[1];
+    l[8] = v[2];
+    set_linear(m, l, NULL);
+    return st;
+}
+
+/* Reflection through the plane through the origin normal to v (identity for v = 0). */
+static mcsg_status mirror_matrix(scad_context *sc, const call_args *ca, double m[12],
+                                 mcsg_error *err)
+{
+    double v[3] = {1, 0, 0}, l[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, a;
+    mcsg_status st = MCSG_OK;
+    if (given(ca, 0))
+        st = arg_finite_vec3(sc, ca, 0, 0.0, v, err);
+    else
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "mirror(): no vector given, mirroring x");
+    a = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (st == MCSG_OK && (v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0)) {
+        /* OpenSCAD's expressions: divide inside each term rather than normalising v. */
+        for (int r = 0; r < 3; r++) {
+            for (int c = 0; c < 3; c++)
+                l[3 * r + c] = (r == c) ? 1 - 2 * v[r] * v[r] / a : -2 * v[c] * v[r] / a;
+        }
+    }
+    set_linear(m, l, NULL);
+    return st;
+}
+
+/* multmatrix(m): up to 4 rows of up to 4 numbers over the identity, then divided by
+ * m[3][3] when that is not 1; the bottom row is otherwise ignored (an affine map). */
+static mcsg_status multmatrix_matrix(scad_context *sc, const call_args *ca, double m[12],
+                                     mcsg_error *err)
+{
+    const scad_value *rows = &ca->slot[0].value;
+    double full[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, w;
+    if (!given(ca, 0))
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "multmatrix(): no matrix given");
+    else if (rows->type != VAL_VECTOR || rows->count > 4)
+        return wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
+    for (uint32_t r = 0; given(ca, 0) && r < rows->count; r++) {
+        const scad_value *row = element(sc, rows, r);
+        if (row->type != VAL_VECTOR || row->count > 4)
+            return wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
+        for (uint32_t c = 0; c < row->count; c++) {
+            if (element(sc, row, c)->type != VAL_NUMBER)
+                return wrong_type(sc, ca, 0, "a matrix of numbers", err);
+            full[4 * r + c] = element(sc, row, c)->number;
+        }
+    }
+    w = full[15];
+    for (int i = 0; i < 12; i++) {
+        m[i] = w != 1.0 ? full[i] / w : full[i];
+        if (!isfinite(m[i]))
+            return scad_fail_at(sc->name, ca->slot[0].line, ca->slot[0].col, err,
+                                MCSG_ERR_PARSE, "multmatrix(): the matrix is not finite%s",
+                                w == 0 ? " (m[3][3] is 0)" : "");
+    }
+    return MCSG_OK;
+}
+
+/* parent * own, with Eigen's order of operations for a 4x4 affine product. */
+static void compose(const double p[12], const double o[12], double out[12])
+{
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 4; c++) {
+            double sum = p[4 * r] * o[c] + p[4 * r + 1] * o[4 + c] + p[4 * r + 2] * o[8 + c];
+            out[4 * r + c] = c == 3 ? sum + p[4 * r + 3] : sum;
+        }
+    }
+}
+
+static double determinant(const double m[12])
+{
+    return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+           m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+
+/* The transform for the children of a transform module. */
+static mcsg_status child_transform(scad_context *sc, const call_args *ca,
+                                   const scad_transform *parent, scad_transform *child,
+                                   mcsg_error *err)
+{
+    double own[12];
+    mcsg_status st;
+    switch ((scad_module)ca->stmt->module) {
+    case MOD_TRANSLATE: st = translate_matrix(sc, ca, own, err); break;
+    case MOD_ROTATE: st = rotate_matrix(sc, ca, own, err); break;
+    case MOD_SCALE: st = scale_matrix(sc, ca, own, err); break;
+    case MOD_MIRROR: st = mirror_matrix(sc, ca, own, err); break;
+    case MOD_MULTMATRIX: st = multmatrix_matrix(sc, ca, own, err); break;
+    default: *child = *parent; return MCSG_OK;
+    }
+    if (st != MCSG_OK)
+        return st;
+    compose(parent->m, own, child->m);
+    child->degenerate = parent->degenerate || determinant(own) == 0 ||
+                        determinant(child->m) == 0;
+    if (child->degenerate && !parent->degenerate)
+        scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col, "%s() flattens its "
+                     "children to zero volume: they are treated as empty (OpenSCAD makes them "
+                     "degenerate)", ca->module);
+    return MCSG_OK;
+}
+
+mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transform *parent,
+                             scad_transform *child, scad_role *role, mcsg_node_id *node,
+                             mcsg_error *err)
+{
+    const scad_stmt *s = &sc->prog->stmts[stmt];
+    call_args ca;
+    mci_buf label = {0};
+    mcsg_status st = bind_arguments(sc, s, &ca, err);
+    *node = MCSG_NO_NODE;
+    *role = (s->module <= MOD_INTERSECTION) ? ROLE_OP : ROLE_GROUP;
+    if (st != MCSG_OK)
+        return st;
+    switch ((scad_module)s->module) {
+    case MOD_CUBE: st = make_cube(sc, &ca, parent, &label, node, err); break;
+    case MOD_SPHERE: st = make_sphere(sc, &ca, parent, &label, node, err); break;
+    case MOD_CYLINDER: st = make_cylinder(sc, &ca, parent, &label, node, err); break;
+    case MOD_POLYHEDRON: st = make_polyhedron(sc, &ca, parent, &label, node, err); break;
+    case MOD_IMPORT: st = make_import(sc, &ca, parent, &label, node, err); break;
+    default: st = child_transform(sc, &ca, parent, child, err); break;
+    }
+    mci_buf_free(sc->ev.ctx, &label);
+    return st;
+}

@@ -1,0 +1,356 @@
+/*
+ * The CSG-language reader's entry points and its walk over the parsed statements.
+ * The walk is an explicit-stack depth-first traversal (files may nest 100,000 levels),
+ * creating each tree node after its children, as mcsg_tree requires. It follows
+ * OpenSCAD's evaluation rules:
+ *  - a scope's assignments ($fn = 8;) are all evaluated before its calls, in source
+ *    order; assigning one variable twice in a scope keeps the first position with the
+ *    last value (with a warning), as OpenSCAD does;
+ *  - special variables are dynamically scoped: a call's $-arguments and its scope's
+ *    assignments hold for the call and everything inside it;
+ *  - transforms multiply down the tree and are applied to each leaf's mesh;
+ *  - `*` (disable) drops a call without evaluating it; `%` (background) is likewise left
+ *    out of the result (OpenSCAD only previews it); `#` (highlight) changes nothing;
+ *  - union/difference/intersection always make an operation node; group, render, color,
+ *    the transforms and the file itself unite their children implicitly: no node for a
+ *    single child, a union node for several, the empty set (a childless union) for none.
+ */
+#include "scad/scad.h"
+#include "mesh/tree.h"
+
+#include <string.h>
+
+typedef struct walk_frame {
+    uint32_t stmt;      /* the call (or the root) whose scope is being walked */
+    uint32_t next;      /* next statement of that scope, or SCAD_NONE */
+    uint32_t results;   /* height of the result stack when the scope was entered */
+    uint32_t bindings;  /* binding-stack height before the call's arguments */
+    uint32_t heap;      /* value-heap height before the call's arguments */
+    uint32_t transform; /* index of the children's transform */
+    bool own_transform; /* that transform was pushed for this frame */
+    uint8_t role;       /* scad_role */
+} walk_frame;
+
+typedef struct walker {
+    scad_context *sc;
+    walk_frame *frames;
+    uint32_t frame_len, frame_cap;
+    scad_transform *transforms;
+    uint32_t transform_len, transform_cap;
+    mcsg_node_id *results;
+    uint32_t result_len, result_cap;
+    uint32_t *seen_in_scope; /* var -> serial of the last scope that assigned it */
+    uint32_t *last_assign;   /* var -> that scope's last assignment to it */
+    uint32_t scope_serial;
+} walker;
+
+/* Make room for one more element; false on allocation failure. */
+static bool room(const mci_ctx *ctx, void **data, uint32_t *cap, uint32_t len, size_t elem)
+{
+    void *grown;
+    uint32_t new_cap;
+    if (len < *cap)
+        return true;
+    if (*cap >= UINT32_MAX / 2)
+        return false;
+    new_cap = *cap ? *cap * 2 : 64;
+    grown = mci_realloc_array(ctx, *data, new_cap, elem);
+    if (!grown)
+        return false;
+    *data = grown;
+    *cap = new_cap;
+    return true;
+}
+
+static mcsg_status push_result(walker *w, mcsg_node_id id, mcsg_error *err)
+{
+    void *data = w->results;
+    if (!room(w->sc->ev.ctx, &data, &w->result_cap, w->result_len, sizeof *w->results))
+        return mci_fail_nomem(err, "reading CSG text");
+    w->results = data;
+    w->results[w->result_len++] = id;
+    return MCSG_OK;
+}
+
+/* Evaluate the assignments of the scope of `stmt` (hoisted, OpenSCAD-style). */
+static mcsg_status enter_scope(walker *w, uint32_t stmt, mcsg_error *err)
+{
+    const scad_program *prog = w->sc->prog;
+    uint32_t serial = ++w->scope_serial;
+    mcsg_status st = MCSG_OK;
+    for (uint32_t c = prog->stmts[stmt].first_child; c != SCAD_NONE; c = prog->stmts[c].next) {
+        if (prog->stmts[c].kind == ST_ASSIGN)
+            w->last_assign[prog->stmts[c].var] = c;
+    }
+    for (uint32_t c = prog->stmts[stmt].first_child; c != SCAD_NONE && st == MCSG_OK;
+         c = prog->stmts[c].next) {
+        const scad_stmt *s = &prog->stmts[c], *last;
+        scad_value value;
+        if (s->kind != ST_ASSIGN || w->seen_in_scope[s->var] == serial)
+            continue;
+        w->seen_in_scope[s->var] = serial;
+        last = &prog->stmts[w->last_assign[s->var]];
+        if (last != s)
+            scad_warn_at(w->sc->ev.ctx, w->sc->name, last->line, last->col, "%.*s was "
+                         "assigned on line %u but is overwritten here (the last value counts, "
+                         "from the first position)", (int)prog->vars[s->var].len,
+                         prog->vars[s->var].text, s->line);
+        st = scad_eval_expr(&w->sc->ev, last->expr_begin, last->expr_end, &value, err);
+        if (st == MCSG_OK)
+            st = scad_bind(&w->sc->ev, s->var, &value, true, err);
+    }
+    return st;
+}
+
+static mcsg_status push_frame(walker *w, uint32_t stmt, uint32_t bindings, uint32_t heap,
+                              uint32_t transform, bool own_transform, scad_role role,
+                              mcsg_error *err)
+{
+    void *data = w->frames;
+    walk_frame *f;
+    if (!room(w->sc->ev.ctx, &data, &w->frame_cap, w->frame_len, sizeof *f))
+        return mci_fail_nomem(err, "reading CSG text");
+    w->frames = data;
+    f = &w->frames[w->frame_len++];
+    f->stmt = stmt;
+    f->next = w->sc->prog->stmts[stmt].first_child;
+    f->results = w->result_len;
+    f->bindings = bindings;
+    f->heap = heap;
+    f->transform = transform;
+    f->own_transform = own_transform;
+    f->role = (uint8_t)role;
+    return enter_scope(w, stmt, err);
+}
+
+static bool is_transform(scad_module m) { return m >= MOD_TRANSLATE && m <= MOD_MULTMATRIX; }
+
+static mcsg_status push_transform(walker *w, const scad_transform *t, mcsg_error *err)
+{
+    void *data = w->transforms;
+    if (!room(w->sc->ev.ctx, &data, &w->transform_cap, w->transform_len, sizeof *t))
+        return mci_fail_nomem(err, "reading CSG text");
+    w->transforms = data;
+    w->transforms[w->transform_len++] = *t;
+    return MCSG_OK;
+}
+
+/* Evaluate one call: a leaf goes onto the result stack, anything else opens a frame. */
+static mcsg_status visit_call(walker *w, uint32_t stmt, uint32_t parent_transform,
+                              mcsg_error *err)
+{
+    scad_context *sc = w->sc;
+    const scad_stmt *s = &sc->prog->stmts[stmt];
+    uint32_t bindings = sc->ev.binding_len, heap = sc->ev.heap_len;
+    scad_transform child;
+    scad_role role;
+    mcsg_node_id node;
+    mcsg_status st;
+    if (s->modifiers & (MODIFIER_DISABLE | MODIFIER_BACKGROUND)) {
+        mci_log(sc->ev.ctx, MCSG_LOG_INFO, "%s:%u:%u: %s %s() is left out of the result",
+                sc->name, s->line, s->col, (s->modifiers & MODIFIER_DISABLE) ? "disabled (*)"
+                : "background (%)", scad_module_name((scad_module)s->module));
+        return MCSG_OK;
+    }
+    st = scad_instantiate(sc, stmt, &w->transforms[parent_transform], &child, &role, &node,
+                          err);
+    if (st == MCSG_OK && node != MCSG_NO_NODE) {
+        if (s->first_child != SCAD_NONE)
+            scad_warn_at(sc->ev.ctx, sc->name, s->line, s->col, "%s() takes no children: "
+                         "ignoring them", scad_module_name((scad_module)s->module));
+        scad_unbind_to(&sc->ev, bindings);
+        sc->ev.heap_len = heap;
+        return push_result(w, node, err);
+    }
+    if (st == MCSG_OK && is_transform((scad_module)s->module)) {
+        st = push_transform(w, &child, err);
+        if (st == MCSG_OK)
+            st = push_frame(w, stmt, bindings, heap, w->transform_len - 1, true, role, err);
+    } else if (st == MCSG_OK) {
+        st = push_frame(w, stmt, bindings, heap, parent_transform, false, role, err);
+    }
+    return st;
+}
+
+static mcsg_status frame_label(const walker *w, const walk_frame *f, mci_buf *label)
+{
+    const scad_context *sc = w->sc;
+    const scad_stmt *s = &sc->prog->stmts[f->stmt];
+    bool ok = s->kind == ST_ROOT
+                  ? mci_buf_printf(sc->ev.ctx, label, "top level of %s", sc->name)
+                  : mci_buf_printf(sc->ev.ctx, label, "%s() at %s:%u:%u",
+                                   scad_module_name((scad_module)s->module), sc->name,
+                                   s->line, s->col);
+    return ok ? MCSG_OK : MCSG_ERR_NOMEM;
+}
+
+/* A scope is done: combine its results into one node for the enclosing scope. */
+static mcsg_status exit_frame(walker *w, mcsg_error *err)
+{
+    static const mcsg_node_kind ops[3] = {MCSG_NODE_UNION, MCSG_NODE_DIFFERENCE,
+                                          MCSG_NODE_INTERSECTION};
+    walk_frame f = w->frames[--w->frame_len];
+    const scad_stmt *s = &w->sc->prog->stmts[f.stmt];
+    uint32_t count = w->result_len - f.results;
+    mcsg_node_id node;
+    mci_buf label = {0};
+    mcsg_status st = MCSG_OK;
+    if (f.role == ROLE_GROUP && count == 1) {
+        node = w->results[f.results];
+    } else if (frame_label(w, &f, &label) != MCSG_OK) {
+        st = mci_fail_nomem(err, "reading CSG text");
+    } else {
+        mcsg_node_kind kind = f.role == ROLE_OP ? ops[s->module] : MCSG_NODE_UNION;
+        st = mcsg_tree_add_op(w->sc->tree, kind, count ? w->results + f.results : NULL, count,
+                              (const char *)label.data, &node, err);
+        if (st != MCSG_OK && st != MCSG_ERR_NOMEM) /* the node limit */
+            st = scad_fail_at(w->sc->name, s->line, s->col, err, st, "too many nodes");
+    }
+    mci_buf_free(w->sc->ev.ctx, &label);
+    if (st != MCSG_OK)
+        return st;
+    w->result_len = f.results;
+    scad_unbind_to(&w->sc->ev, f.bindings);
+    w->sc->ev.heap_len = f.heap;
+    if (f.own_transform)
+        w->transform_len--;
+    return push_result(w, node, err);
+}
+
+static mcsg_status walk_steps(walker *w, mcsg_error *err)
+{
+    const scad_program *prog = w->sc->prog;
+    mcsg_status st = MCSG_OK;
+    while (st == MCSG_OK && w->frame_len > 0) {
+        walk_frame *top = &w->frames[w->frame_len - 1];
+        uint32_t stmt = top->next;
+        if (stmt == SCAD_NONE) {
+            st = exit_frame(w, err);
+            continue;
+        }
+        top->next = prog->stmts[stmt].next;
+        if (prog->stmts[stmt].kind == ST_CALL)
+            st = visit_call(w, stmt, top->transform, err);
+    }
+    return st;
+}
+
+/* Bind OpenSCAD's defaults for the predefined special variables ($preview is false:
+ * meshcsg renders, like `openscad -o`). */
+static mcsg_status bind_defaults(scad_eval *ev, mcsg_error *err)
+{
+    static const double defaults[VAR_PREDEFINED] = {0, 12, 2, 0, 0};
+    mcsg_status st = MCSG_OK;
+    for (uint32_t var = 0; var < VAR_PREDEFINED && st == MCSG_OK; var++) {
+        scad_value v;
+        memset(&v, 0, sizeof v);
+        v.type = var == VAR_PREVIEW ? VAL_BOOL : VAL_NUMBER;
+        v.number = defaults[var];
+        st = scad_bind(ev, var, &v, true, err);
+    }
+    return st;
+}
+
+static mcsg_status walk(scad_context *sc, mcsg_error *err)
+{
+    static const scad_transform identity = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}, false};
+    const mci_ctx *ctx = sc->ev.ctx;
+    walker w;
+    mcsg_status st;
+    memset(&w, 0, sizeof w);
+    w.sc = sc;
+    w.seen_in_scope = mci_calloc_array(ctx, sc->prog->var_count, sizeof *w.seen_in_scope);
+    w.last_assign = mci_calloc_array(ctx, sc->prog->var_count, sizeof *w.last_assign);
+    st = (w.seen_in_scope && w.last_assign) ? MCSG_OK
+                                            : mci_fail_nomem(err, "reading CSG text");
+    if (st == MCSG_OK)
+        st = bind_defaults(&sc->ev, err);
+    if (st == MCSG_OK)
+        st = push_transform(&w, &identity, err);
+    if (st == MCSG_OK)
+        st = push_frame(&w, 0, sc->ev.binding_len, sc->ev.heap_len, 0, false, ROLE_GROUP, err);
+    if (st == MCSG_OK)
+        st = walk_steps(&w, err);
+    if (st == MCSG_OK)
+        st = mcsg_tree_set_root(sc->tree, w.results[0], err);
+    mci_free(ctx, w.frames);
+    mci_free(ctx, w.transforms);
+    mci_free(ctx, w.results);
+    mci_free(ctx, w.seen_in_scope);
+    mci_free(ctx, w.last_assign);
+    return st;
+}
+
+mcsg_status mcsg_scad_read_memory(const char *text, size_t size, const char *name,
+                                  const char *base_dir, const mcsg_options *opts,
+                                  mcsg_tree **out, mcsg_error *err)
+{
+    mci_ctx ctx;
+    scad_program prog;
+    scad_context sc;
+    mcsg_status st;
+    if (!out)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_scad_read_memory: NULL output");
+    *out = NULL;
+    if (!text && size)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_scad_read_memory: NULL text");
+    name = name ? name : "<memory>";
+    if (size >= UINT32_MAX - 16)
+        return mci_fail(err, MCSG_ERR_LIMIT, "%s: CSG text of 4 GiB or more", name);
+    mci_ctx_init(&ctx, opts);
+    memset(&sc, 0, sizeof sc);
+    sc.prog = &prog;
+    sc.opts = opts;
+    sc.base_dir = base_dir;
+    sc.name = name;
+    st = scad_parse(&prog, &ctx, text ? text : "", (uint32_t)size, name, err);
+    if (st == MCSG_OK)
+        st = scad_eval_init(&sc.ev, &prog, err);
+    if (st == MCSG_OK)
+        st = mcsg_tree_create(opts, &sc.tree, err);
+    if (st == MCSG_OK)
+        st = scad_prefetch_imports(&sc, err);
+    if (st == MCSG_OK)
+        st = walk(&sc, err);
+    scad_prefetch_free(&sc);
+    scad_eval_free(&sc.ev);
+    scad_program_free(&prog);
+    if (st != MCSG_OK) {
+        mcsg_tree_free(sc.tree);
+        return st;
+    }
+    *out = sc.tree;
+    return MCSG_OK;
+}
+
+mcsg_status mcsg_scad_read(const char *path, const mcsg_options *opts, mcsg_tree **out,
+                           mcsg_error *err)
+{
+    mci_ctx ctx;
+    unsigned char *text;
+    char *dir = NULL;
+    const char *slash;
+    size_t size;
+    mcsg_status st;
+    if (out)
+        *out = NULL;
+    if (!path || !out)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_scad_read: NULL argument");
+    mci_ctx_init(&ctx, opts);
+    slash = strrchr(path, '/');
+    if (slash) {
+        size_t n = (size_t)(slash - path) + (slash == path); /* keep "/" for the root */
+        dir = mci_malloc(&ctx, n + 1);
+        if (!dir)
+            return mci_fail_nomem(err, "reading a CSG file");
+        memcpy(dir, path, n);
+        dir[n] = 0;
+    }
+    st = mci_read_file(&ctx, path, &text, &size, err);
+    if (st == MCSG_OK) {
+        st = mcsg_scad_read_memory((const char *)text, size, path, dir, opts, out, err);
+        mci_free(&ctx, text);
+    }
+    mci_free(&ctx, dir);
+    return st;
+}

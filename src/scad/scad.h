@@ -1,0 +1,251 @@
+/*
+ * Internal interface between the modules of the CSG-language reader (the OpenSCAD
+ * subset described in docs/csg-language.md):
+ *   lexer.c     bytes -> tokens (comments, numbers via mci_parse_double, strings)
+ *   parser.c    tokens -> program: statements, arguments and expressions in flat
+ *               arrays, built without recursion on statement nesting
+ *   expr.c      expression evaluation: a stack machine over postfix expressions,
+ *               values (numbers, booleans, strings, vectors) and built-in functions
+ *   modules.c   the built-in modules: argument binding, primitives, transforms,
+ *               polyhedron and import, producing tree nodes
+ *   prefetch.c  the files of import() calls, read ahead in parallel
+ *   scad.c      the public entry points and the non-recursive walk over statements
+ * Offsets and counts are 32-bit: texts of 4 GiB or more are refused up front.
+ */
+#ifndef MESHCSG_SCAD_SCAD_H
+#define MESHCSG_SCAD_SCAD_H
+
+#include "base/core.h"
+
+#define SCAD_NONE UINT32_MAX
+/* Deepest expression nesting (parentheses, vectors, unary operators, call arguments). */
+#define SCAD_MAX_EXPR_DEPTH 256
+
+/* ---------------------------------------------------------------------------------- */
+/* Tokens */
+
+typedef enum scad_tok_kind {
+    TK_EOF = 0, TK_IDENT, TK_NUMBER, TK_STRING,
+    TK_LPAREN, TK_RPAREN, TK_LBRACKET, TK_RBRACKET, TK_LBRACE, TK_RBRACE,
+    TK_COMMA, TK_SEMI, TK_ASSIGN, TK_PLUS, TK_MINUS, TK_STAR, TK_SLASH, TK_PERCENT,
+    TK_CARET, TK_BANG, TK_HASH, TK_COLON, TK_QUESTION, TK_DOT, TK_LT, TK_GT, TK_LE,
+    TK_GE, TK_EQ, TK_NE, TK_AND, TK_OR, TK_TILDE, TK_AMP, TK_PIPE, TK_LSHIFT, TK_RSHIFT
+} scad_tok_kind;
+
+typedef struct scad_token {
+    scad_tok_kind kind;
+    uint32_t line, col;    /* 1-based; col counts bytes */
+    uint32_t start, len;   /* the token's bytes in the text */
+    double number;         /* TK_NUMBER */
+    uint32_t str_off, str_len; /* TK_STRING: decoded bytes in the string pool */
+} scad_token;
+
+typedef struct scad_lexer {
+    const mci_ctx *ctx;
+    const char *text;
+    uint32_t size, pos;
+    uint32_t line, line_start; /* column = pos - line_start + 1 */
+    const char *name;          /* for messages */
+    mci_buf *strings;          /* decoded string literals */
+} scad_lexer;
+
+/* Read the next token. Errors (MCSG_ERR_PARSE, MCSG_ERR_NOMEM) name name:line:col. */
+mcsg_status scad_lex(scad_lexer *lx, scad_token *tok, mcsg_error *err);
+/* A short description of a token for messages: "`foo`", "number", "end of file". */
+void scad_describe_token(const scad_lexer *lx, const scad_token *tok, char *buf, size_t size);
+
+/* ---------------------------------------------------------------------------------- */
+/* Program */
+
+typedef enum scad_expr_op {
+    EX_NUMBER, EX_STRING, EX_BOOL, EX_UNDEF, EX_SPECIAL, EX_NEG, EX_ADD, EX_SUB, EX_MUL,
+    EX_DIV, EX_MOD, EX_POW, EX_VECTOR, EX_CALL
+} scad_expr_op;
+
+typedef enum scad_func {
+    FN_SIN, FN_COS, FN_TAN, FN_ASIN, FN_ACOS, FN_ATAN, FN_ATAN2, FN_SQRT, FN_ABS, FN_POW,
+    FN_MIN, FN_MAX, FN_FLOOR, FN_CEIL, FN_ROUND, FN_EXP, FN_LN, FN_LOG, FN_SIGN, FN_NORM,
+    FN_LEN, FN_COUNT
+} scad_func;
+
+/* One node of a postfix expression: operands come before their operator, so an
+ * expression is a contiguous range evaluated left to right with a value stack. */
+typedef struct scad_expr {
+    uint8_t op;   /* scad_expr_op */
+    uint8_t func; /* EX_CALL: scad_func */
+    uint32_t line, col;
+    uint32_t a, b; /* EX_STRING: pool offset, length; EX_VECTOR/EX_CALL: count in a;
+                      EX_SPECIAL: variable id in a; EX_BOOL: value in a */
+    double number; /* EX_NUMBER */
+} scad_expr;
+
+typedef struct scad_arg {
+    uint32_t name_start, name_len; /* name_len 0: positional */
+    uint32_t var;                  /* a $name: its special variable id, else SCAD_NONE */
+    uint32_t expr_begin, expr_end; /* [begin, end) in the expression array */
+    uint32_t line, col;
+} scad_arg;
+
+typedef enum scad_module {
+    MOD_UNION, MOD_DIFFERENCE, MOD_INTERSECTION, MOD_GROUP, MOD_RENDER, MOD_COLOR,
+    MOD_TRANSLATE, MOD_ROTATE, MOD_SCALE, MOD_MIRROR, MOD_MULTMATRIX, MOD_CUBE, MOD_SPHERE,
+    MOD_CYLINDER, MOD_POLYHEDRON, MOD_IMPORT, MOD_COUNT
+} scad_module;
+
+enum { ST_ROOT, ST_CALL, ST_ASSIGN };
+enum { MODIFIER_DISABLE = 1, MODIFIER_BACKGROUND = 2, MODIFIER_HIGHLIGHT = 4 };
+
+/* A statement. The statements of a scope (a call's children, or the file) form a list
+ * through `next`, in source order; assignments are part of that list. */
+typedef struct scad_stmt {
+    uint8_t kind;      /* ST_* */
+    uint8_t module;    /* ST_CALL: scad_module */
+    uint8_t modifiers; /* ST_CALL: MODIFIER_* */
+    uint32_t line, col;
+    uint32_t arg_begin, arg_count;  /* ST_CALL */
+    uint32_t var;                   /* ST_ASSIGN: special variable id */
+    uint32_t expr_begin, expr_end;  /* ST_ASSIGN */
+    uint32_t first_child, last_child, next;
+} scad_stmt;
+
+/* Special variables ($fn, ...) are interned: id -> name in the text. The first ones
+ * are predefined, with fixed ids. */
+enum { VAR_FN, VAR_FA, VAR_FS, VAR_T, VAR_PREVIEW, VAR_PREDEFINED };
+
+typedef struct scad_name {
+    const char *text; /* in the program text, not NUL-terminated */
+    uint32_t len;
+} scad_name;
+
+typedef struct scad_program {
+    const mci_ctx *ctx;
+    const char *text;
+    uint32_t size;
+    const char *name;
+    scad_stmt *stmts;  /* stmts[0] is the file's root scope */
+    uint32_t stmt_count, stmt_cap;
+    scad_arg *args;
+    uint32_t arg_count, arg_cap;
+    scad_expr *exprs;
+    uint32_t expr_count, expr_cap;
+    mci_buf strings;  /* decoded string literals */
+    scad_name *vars;  /* special variable id -> name */
+    uint32_t var_count, var_cap;
+    uint32_t *var_hash; /* open addressing: id + 1, 0 = empty */
+    uint32_t var_hash_cap;
+} scad_program;
+
+/* Parse `text` into *prog (which must be zeroed). On failure the program may hold
+ * partial results: release it with scad_program_free in every case. */
+mcsg_status scad_parse(scad_program *prog, const mci_ctx *ctx, const char *text,
+                       uint32_t size, const char *name, mcsg_error *err);
+void scad_program_free(scad_program *prog);
+
+/* The module's name ("cube", ...) and the comma-separated list of supported ones. */
+const char *scad_module_name(scad_module module);
+extern const char scad_supported_modules[];
+
+/* ---------------------------------------------------------------------------------- */
+/* Values and expression evaluation */
+
+typedef enum scad_type { VAL_UNDEF, VAL_BOOL, VAL_NUMBER, VAL_STRING, VAL_VECTOR } scad_type;
+
+/* A value. Strings point into the program's string pool, vectors into the evaluator's
+ * value heap (elements heap[start .. start+count)). */
+typedef struct scad_value {
+    uint8_t type;
+    uint32_t start, count;
+    double number; /* VAL_NUMBER; VAL_BOOL: 0 or 1 */
+} scad_value;
+
+typedef struct scad_binding {
+    uint32_t var, prev; /* prev: the binding this one shadows, or SCAD_NONE */
+    bool active;
+    scad_value value;
+} scad_binding;
+
+typedef struct scad_eval {
+    const scad_program *prog;
+    const mci_ctx *ctx;
+    scad_value *heap;     /* vector elements */
+    uint32_t heap_len, heap_cap, heap_limit;
+    scad_value *stack;    /* operands during one expression */
+    uint32_t stack_len, stack_cap;
+    scad_binding *bindings; /* special variables in scope, innermost last */
+    uint32_t binding_len, binding_cap;
+    uint32_t *current;    /* var id -> innermost binding, or SCAD_NONE */
+} scad_eval;
+
+mcsg_status scad_eval_init(scad_eval *ev, const scad_program *prog, mcsg_error *err);
+void scad_eval_free(scad_eval *ev);
+/* Evaluate exprs[begin, end) to *out (valid until the heap is truncated below it). */
+mcsg_status scad_eval_expr(scad_eval *ev, uint32_t begin, uint32_t end, scad_value *out,
+                           mcsg_error *err);
+/* Bind a special variable in the innermost scope; scad_unbind_to pops bindings. A
+ * binding made with active = false takes effect only at scad_activate_bindings(ev, from),
+ * which activates every inactive binding from index `from` on, in order. */
+mcsg_status scad_bind(scad_eval *ev, uint32_t var, const scad_value *value, bool active,
+                      mcsg_error *err);
+void scad_activate_bindings(scad_eval *ev, uint32_t from);
+void scad_unbind_to(scad_eval *ev, uint32_t binding_len);
+/* The value of a special variable, or undef. */
+scad_value scad_lookup(const scad_eval *ev, uint32_t var);
+const char *scad_type_name(scad_type type);
+/* The bytes of a string value (count of them; "" when empty). */
+const char *scad_string(const scad_program *prog, const scad_value *v);
+/* Append a printable form of a value ("[1, 2, 3]", "\"a.off\"") to buf. */
+bool scad_format_value(const scad_eval *ev, const scad_value *v, mci_buf *buf);
+
+/* ---------------------------------------------------------------------------------- */
+/* Module instantiation (modules.c), driven by the walk in scad.c */
+
+/* An affine map (row-major 3x4) with a flag for maps that flatten everything. */
+typedef struct scad_transform {
+    double m[12];
+    bool degenerate;
+} scad_transform;
+
+/* Meshes of import() calls read ahead of the walk (prefetch.c). */
+typedef struct scad_prefetch {
+    struct prefetched *entries; /* sorted by path */
+    size_t count;
+} scad_prefetch;
+
+typedef struct scad_context {
+    scad_eval ev;
+    const scad_program *prog;
+    const mcsg_options *opts;
+    mcsg_tree *tree;
+    const char *base_dir; /* NULL: current directory */
+    const char *name;     /* for messages and labels */
+    scad_prefetch prefetch;
+} scad_context;
+
+/* Read the files of every import() call with a literal file name, on the options'
+ * threads, into sc->prefetch (failed reads are kept as failures, not reported). */
+mcsg_status scad_prefetch_imports(scad_context *sc, mcsg_error *err);
+/* The mesh read ahead for `path`, if there is one (*found): moved out for its last
+ * call, copied for the others; the messages its read logged are logged again. */
+mcsg_status scad_prefetch_take(scad_context *sc, const char *path, mcsg_mesh *mesh,
+                               bool *found, mcsg_error *err);
+void scad_prefetch_free(scad_context *sc);
+
+/* What a call with children contributes once its children are done. */
+typedef enum scad_role { ROLE_OP, ROLE_GROUP } scad_role;
+
+/* Evaluate the arguments of call `stmt`. For a primitive, polyhedron or import, add
+ * its leaf (or an empty union) under `parent` and set *node; otherwise fill *child
+ * with the transform for the children (parent's, composed with the call's own) and
+ * *role. Special variables passed as arguments are bound (the caller unbinds them). */
+mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transform *parent,
+                             scad_transform *child, scad_role *role, mcsg_node_id *node,
+                             mcsg_error *err);
+
+/* Fail with "NAME:LINE:COL: message" and the given status. */
+mcsg_status scad_fail_at(const char *name, uint32_t line, uint32_t col, mcsg_error *err,
+                         mcsg_status status, const char *fmt, ...) MCI_PRINTF(6, 7);
+/* Warn through the log with the same prefix. */
+void scad_warn_at(const mci_ctx *ctx, const char *name, uint32_t line, uint32_t col,
+                  const char *fmt, ...) MCI_PRINTF(5, 6);
+
+#endif
