@@ -23,7 +23,7 @@ import time
 BEGIN, END = '<!-- eval-bench:begin -->', '<!-- eval-bench:end -->'
 GENERATOR_VERSION = '1'
 
-# Targets of issue 7: whole process, one thread, seconds.
+# Time targets: whole process, one thread, seconds.
 TARGETS = {
     'ring_spheres_800': 0.5, 'spheres_overlap_700': 0.5, 'cow100K_minus_shifted': 0.4,
     'armadillo_union_6bunnies': 0.6, 'cylinder_28_holes': 0.1, 'bunny_and_bunny_same': 0.1,

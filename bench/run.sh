@@ -15,7 +15,7 @@ only=()
 python3 "$root/bench/eval_bench.py" "$build/meshcsg" "$MCSG_SHARED_DIR" "$build/bench-scenes" \
   "$root/docs/benchmarks.md" --runs "${BENCH_RUNS:-5}" "${only[@]}"
 echo "docs/benchmarks.md updated"
-# The peer comparison (issue 7, optional): built by make bench when CGAL is installed.
+# The peer comparison (optional): built by make bench when CGAL is installed.
 if [ "${BENCH_CGAL:-1}" = 0 ]; then
   :
 elif [ -x "$build/cgal_csg" ]; then

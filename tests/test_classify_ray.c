@@ -7,6 +7,7 @@
  * classification) against every pair of boxes.
  */
 #include "testlib.h"
+#include "csg/leaf_boxes.h"
 #include "csg/classify.h"
 
 #include <math.h>

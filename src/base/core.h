@@ -23,6 +23,17 @@
 /* "No index": an absent face, arrangement, point or vertex in the uint32_t index arrays. */
 #define MCI_NONE UINT32_MAX
 
+/* The root of x in a union-find forest (parent[r] == r at a root), halving the path on
+ * the way. */
+static inline uint32_t mci_find_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
 typedef struct mcsg_pool mci_pool; /* the public pool type, opaque outside parallel.c */
 
 /* Resolved options: the allocator is always complete, the logger may be NULL. */

@@ -33,6 +33,18 @@ static inline bool u64_less(const uint64_t *a, const uint64_t *b)
 
 MCI_DEFINE_SORT(u64_sort, uint64_t, u64_less)
 
+static inline bool u32_less(const uint32_t *a, const uint32_t *b)
+{
+    return *a < *b;
+}
+
+MCI_DEFINE_SORT(u32_sort, uint32_t, u32_less)
+
+void mci_sort_u32(uint32_t *items, size_t n)
+{
+    u32_sort(items, n);
+}
+
 void mci_sort_u64(uint64_t *items, size_t n)
 {
     u64_sort(items, n);

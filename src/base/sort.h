@@ -17,6 +17,8 @@ typedef struct mci_keyed {
 uint64_t mci_edge_key(uint32_t u, uint32_t v);
 /* Sort by key, then ref. */
 void mci_sort_keyed(mci_keyed *items, size_t n);
+/* Sort 32-bit integers ascending (an introsort without qsort's callback). */
+void mci_sort_u32(uint32_t *items, size_t n);
 /* Sort 64-bit integers ascending (an introsort without qsort's callback). */
 void mci_sort_u64(uint64_t *items, size_t n);
 /* The same for long arrays: a least-significant-digit radix sort through tmp (n keys),

@@ -9,6 +9,7 @@
 
 #include "csg/csgtree.h"
 #include "csg/intersect.h"
+#include "csg/rays.h"
 
 /* The kept pieces: triangle t has output vertices tris[3t..3t+2] (counter-clockwise
  * seen from outside the result) and comes from face faces[t] (global face id). */
@@ -45,15 +46,6 @@ typedef struct mci_classifier {
     mci_trimmed_list *trimmed;
 } mci_classifier;
 
-/* The bounding box of a mesh's vertices: lo[3], hi[3] (zeros for an empty mesh). */
-void mci_leaf_box(const mcsg_mesh *m, double box[6]);
-
-/* The boxes each of n closed boxes meets, itself excepted: those of box i are
- * list[start[i] .. start[i + 1]), in increasing index. Both arrays are allocated with
- * ctx (the caller frees them); false when out of memory (nothing allocated). */
-bool mci_box_overlaps(const mci_ctx *ctx, const double (*box)[6], size_t n, uint32_t **start,
-                      uint32_t **list);
-
 mcsg_status mci_classifier_init(const mci_ctx *ctx, mci_scene *scene,
                                 const mci_ptree *tree, mci_classifier *cl, mcsg_error *err);
 void mci_classifier_free(const mci_ctx *ctx, mci_classifier *cl);
@@ -70,23 +62,5 @@ typedef struct mci_classify_stats {
  * input that is not closed and edge-manifold) or a label cannot be decided. */
 mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint32_t leaf,
                               mci_kept *kept, mci_classify_stats *stats, mcsg_error *err);
-
-/* Where point p is with respect to the closed mesh m, by an exact ray along +x,
- * symbolically perturbed so that rays through edges and vertices are decided
- * consistently: IN, OUT, or UNKNOWN when p lies on m's surface. */
-mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m);
-
-/* Reusable buffers for mci_ray_label_octree (zero-initialise; free when done). */
-typedef struct mci_ray_scratch {
-    uint32_t *faces, *stack;
-    size_t face_count, face_capacity, stack_capacity;
-} mci_ray_scratch;
-
-void mci_ray_scratch_free(const mci_ctx *ctx, mci_ray_scratch *s);
-
-/* mci_ray_label for the leaf m of octree o, testing only m's faces in the cells the ray
- * passes through (paper §5.2). Returns false when out of memory (*label unset). */
-bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
-                          uint32_t m, mci_ray_scratch *s, mci_label *label);
 
 #endif

@@ -111,4 +111,17 @@ static inline const double *mci_scene_corner(const mci_scene *scene, uint32_t f,
     return mci_octree_face_vertex(&scene->octree, f, k);
 }
 
+/* The plane of global face f. */
+static inline void mci_scene_face_plane(const mci_scene *scene, uint32_t f, mci_plane *plane)
+{
+    mci_plane_init(plane, mci_scene_corner(scene, f, 0), mci_scene_corner(scene, f, 1),
+                   mci_scene_corner(scene, f, 2));
+}
+
+/* The arrangement of global face f, or NULL when it was not touched. */
+static inline const mci_face_arr *mci_scene_arr_of_face(const mci_scene *scene, uint32_t f)
+{
+    return scene->arr_of[f] == MCI_NONE ? NULL : &scene->arrs[scene->arr_of[f]];
+}
+
 #endif

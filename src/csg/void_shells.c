@@ -28,13 +28,6 @@ typedef struct shell {
     size_t first, count; /* if settled exactly, its triangles: by_shell[first ..) */
 } shell;
 
-static uint32_t find_root(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-    return x;
-}
-
 /* shell_of[v] for every vertex used (dense ids, in the order of the shells' first
  * triangles; NO_SHELL for unused vertices); returns the number of shells. parent has room
  * for the vertices. */
@@ -45,18 +38,18 @@ static size_t number_shells(const mcsg_mesh *m, uint32_t *parent, uint32_t *shel
         parent[v] = (uint32_t)v, shell_of[v] = NO_SHELL;
     for (size_t t = 0; t < m->triangle_count; t++)
         for (int i = 1; i < 3; i++) {
-            uint32_t a = find_root(parent, m->triangles[3 * t]);
-            uint32_t b = find_root(parent, m->triangles[3 * t + (size_t)i]);
+            uint32_t a = mci_find_root(parent, m->triangles[3 * t]);
+            uint32_t b = mci_find_root(parent, m->triangles[3 * t + (size_t)i]);
             if (a != b)
                 parent[a > b ? a : b] = a > b ? b : a;
         }
     for (size_t t = 0; t < m->triangle_count; t++) {
-        uint32_t root = find_root(parent, m->triangles[3 * t]);
+        uint32_t root = mci_find_root(parent, m->triangles[3 * t]);
         if (shell_of[root] == NO_SHELL)
             shell_of[root] = (uint32_t)count++;
     }
     for (size_t v = 0; v < m->vertex_count; v++)
-        shell_of[v] = shell_of[find_root(parent, (uint32_t)v)];
+        shell_of[v] = shell_of[mci_find_root(parent, (uint32_t)v)];
     return count;
 }
 

@@ -250,19 +250,10 @@ static bool sort_edges(const check_state *s, const edge_use *in, size_t n, edge_
     return ok;
 }
 
-static uint32_t find_root(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
-}
-
 static void unite(uint32_t *parent, uint32_t a, uint32_t b)
 {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
+    a = mci_find_root(parent, a);
+    b = mci_find_root(parent, b);
     if (a != b)
         parent[a < b ? b : a] = a < b ? a : b;
 }
@@ -340,7 +331,7 @@ static bool count_components_and_unused(check_state *s)
     for (size_t t = 0; t < m->triangle_count; t++) {
         if (!s->tri_ok[t])
             continue;
-        if (find_root(s->parent, (uint32_t)t) == t)
+        if (mci_find_root(s->parent, (uint32_t)t) == t)
             s->report->components++;
         for (int k = 0; k < 3; k++)
             used[m->triangles[3 * t + (size_t)k]] = 1;

@@ -1,0 +1,421 @@
+/*
+ * One leaf's labels (paper §5.2, §5.3, §5.5): the candidates (leaves whose boxes meet
+ * this one's), the trimmed CSGlist, the first seed of each connected part by exact rays,
+ * and every other region's labels inherited across a separator, re-deciding only the
+ * leaves whose surface holds it by the exact local test. Copies of this leaf share its
+ * regions; a candidate that is a copy of another leaf borrows that leaf's labels.
+ */
+#include "csg/classify_leaf.h"
+#include "csg/local_test.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* The candidates: the other leaves whose boxes meet this leaf's, in increasing index. */
+static mcsg_status find_candidates(mci_leaf_work *w)
+{
+    size_t n = w->s->octree.leaf_count;
+    const uint32_t *first = w->cl->overlap + w->cl->overlap_start[w->leaf];
+    size_t count = w->cl->overlap_start[w->leaf + 1] - w->cl->overlap_start[w->leaf];
+    w->cand = mci_malloc_array(w->ctx, count + 1, sizeof *w->cand);
+    w->slot_of_leaf = mci_malloc_array(w->ctx, n + 1, sizeof *w->slot_of_leaf);
+    if (!w->cand || !w->slot_of_leaf)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t l = 0; l < n; l++)
+        w->slot_of_leaf[l] = MCI_NONE;
+    for (size_t c = 0; c < count; c++) {
+        w->slot_of_leaf[first[c]] = (uint32_t)w->ncand;
+        w->cand[w->ncand++] = first[c];
+    }
+    if (w->nreg > 0 && w->ncand > SIZE_MAX / w->nreg)
+        return mci_fail(w->err, MCSG_ERR_LIMIT, "too many labels in one leaf");
+    w->labels = mci_malloc_array(w->ctx, w->nreg * w->ncand + 1, 1);
+    if (!w->labels)
+        return mci_fail_nomem(w->err, "classifying faces");
+    memset(w->labels, MCI_LABEL_UNKNOWN, w->nreg * w->ncand);
+    return MCSG_OK;
+}
+
+static bool point_outside_box(const mci_point *p, const double box[6])
+{
+    double lo[3], hi[3];
+    mci_point_bounds(p, lo, hi);
+    for (int k = 0; k < 3; k++)
+        if (hi[k] < box[k] || lo[k] > box[3 + k])
+            return true;
+    return false;
+}
+
+static void local_labels_at(mci_leaf_work *w, uint8_t *to, size_t k, bool only_unknown);
+
+/* Labels a seed region's rays left open (every vertex tried lies on that leaf's
+ * surface): decided at a separator of the region on that leaf, if any. */
+static void seed_by_local_tests(mci_leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (uint32_t i = w->sep_start[r]; i < w->sep_start[r + 1]; i++)
+        local_labels_at(w, lab, w->sep_slots[i], true);
+}
+
+/* First seed: the region's labels by rays from its vertices (untouched faces' vertices
+ * first: they lie on no other surface). A ray from a vertex on the other leaf's surface
+ * decides nothing; the next vertex is tried. */
+static void seed_region(mci_leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1]; k++) {
+            uint32_t p = w->reg_pieces[k];
+            bool untouched = mci_scene_arr_of_face(w->s, w->pface[p]) == NULL;
+            if (untouched != (pass == 0))
+                continue;
+            for (int i = 0; i < 3; i++) {
+                mci_point v;
+                mci_label label;
+                bool all = true;
+                mci_leaf_piece_point(w, p, i, &v);
+                for (size_t c = 0; c < w->ncand; c++) {
+                    uint32_t m = w->cand[c];
+                    if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
+                        continue;
+                    if (point_outside_box(&v, w->cl->box[m])) {
+                        lab[c] = MCI_LABEL_OUT;
+                        continue;
+                    }
+                    w->stats->rays++;
+                    if (!mci_ray_label_octree(w->ctx, &v, &w->s->octree, m, &w->ray, &label)) {
+                        w->out_of_memory = true;
+                        return;
+                    }
+                    lab[c] = (uint8_t)label;
+                    all = all && label != MCI_LABEL_UNKNOWN;
+                }
+                if (all)
+                    return;
+            }
+        }
+    seed_by_local_tests(w, r);
+}
+
+/* Labels of the region of piece k / 3 with respect to the leaves holding its edge slot
+ * k, by local tests (only those still unknown if only_unknown). */
+static void local_labels_at(mci_leaf_work *w, uint8_t *to, size_t k, bool only_unknown)
+{
+    const mci_scene *s = w->s;
+    size_t p = k / 3;
+    uint64_t key = mci_edge_key(mci_leaf_slot_from(w, k), mci_leaf_slot_to(w, k));
+    mci_point x, y, far;
+    mci_leaf_piece_point(w, p, (int)(k % 3), &x);
+    mci_leaf_piece_point(w, p, (int)(k % 3 + 1) % 3, &y);
+    mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, &far);
+    for (size_t e = mci_leaf_find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++) {
+        uint32_t h = w->sep[e].ref, c = w->slot_of_leaf[s->octree.face_leaf[h]];
+        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
+            continue;
+        w->stats->local_tests++;
+        to[c] = (uint8_t)mci_local_label(s, mci_scene_arr_of_face(s, w->pface[p]), &x, &y, &far, h);
+    }
+}
+
+/* Labels of region r2 from those of r1 across separator slot k (a slot of r2): equal
+ * but for the leaves whose surface holds the separator (paper Prop. 2). */
+static void inherit_labels(mci_leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
+{
+    uint8_t *to = w->labels + (size_t)r2 * w->ncand;
+    memcpy(to, w->labels + (size_t)r1 * w->ncand, w->ncand);
+    local_labels_at(w, to, k, false);
+}
+
+/* Whether separator slot k lies on the surface of leaf m. */
+static bool separator_on_leaf(const mci_leaf_work *w, size_t k, uint32_t m)
+{
+    uint64_t key = mci_edge_key(mci_leaf_slot_from(w, k), mci_leaf_slot_to(w, k));
+    for (size_t e = mci_leaf_find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++)
+        if (w->s->octree.face_leaf[w->sep[e].ref] == m)
+            return true;
+    return false;
+}
+
+/* memchr first: the ring of ring-800 has ~800 candidates, all needed and labelled. */
+static bool has_unknown_label(const mci_leaf_work *w, uint32_t r)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand, *end = lab + w->ncand, *at = lab;
+    while ((at = memchr(at, MCI_LABEL_UNKNOWN, (size_t)(end - at))) != NULL) {
+        if (w->needed[at - lab])
+            return true;
+        at++;
+    }
+    return false;
+}
+
+/* Labels still unknown after the sweep: a seed's vertices all lie on a leaf (e.g. a
+ * face coplanar with that leaf's face), and regions reached from it across curves of
+ * other leaves inherited the unknown. They are decided by local tests at the region's
+ * own separators on that leaf, if any, and otherwise copied from neighbours across
+ * separators not on that leaf, until nothing changes. */
+static void fill_unknown_labels(mci_leaf_work *w)
+{
+    bool changed = true, any = false;
+    for (uint32_t r = 0; r < w->nreg; r++)
+        if (has_unknown_label(w, r)) {
+            seed_by_local_tests(w, r);
+            any = any || has_unknown_label(w, r);
+        }
+    while (changed && any) { /* nearly always none left: no pass over every label */
+        changed = false;
+        for (uint32_t r = 0; r < w->nreg; r++) {
+            uint8_t *lab = w->labels + (size_t)r * w->ncand;
+            for (size_t c = 0; c < w->ncand; c++) {
+                for (uint32_t i = w->sep_start[r];
+                     w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN && i < w->sep_start[r + 1]; i++) {
+                    uint32_t k = w->sep_slots[i], r2;
+                    uint8_t there;
+                    if (w->mate[k] == MCI_NONE)
+                        continue; /* a wall */
+                    r2 = w->region[w->mate[k] / 3];
+                    there = w->labels[(size_t)r2 * w->ncand + c];
+                    if (there != MCI_LABEL_UNKNOWN && !separator_on_leaf(w, k, w->cand[c])) {
+                        lab[c] = there;
+                        changed = true;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* Breadth-first over regions across separators, seeding each unreached part. */
+static mcsg_status label_regions(mci_leaf_work *w)
+{
+    uint32_t *queue = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *queue);
+    uint8_t *seen = mci_calloc_array(w->ctx, w->nreg + 1, 1);
+    size_t head = 0, tail = 0;
+    if (!queue || !seen) {
+        mci_free(w->ctx, queue);
+        mci_free(w->ctx, seen);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (uint32_t start = 0; start < w->nreg && !w->out_of_memory; start++) {
+        if (seen[start])
+            continue;
+        seed_region(w, start);
+        seen[start] = 1;
+        queue[tail++] = start;
+        while (head < tail) {
+            uint32_t r1 = queue[head++];
+            for (uint32_t i = w->sep_start[r1]; i < w->sep_start[r1 + 1]; i++) {
+                uint32_t k = w->mate[w->sep_slots[i]], r2;
+                if (k == MCI_NONE || seen[r2 = w->region[k / 3]])
+                    continue; /* a wall, or seen */
+                inherit_labels(w, r1, r2, k);
+                seen[r2] = 1;
+                queue[tail++] = r2;
+            }
+        }
+    }
+    mci_free(w->ctx, queue);
+    mci_free(w->ctx, seen);
+    if (w->out_of_memory)
+        return mci_fail_nomem(w->err, "classifying faces");
+    fill_unknown_labels(w);
+    return MCSG_OK;
+}
+
+/* Adds +1 over the node range of each entry's subtree to the difference array cover. */
+static void cover_entries(const mci_ptree *t, const mci_csg_entry *list, size_t n,
+                          int32_t *cover)
+{
+    for (size_t i = 0; i < n; i++) {
+        uint32_t node = list[i].node;
+        cover[node + 1 - t->nodes[node].size]++;
+        cover[node + 1]--;
+    }
+}
+
+/* Copies: leaves that are the same mesh as this one. */
+
+/* A copy B of this leaf P has P's pieces and regions; its labels are P's, with P's
+ * own label SAME (the faces coincide, with the same orientation). P's classification
+ * therefore also decides B's output, with B's CSGlist. And in P's labels, a candidate
+ * that is a copy of another leaf R borrows R's labels (it has no faces in the scene). */
+static uint32_t stand_in(const mci_leaf_work *w, uint32_t m)
+{
+    return mci_scene_leaf_stand_in(w->s, m);
+}
+
+/* The copies of this leaf and their trimmed CSGlists (candidates: this leaf's, less the
+ * copy, plus this leaf), marked in cover as well. */
+static mcsg_status trim_copy_lists(mci_leaf_work *w, int32_t *cover)
+{
+    const mci_ptree *t = w->cl->tree;
+    if (!w->cl->copy_start)
+        return MCSG_OK;
+    w->copies = w->cl->copy_of + w->cl->copy_start[w->leaf];
+    w->ncopies = w->cl->copy_start[w->leaf + 1] - w->cl->copy_start[w->leaf];
+    if (w->ncopies == 0)
+        return MCSG_OK;
+    w->copy_list = mci_calloc_array(w->ctx, w->ncopies, sizeof *w->copy_list);
+    w->copy_nlist = mci_calloc_array(w->ctx, w->ncopies, sizeof *w->copy_nlist);
+    if (!w->copy_list || !w->copy_nlist)
+        return MCSG_ERR_NOMEM;
+    for (size_t k = 0; k < w->ncopies; k++) {
+        uint32_t b = w->copies[k];
+        bool rejected;
+        if (!(w->copy_list[k] = mci_malloc_array(w->ctx, t->node_count + 1, sizeof **w->copy_list)))
+            return MCSG_ERR_NOMEM;
+        w->leaf_labels[b] = MCI_LABEL_OUT;
+        w->leaf_labels[w->leaf] = MCI_LABEL_UNKNOWN;
+        w->copy_nlist[k] = mci_csglist_trim(t, b, w->leaf_labels, w->scratch, w->copy_list[k],
+                                            &rejected);
+        w->leaf_labels[b] = MCI_LABEL_UNKNOWN;
+        w->leaf_labels[w->leaf] = MCI_LABEL_OUT;
+        if (rejected)
+            w->copy_nlist[k] = SIZE_MAX; /* none of its faces is kept */
+        else
+            cover_entries(t, w->copy_list[k], w->copy_nlist[k], cover);
+    }
+    return MCSG_OK;
+}
+
+/* Before labelling: copies of this leaf are SAME everywhere; a copy of another leaf is
+ * not labelled itself (it has no faces for rays or separators), that leaf is instead. */
+static mcsg_status prepare_copy_labels(mci_leaf_work *w)
+{
+    if (!w->s->alias)
+        return MCSG_OK;
+    w->borrowed = mci_calloc_array(w->ctx, w->ncand + 1, 1);
+    if (!w->borrowed)
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t c = 0; c < w->ncand; c++) {
+        uint32_t r = stand_in(w, w->cand[c]), rc;
+        if (r == w->cand[c])
+            continue;
+        if (r == w->leaf) {
+            for (size_t g = 0; g < w->nreg; g++)
+                w->labels[g * w->ncand + c] = MCI_LABEL_SAME;
+            continue;
+        }
+        rc = w->slot_of_leaf[r]; /* a candidate: its box is the copy's */
+        if (rc == MCI_NONE)
+            return mci_fail(w->err, MCSG_ERR_INTERNAL, "leaf %u: a copy's leaf is no "
+                            "candidate", w->leaf);
+        w->borrowed[c] = 1 + w->needed[c];
+        w->needed[rc] |= w->needed[c];
+        w->needed[c] = 0;
+    }
+    return MCSG_OK;
+}
+
+/* After labelling: a copy of another leaf takes that leaf's labels. */
+static void finish_copy_labels(mci_leaf_work *w)
+{
+    for (size_t c = 0; w->borrowed && c < w->ncand; c++) {
+        size_t rc;
+        if (!w->borrowed[c])
+            continue;
+        rc = w->slot_of_leaf[stand_in(w, w->cand[c])];
+        for (size_t g = 0; g < w->nreg; g++)
+            w->labels[g * w->ncand + c] = w->labels[g * w->ncand + rc];
+        w->needed[c] = w->borrowed[c] - 1;
+    }
+}
+
+/* The first trimmed tree (paper §5.2, §5.3): every leaf whose box misses this leaf's is
+ * OUT for all its faces. CSGlist entries that this decides are dropped when desired and
+ * reject the whole leaf when not; the candidates outside the remaining entries need no
+ * labels at all (the paper's pseudo-IPs). */
+#ifndef NDEBUG
+/* Debug builds check a list made by the whole-face decision against the trimming here. */
+static mcsg_status check_trimmed_list(mci_leaf_work *w, const mci_trimmed_list *made)
+{
+    mci_csg_entry *list = mci_malloc_array(w->ctx, w->cl->tree->node_count + 1, sizeof *list);
+    bool rejected, same;
+    size_t n;
+    if (!list)
+        return mci_fail_nomem(w->err, "classifying faces");
+    n = mci_csglist_trim(w->cl->tree, w->leaf, w->leaf_labels, w->scratch, list, &rejected);
+    same = rejected == made->rejected && (rejected || n == made->count);
+    for (size_t i = 0; same && !rejected && i < n; i++)
+        same = list[i].node == made->list[i].node && list[i].desired == made->list[i].desired;
+    mci_free(w->ctx, list);
+    return same ? MCSG_OK
+                : mci_fail(w->err, MCSG_ERR_INTERNAL, "primitive %u: the trimmed CSGlist "
+                           "handed on differs from its own", w->leaf);
+}
+#endif
+
+static mcsg_status trim_csglist(mci_leaf_work *w)
+{
+    const mci_ptree *t = w->cl->tree;
+    mci_trimmed_list *made = w->cl->trimmed ? &w->cl->trimmed[w->leaf] : NULL;
+    int32_t *cover = mci_calloc_array(w->ctx, t->node_count + 2, sizeof *cover);
+    w->list = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->list);
+    w->scratch = mci_malloc_array(w->ctx, t->node_count + 1, sizeof *w->scratch);
+    w->leaf_labels = mci_malloc_array(w->ctx, t->leaf_count + 1, sizeof *w->leaf_labels);
+    w->needed = mci_calloc_array(w->ctx, w->ncand + 1, 1);
+    if (!cover || !w->list || !w->scratch || !w->leaf_labels || !w->needed) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (size_t l = 0; l < t->leaf_count; l++)
+        w->leaf_labels[l] = MCI_LABEL_OUT;
+    for (size_t c = 0; c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = MCI_LABEL_UNKNOWN;
+    if (made && made->valid) { /* the same labels made it: every other leaf is a candidate */
+#ifndef NDEBUG
+        mcsg_status checked = check_trimmed_list(w, made);
+        if (checked != MCSG_OK) {
+            mci_free(w->ctx, cover);
+            return checked;
+        }
+#endif
+        memcpy(w->list, made->list, made->count * sizeof *w->list);
+        w->nlist = made->count;
+        w->rejected = made->rejected;
+    } else if (!mci_csglist_trim_sparse(w->ctx, t, &w->cl->trim_base, w->leaf, w->cand,
+                                        w->ncand, w->list, &w->nlist, &w->rejected)) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    if (!w->rejected)
+        cover_entries(t, w->list, w->nlist, cover);
+    if (trim_copy_lists(w, cover) != MCSG_OK) {
+        mci_free(w->ctx, cover);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (size_t n = 1; n <= t->node_count; n++)
+        cover[n] += cover[n - 1];
+    for (size_t c = 0; c < w->ncand; c++)
+        w->needed[c] = cover[t->leaf_node[w->cand[c]]] > 0;
+    mci_free(w->ctx, cover);
+    if (made && made->valid && !w->rejected) { /* taken over: freed with the leaf's work */
+        w->blist = made->blist;
+        memset(&made->blist, 0, sizeof made->blist);
+    } else if (!w->rejected &&
+               !mci_blist_build(w->ctx, t, w->list, w->nlist, w->leaf_labels, &w->blist)) {
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    /* Every leaf a step reads is UNKNOWN in the trimming labels: a candidate. */
+    if (!(w->blist_slot = mci_malloc_array(w->ctx, w->blist.count + 1, sizeof *w->blist_slot)))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t i = 0; i < w->blist.count; i++)
+        w->blist_slot[i] = w->slot_of_leaf[w->blist.steps[i].leaf];
+    return MCSG_OK;
+}
+
+mcsg_status mci_leaf_trim(mci_leaf_work *w)
+{
+    mcsg_status st = find_candidates(w);
+    if (st == MCSG_OK)
+        st = trim_csglist(w);
+    return st;
+}
+
+mcsg_status mci_leaf_label(mci_leaf_work *w)
+{
+    mcsg_status st = prepare_copy_labels(w);
+    if (st == MCSG_OK)
+        st = label_regions(w);
+    finish_copy_labels(w);
+    return st;
+}

@@ -1,0 +1,94 @@
+/*
+ * The classification of one leaf, shared by the files that do it (csg/classify*.c); the
+ * rest of the pipeline sees csg/classify.h. mci_classify_leaf (classify.c) runs:
+ *   mci_leaf_regions  (classify_regions.c) pieces, separators, walls, edge pairing,
+ *                     regions
+ *   mci_leaf_trim     (classify_labels.c)  the candidates and the trimmed CSGlist
+ *   mci_leaf_label    (classify_labels.c)  labels of every region: seeds by rays,
+ *                     inheritance across separators by the local test, copies
+ *   mci_leaf_select   (classify_select.c)  the regions kept, their pieces re-tessellated
+ *                     and emitted
+ */
+#ifndef MESHCSG_CSG_CLASSIFY_LEAF_H
+#define MESHCSG_CSG_CLASSIFY_LEAF_H
+
+#include "base/sort.h"
+#include "csg/classify.h"
+
+/* The state of one leaf's classification, from its pieces to its kept triangles. */
+typedef struct mci_leaf_work {
+    const mci_ctx *ctx;
+    const mci_classifier *cl;
+    const mci_scene *s;
+    uint32_t leaf, face_base, face_count;
+    size_t np;        /* pieces */
+    uint32_t *pv;     /* 3 per piece: output vertex ids */
+    uint32_t *pface;  /* per piece: global face id */
+    uint32_t *plocal; /* 3 per piece: arrangement point id (arranged faces) */
+    uint32_t *mate;   /* per edge slot 3p + i (pv[i] -> pv[i + 1]): the slot across */
+    uint8_t *is_sep;  /* per edge slot */
+    mci_keyed *sep;       /* separators: (edge key, face of another leaf holding it), sorted */
+    size_t nsep;
+    mci_keyed *walls;     /* border sides of the leaf's faces dropped whole, sorted */
+    size_t nwalls;
+    uint32_t *region; /* per piece */
+    size_t nreg;
+    uint32_t *reg_start, *reg_pieces; /* pieces by region (CSR) */
+    uint32_t *sep_start, *sep_slots;  /* separator slots by region (CSR) */
+    uint32_t *cand;   /* leaves whose box meets this leaf's */
+    size_t ncand;
+    uint32_t *slot_of_leaf; /* leaf -> index in cand, or MCI_NONE */
+    uint8_t *labels;  /* nreg x ncand */
+    uint8_t *needed;  /* per candidate: in a subtree of the trimmed CSGlist */
+    mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
+    size_t nlist;
+    bool rejected;    /* the trimmed CSGlist drops every face of the leaf */
+    mci_blist blist;  /* the trimmed CSGlist compiled for IN/OUT labels (paper §5.4) */
+    uint32_t *blist_slot; /* per blist step: the candidate slot of the leaf it reads */
+    mci_ray_scratch ray;
+    bool out_of_memory; /* set by a ray test that could not allocate */
+    mci_label *scratch, *leaf_labels;
+    const uint32_t *copies; /* leaves that are copies of this one (see eval.c) ... */
+    size_t ncopies;
+    mci_csg_entry **copy_list; /* ... their trimmed CSGlists */
+    size_t *copy_nlist;
+    uint8_t *borrowed;    /* per candidate: a copy of another leaf, labelled as that one */
+    mci_kept *kept_all;   /* per leaf: the kept triangles (copies' too) */
+    mci_classify_stats *stats;
+    mcsg_error *err;
+} mci_leaf_work;
+
+/* The point of vertex i of piece p. */
+static inline void mci_leaf_piece_point(const mci_leaf_work *w, size_t p, int i, mci_point *out)
+{
+    const mci_face_arr *arr = mci_scene_arr_of_face(w->s, w->pface[p]);
+    if (arr) {
+        *out = *arr->points[w->plocal[3 * p + i]];
+    } else {
+        const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+        mci_point_explicit(out, m->vertices + 3 * (size_t)w->plocal[3 * p + i]);
+    }
+}
+
+static inline uint32_t mci_leaf_slot_from(const mci_leaf_work *w, size_t slot)
+{
+    return w->pv[slot];
+}
+
+static inline uint32_t mci_leaf_slot_to(const mci_leaf_work *w, size_t slot)
+{
+    return w->pv[slot - slot % 3 + (slot % 3 + 1) % 3];
+}
+
+/* Index of the first separator entry with this key, or nsep. */
+static inline size_t mci_leaf_find_separator(const mci_leaf_work *w, uint64_t key)
+{
+    return mci_find_key(w->sep, w->nsep, key);
+}
+
+mcsg_status mci_leaf_regions(mci_leaf_work *w);
+mcsg_status mci_leaf_trim(mci_leaf_work *w);
+mcsg_status mci_leaf_label(mci_leaf_work *w);
+mcsg_status mci_leaf_select(mci_leaf_work *w);
+
+#endif

@@ -1,0 +1,309 @@
+/*
+ * Which regions of one leaf belong to the result (the CSGlist evaluated on each region's
+ * labels, for the leaf and each copy of it), and their pieces emitted as kept triangles:
+ * an arranged face is re-tessellated with its valid constraints only (paper §5.4)
+ * before its kept triangles are output.
+ */
+#include "csg/classify_leaf.h"
+#include "csg/retessellate.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static bool grow_kept(const mci_ctx *ctx, mci_kept *kept, size_t need)
+{
+    size_t cap = kept->capacity;
+    if (!mci_grow_array(ctx, (void **)&kept->tris, &cap, need, 3 * sizeof *kept->tris, 1024))
+        return false;
+    cap = kept->capacity;
+    if (!mci_grow_array(ctx, (void **)&kept->faces, &cap, need, sizeof *kept->faces, 1024))
+        return false;
+    kept->capacity = cap;
+    return true;
+}
+
+static bool push_triangle(const mci_ctx *ctx, mci_kept *kept, const uint32_t *v,
+                          bool reversed, uint32_t face)
+{
+    uint32_t *tri;
+    if (!grow_kept(ctx, kept, kept->count + 1))
+        return false;
+    tri = kept->tris + 3 * kept->count;
+    tri[0] = v[0];
+    tri[1] = v[reversed ? 2 : 1];
+    tri[2] = v[reversed ? 1 : 2];
+    kept->faces[kept->count++] = face;
+    return true;
+}
+
+/* Who takes kept pieces of this leaf's regions: the leaf itself, and each copy of it
+ * (with its own decisions, orientation, output list, and face ids offset by its place). */
+typedef struct owner {
+    const uint8_t *keep; /* per region */
+    bool reversed;
+    mci_kept *kept;
+    uint32_t face_offset;
+} owner;
+
+/* The kept triangles of arranged face f, whose pieces start at piece `first`, after
+ * re-tessellating it with its valid constraints only. */
+static mcsg_status emit_arranged_face(mci_leaf_work *w, uint32_t f, size_t first, const owner *o)
+{
+    mci_face_arr *arr = &w->cl->scene->arrs[w->s->arr_of[f]];
+    const uint32_t *gid = w->s->gid + w->s->gid_start[w->s->arr_of[f]];
+    uint8_t stack_keep[2 * 256]; /* piece and triangle flags: most faces allocate none */
+    uint8_t *piece_keep = arr->tri_count <= 256 ? stack_keep
+                                                : mci_malloc_array(w->ctx, 2 * arr->tri_count, 1);
+    uint8_t *tri_keep = piece_keep ? piece_keep + arr->tri_count : NULL;
+    mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
+        piece_keep[i] = o->keep[w->region[first + i]];
+    if (st == MCSG_OK)
+        st = mci_arr_retessellate(w->ctx, arr, piece_keep, tri_keep, w->err);
+    for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
+        uint32_t v[3];
+        if (!tri_keep[t])
+            continue;
+        for (int i = 0; i < 3; i++)
+            v[i] = gid[arr->tris[3 * t + i]];
+        if (!push_triangle(w->ctx, o->kept, v, o->reversed, f + o->face_offset))
+            st = mci_fail_nomem(w->err, "classifying faces");
+    }
+    if (piece_keep != stack_keep)
+        mci_free(w->ctx, piece_keep);
+    return st;
+}
+
+/* A face whose pieces go to several owners (a leaf and a copy of it, each keeping a
+ * part): each takes its pieces as tessellated with all constraints (re-tessellating for
+ * one would change the pieces of the other). */
+static mcsg_status emit_shared_face(mci_leaf_work *w, uint32_t f, size_t first,
+                                    const owner *owners, size_t n)
+{
+    const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
+    for (size_t k = 0; k < n; k++)
+        for (size_t p = first; p < first + arr->tri_count; p++)
+            if (owners[k].keep[w->region[p]] &&
+                !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
+                               f + owners[k].face_offset))
+                return mci_fail_nomem(w->err, "classifying faces");
+    return MCSG_OK;
+}
+
+/* The owner keeping pieces of the face [first, first + count), the number of such owners
+ * in *n. */
+static const owner *face_owner(const mci_leaf_work *w, size_t first, size_t count,
+                               const owner *owners, size_t n_owners, size_t *n)
+{
+    const owner *found = NULL;
+    *n = 0;
+    for (size_t k = 0; k < n_owners; k++)
+        for (size_t p = first; p < first + count; p++)
+            if (owners[k].keep[w->region[p]]) {
+                found = &owners[k];
+                ++*n;
+                break;
+            }
+    return found;
+}
+
+static mcsg_status emit_kept(mci_leaf_work *w, const owner *owners, size_t n_owners)
+{
+    mcsg_status st = MCSG_OK;
+    size_t p = 0;
+    while (p < w->np && st == MCSG_OK) {
+        uint32_t f = w->pface[p];
+        const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
+        if (arr) {
+            size_t n = arr->tri_count, takers;
+            const owner *o = face_owner(w, p, n, owners, n_owners, &takers);
+            if (takers == 1)
+                st = emit_arranged_face(w, f, p, o);
+            else if (takers > 1)
+                st = emit_shared_face(w, f, p, owners, n_owners);
+            p += n;
+            continue;
+        }
+        for (size_t k = 0; k < n_owners && st == MCSG_OK; k++)
+            if (owners[k].keep[w->region[p]] &&
+                !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
+                               f + owners[k].face_offset))
+                st = mci_fail_nomem(w->err, "classifying faces");
+        p++;
+    }
+    return st;
+}
+
+/* Labels of region r for the CSGlist of leaf `as` (this leaf or a copy of it): this
+ * leaf is SAME for a copy; reversed for a complemented leaf. */
+static void region_labels(mci_leaf_work *w, size_t r, uint32_t as)
+{
+    const mci_ptree *t = w->cl->tree;
+    bool reversed = t->nodes[t->leaf_node[as]].complement;
+    const uint8_t *lab = w->labels + r * w->ncand;
+    for (size_t c = 0; c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = (mci_label)lab[c];
+    if (as != w->leaf)
+        w->leaf_labels[w->leaf] = MCI_LABEL_SAME;
+    for (size_t c = 0; reversed && c < w->ncand; c++)
+        w->leaf_labels[w->cand[c]] = mci_label_reverse(w->leaf_labels[w->cand[c]]);
+    if (reversed && as != w->leaf)
+        w->leaf_labels[w->leaf] = mci_label_reverse(w->leaf_labels[w->leaf]);
+}
+
+/* A point strictly inside the triangle a, b, c (input vertices): where a line through its
+ * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
+ * vertices; `ends` holds the line's two ends, which the point refers to). False when the
+ * doubles do not give a line crossing the plane or a point strictly inside (slivers). */
+static bool point_inside_triangle(const double *a, const double *b, const double *c,
+                                  double ends[2][3], mci_point *out)
+{
+    double e1[3], e2[3], n[3], size = 0, norm = 0;
+    mci_plane plane;
+    mci_point corner[3];
+    int axis, sign, turns[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        size = fmax(size, fmax(fabs(e1[k]), fabs(e2[k])));
+    }
+    for (int k = 0; k < 3; k++) {
+        n[k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
+        norm = fmax(norm, fabs(n[k]));
+    }
+    if (!(norm > 0) || !(size > 0) || !isfinite(norm))
+        return false;
+    for (int k = 0; k < 3; k++) {
+        double centre = (a[k] + b[k] + c[k]) / 3, step = n[k] / norm * size;
+        ends[0][k] = centre + step;
+        ends[1][k] = centre - step;
+    }
+    mci_plane_init(&plane, a, b, c);
+    if (mci_orient3d_vertices(a, b, c, ends[0]) * mci_orient3d_vertices(a, b, c, ends[1]) >= 0 ||
+        !mci_point_lpi(out, ends[0], ends[1], &plane) ||
+        (axis = mci_plane_projection_axis(&plane, &sign)) < 0)
+        return false;
+    mci_point_explicit(&corner[0], a);
+    mci_point_explicit(&corner[1], b);
+    mci_point_explicit(&corner[2], c);
+    for (int i = 0; i < 3; i++)
+        turns[i] = mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], out, axis);
+    return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
+}
+
+/* The region's labels still unknown when its labels do not decide it: rays from a point
+ * strictly inside one of its pieces with input corners. The seeds cast rays from region
+ * vertices only; when every vertex lies on a leaf's surface and no side of the region is
+ * on it (faces touching that leaf only at their corners), the inside of a piece still
+ * tells. False when nothing was learnt. */
+static bool labels_from_inside(mci_leaf_work *w, uint32_t r)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    bool learnt = false;
+    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && !learnt; k++) {
+        mci_point v[3], probe;
+        double ends[2][3];
+        uint32_t p = w->reg_pieces[k];
+        for (int i = 0; i < 3; i++)
+            mci_leaf_piece_point(w, p, i, &v[i]);
+        if (v[0].kind != MCI_POINT_EXPLICIT || v[1].kind != MCI_POINT_EXPLICIT ||
+            v[2].kind != MCI_POINT_EXPLICIT ||
+            !point_inside_triangle(v[0].v[0], v[1].v[0], v[2].v[0], ends, &probe))
+            continue;
+        for (size_t c = 0; c < w->ncand; c++) {
+            mci_label label;
+            if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
+                continue;
+            w->stats->rays++;
+            if (!mci_ray_label_octree(w->ctx, &probe, &w->s->octree, w->cand[c], &w->ray,
+                                      &label)) {
+                w->out_of_memory = true;
+                return false;
+            }
+            lab[c] = (uint8_t)label;
+            learnt = learnt || label != MCI_LABEL_UNKNOWN;
+        }
+    }
+    return learnt;
+}
+
+/* Whether region r is kept, for this leaf or its copy k (-1: its labels do not tell). */
+/* The blist on region r's own labels (mci_blist_accepts without spreading them over the
+ * leaves first: the ring of ring-800 has ~800 candidates, and a walk reads a few). */
+static int region_blist_accepts(const mci_leaf_work *w, uint32_t r)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    int32_t at = w->blist.start;
+    while (at >= 0) {
+        const mci_blist_step *step = &w->blist.steps[at];
+        uint8_t l = lab[w->blist_slot[at]];
+        if (l == MCI_LABEL_IN)
+            at = step->on_in;
+        else if (l == MCI_LABEL_OUT)
+            at = step->on_out;
+        else
+            return -1;
+    }
+    return at == MCI_BLIST_ACCEPT;
+}
+
+static int region_accepts(mci_leaf_work *w, uint32_t r, size_t k)
+{
+    const mci_ptree *t = w->cl->tree;
+    bool self = k == w->ncopies;
+    /* IN and OUT do not depend on orientation: reversing the labels changes none of
+     * those the blist reads. */
+    int accepts = self ? region_blist_accepts(w, r) : -1;
+    if (accepts >= 0)
+        return accepts;
+    /* Labels on a coplanar face (SAME / OPPO) need the combination rules. */
+    region_labels(w, r, self ? w->leaf : w->copies[k]);
+    return self ? mci_csglist_accepts(t, w->list, w->nlist, w->leaf_labels, w->scratch)
+                : mci_csglist_accepts(t, w->copy_list[k], w->copy_nlist[k], w->leaf_labels,
+                                      w->scratch);
+}
+
+/* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
+static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
+{
+    bool self = k == w->ncopies, rejected = self ? w->rejected : w->copy_nlist[k] == SIZE_MAX;
+    for (uint32_t r = 0; r < w->nreg; r++) {
+        int accepts = 0;
+        if (!rejected) {
+            accepts = region_accepts(w, r, k);
+            if (accepts < 0 && labels_from_inside(w, r))
+                accepts = region_accepts(w, r, k);
+            if (w->out_of_memory)
+                return mci_fail_nomem(w->err, "classifying faces");
+            if (accepts < 0)
+                return mci_fail(w->err, MCSG_ERR_INTERNAL,
+                                "leaf %u: a region's label could not be decided", w->leaf);
+        }
+        keep[r] = accepts == 1;
+    }
+    if (!self)
+        w->leaf_labels[w->leaf] = MCI_LABEL_OUT; /* as trimming left it */
+    return MCSG_OK;
+}
+
+/* Evaluate each region's CSGlist (this leaf's and its copies') and output the pieces of
+ * the kept ones. */
+mcsg_status mci_leaf_select(mci_leaf_work *w)
+{
+    const mci_ptree *t = w->cl->tree;
+    size_t n = w->ncopies + 1;
+    owner *owners = mci_malloc_array(w->ctx, n, sizeof *owners);
+    uint8_t *keep = mci_malloc_array(w->ctx, n * (w->nreg + 1), 1);
+    mcsg_status st = owners && keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    for (size_t k = 0; k < n && st == MCSG_OK; k++) {
+        uint32_t as = k == 0 ? w->leaf : w->copies[k - 1];
+        owners[k] = (owner){keep + k * (w->nreg + 1), t->nodes[t->leaf_node[as]].complement,
+                            &w->kept_all[as],
+                            w->s->octree.face_base[as] - w->s->octree.face_base[w->leaf]};
+        st = decide_regions(w, k == 0 ? w->ncopies : k - 1, keep + k * (w->nreg + 1));
+    }
+    st = st == MCSG_OK ? emit_kept(w, owners, n) : st;
+    mci_free(w->ctx, owners);
+    mci_free(w->ctx, keep);
+    return st;
+}

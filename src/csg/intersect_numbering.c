@@ -1,0 +1,384 @@
+/*
+ * One number per distinct point of all arrangements (mci_scene_number_points): exact
+ * identity over the whole scene, not welding by distance.
+ */
+#include "csg/intersect_internal.h"
+#include "base/parallel.h"
+#include "base/sort.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t definition_hash(const mci_point *p)
+{
+    return mci_hash_vertices(0x9e3779b97f4a7c15u ^ (uint64_t)p->kind, p->v,
+                         mci_point_vertex_count(p));
+}
+
+/* Numbering in three steps, each deterministic:
+ *   1. copies with the same definition (kind and defining vertices) are one point:
+ *      found by hashing, no arithmetic (most shared points are defined identically by
+ *      the faces that share them: canonical edge order, canonical TPI plane order);
+ *   2. distinct definitions of one point (e.g. a crossing exactly at a vertex) are
+ *      found among points whose certified boxes overlap, by a sweep along x, and
+ *      joined after an exact equality test;
+ *   3. numbers follow the first occurrence in (face, local index) order. */
+typedef struct numbering {
+    const mci_ctx *ctx;
+    const mci_point **table; /* by slot */
+    uint8_t *explicit_slot;  /* by slot, filled with the hashes */
+    uint32_t *parent;        /* union-find over slots */
+    size_t total;
+} numbering;
+
+/* Join with the smaller slot as root, so that roots are first occurrences. */
+static void join(uint32_t *parent, uint32_t a, uint32_t b)
+{
+    a = mci_find_root(parent, a);
+    b = mci_find_root(parent, b);
+    if (a < b)
+        parent[b] = a;
+    else if (b < a)
+        parent[a] = b;
+}
+
+/* Copies with one definition are found with one hash table per part of the hash space
+ * (parts by the top bits, filled in parallel): a class of copies lies in one part, each
+ * part takes its slots in increasing order, so every copy is joined to the first slot of
+ * its class as a single table would do. */
+enum { HASH_PARTS = 64, HASH_CHUNK = 16384 };
+
+typedef struct same_job {
+    numbering *nb;
+    uint64_t *hash;                   /* by slot */
+    uint32_t *by_part;                /* slots grouped by part, increasing within a part */
+    size_t part_start[HASH_PARTS + 1];
+} same_job;
+
+static mcsg_status hash_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const same_job *j = user;
+    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
+    (void)err;
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
+        j->hash[slot] = definition_hash(j->nb->table[slot]);
+        j->nb->explicit_slot[slot] = j->nb->table[slot]->kind == MCI_POINT_EXPLICIT;
+    }
+    return MCSG_OK;
+}
+
+static mcsg_status join_part(void *user, size_t part, mcsg_error *err)
+{
+    const same_job *j = user;
+    const numbering *nb = j->nb;
+    size_t first = j->part_start[part], n = j->part_start[part + 1] - first, size = 16;
+    uint32_t *bucket;
+    while (size < 2 * n)
+        size *= 2;
+    if (!(bucket = mci_malloc_array(nb->ctx, size, sizeof *bucket)))
+        return mci_fail_nomem(err, "numbering points");
+    for (size_t i = 0; i < size; i++)
+        bucket[i] = MCI_NONE;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t slot = j->by_part[first + i];
+        size_t at = j->hash[slot] & (size - 1);
+        while (bucket[at] != MCI_NONE &&
+               (j->hash[bucket[at]] != j->hash[slot] ||
+                !mci_points_same_definition(nb->table[bucket[at]], nb->table[slot])))
+            at = (at + 1) & (size - 1);
+        if (bucket[at] == MCI_NONE)
+            bucket[at] = slot;
+        else
+            nb->parent[slot] = bucket[at]; /* both are roots: the first of the class wins */
+    }
+    mci_free(nb->ctx, bucket);
+    return MCSG_OK;
+}
+
+static mcsg_status join_same_definitions(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
+{
+    same_job j = {nb, mci_malloc_array(ctx, nb->total + 1, sizeof *j.hash),
+                  mci_malloc_array(ctx, nb->total + 1, sizeof *j.by_part), {0}};
+    mcsg_status st = j.hash && j.by_part ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, (nb->total + HASH_CHUNK - 1) / HASH_CHUNK, hash_chunk, &j, err);
+    if (st == MCSG_OK) { /* a stable counting sort of the slots by part */
+        size_t at[HASH_PARTS] = {0};
+        for (size_t slot = 0; slot < nb->total; slot++)
+            j.part_start[(j.hash[slot] >> 58) + 1]++;
+        for (size_t q = 0; q < HASH_PARTS; q++)
+            j.part_start[q + 1] += j.part_start[q];
+        for (size_t q = 0; q < HASH_PARTS; q++)
+            at[q] = j.part_start[q];
+        for (size_t slot = 0; slot < nb->total; slot++)
+            j.by_part[at[j.hash[slot] >> 58]++] = (uint32_t)slot;
+        st = mci_parallel_for(ctx, HASH_PARTS, join_part, &j, err);
+    }
+    mci_free(ctx, j.hash);
+    mci_free(ctx, j.by_part);
+    return st;
+}
+
+/* The certified box rounded outward to floats: the table of these is the peak of the
+ * dense scenes' runs (ring-800: 238K roots), and a larger box only adds pairs to test. */
+typedef struct boxed_slot {
+    float lo[3], hi[3];
+    uint32_t slot;
+} boxed_slot;
+
+/* A key whose unsigned order is the numeric order of x (not NaN; -0 counts as +0). */
+static uint32_t orderable_float(float x)
+{
+    uint32_t bits;
+    x += 0.0f; /* -0 -> +0 */
+    memcpy(&bits, &x, sizeof bits);
+    return bits >> 31 ? ~bits : bits | (UINT32_C(1) << 31);
+}
+
+typedef struct bounds_job {
+    const numbering *nb;
+    boxed_slot *items;
+    uint64_t *order; /* per item: its low x (orderable_float) << 32 | its index */
+    size_t n;
+} bounds_job;
+
+/* The certified boxes (the cost of this step: LPI and TPI bounds), in parallel. */
+static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const bounds_job *j = user;
+    size_t end = mci_chunk_end(j->n, chunk, HASH_CHUNK);
+    (void)err;
+    for (size_t i = chunk * HASH_CHUNK; i < end; i++) {
+        boxed_slot *item = &j->items[i];
+        double lo[3], hi[3];
+        mci_point_bounds(j->nb->table[item->slot], lo, hi);
+        for (int k = 0; k < 3; k++) { /* a NaN bound (overflow) bounds nothing */
+            item->lo[k] = isnan(lo[k]) ? -INFINITY : mci_float_below(lo[k]);
+            item->hi[k] = isnan(hi[k]) ? INFINITY : mci_float_above(hi[k]);
+        }
+        j->order[i] = (uint64_t)orderable_float(item->lo[0]) << 32 | i;
+    }
+    return MCSG_OK;
+}
+
+/* Sorted by low x (radix), then each run of equal low x by low y: the run's keys become
+ * low y << 32 | index. run_end[i] is the first later position with another low x. */
+static void sort_by_low_x_then_y(const boxed_slot *items, uint64_t *order, size_t n,
+                                 uint32_t *run_end)
+{
+    for (size_t i = n; i-- > 0;)
+        run_end[i] = i + 1 < n && order[i + 1] >> 32 == order[i] >> 32 ? run_end[i + 1]
+                                                                       : (uint32_t)(i + 1);
+    for (size_t i = 0; i < n; i = run_end[i]) {
+        if (run_end[i] - i < 2)
+            continue;
+        for (size_t k = i; k < run_end[i]; k++)
+            order[k] = (uint64_t)orderable_float(items[(uint32_t)order[k]].lo[1]) << 32 |
+                       (uint32_t)order[k];
+        mci_sort_u64(order + i, run_end[i] - i);
+    }
+}
+
+static bool boxes_meet_in_yz(const boxed_slot *a, const boxed_slot *b)
+{
+    return !(a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
+             b->lo[2] > a->hi[2]);
+}
+
+/* Distinct definitions of one point: a sweep along x over the certified boxes, each
+ * pair whose boxes overlap tested exactly. Items are sorted by low x, then low y: within
+ * a run of equal low x every item overlaps the first in x, and the run is in y order, so
+ * its scan stops at the first item beyond the first's y range. Axis-aligned input puts
+ * hundreds of points on one x (a column of a grid of holes), which a sweep on x alone
+ * compared pairwise (box_grid_64: quadratic per column). The joins do not depend on the
+ * order, only on the pairs. */
+static void join_overlapping(numbering *nb, const boxed_slot *items, const uint64_t *order,
+                             const uint32_t *run_end, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        const boxed_slot *a = &items[(uint32_t)order[i]];
+        size_t k = i + 1;
+        for (; k < run_end[i]; k++) {
+            const boxed_slot *b = &items[(uint32_t)order[k]];
+            if (b->lo[1] > a->hi[1]) {
+                k = run_end[i];
+                break;
+            }
+            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                join(nb->parent, a->slot, b->slot);
+        }
+        for (; k < n && items[(uint32_t)order[k]].lo[0] <= a->hi[0]; k++) {
+            const boxed_slot *b = &items[(uint32_t)order[k]];
+            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                join(nb->parent, a->slot, b->slot);
+        }
+    }
+}
+
+static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
+{
+    size_t roots = 0;
+    bounds_job j = {nb, NULL, NULL, 0};
+    uint32_t *run_end;
+    mcsg_status st;
+    /* Sized for the roots only: most slots are copies (ring-800: 797K slots). */
+    for (uint32_t slot = 0; slot < nb->total; slot++)
+        roots += nb->parent[slot] == slot;
+    j.items = mci_malloc_array(ctx, roots + 1, sizeof *j.items);
+    j.order = mci_malloc_array(ctx, roots + 1, sizeof *j.order);
+    run_end = mci_malloc_array(ctx, roots + 1, sizeof *run_end);
+    st = j.items && j.order && run_end ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    for (uint32_t slot = 0; st == MCSG_OK && slot < nb->total; slot++)
+        if (nb->parent[slot] == slot) /* not a copy of an earlier definition */
+            j.items[j.n++].slot = slot;
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
+    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
+        st = mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK) {
+        sort_by_low_x_then_y(j.items, j.order, j.n, run_end);
+        join_overlapping(nb, j.items, j.order, run_end, j.n);
+    }
+    mci_free(ctx, j.items);
+    mci_free(ctx, j.order);
+    mci_free(ctx, run_end);
+    return st;
+}
+
+/* The table and the identity parents, on the threads in chunks of arrangements
+ * (gid_start set); then, after the joins, the numbers: roots (first occurrences) are
+ * numbered in slot order through per-chunk counts, so the numbering does not depend on
+ * the threads. Both loops ran on one thread: 797K slots on ring-800. */
+enum { SLOT_ARR_CHUNK = 4096 };
+
+typedef struct slots_job {
+    mci_scene *s;
+    numbering *nb;
+    uint32_t *first_id; /* per chunk of slots: the number of its first root */
+} slots_job;
+
+static mcsg_status fill_slot_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const slots_job *j = user;
+    const mci_scene *s = j->s;
+    size_t end = mci_chunk_end(s->arr_count, chunk, SLOT_ARR_CHUNK);
+    (void)err;
+    for (size_t k = chunk * SLOT_ARR_CHUNK; k < end; k++)
+        for (uint32_t p = 0, slot = s->gid_start[k]; p < s->arrs[k].point_count; p++, slot++) {
+            j->nb->table[slot] = s->arrs[k].points[p];
+            j->nb->parent[slot] = slot;
+        }
+    return MCSG_OK;
+}
+
+static mcsg_status fill_slots(const mci_ctx *ctx, mci_scene *s, numbering *nb, mcsg_error *err)
+{
+    slots_job j = {s, nb, NULL};
+    return mci_parallel_for(ctx, (s->arr_count + SLOT_ARR_CHUNK - 1) / SLOT_ARR_CHUNK,
+                            fill_slot_chunk, &j, err);
+}
+
+/* Pass 1: gid[slot] = its root (parent is only read: no path compression on the threads),
+ * and the chunk's count of roots in first_id. */
+static mcsg_status root_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const slots_job *j = user;
+    const uint32_t *parent = j->nb->parent;
+    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
+    uint32_t roots = 0;
+    (void)err;
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
+        uint32_t x = (uint32_t)slot;
+        while (parent[x] != x)
+            x = parent[x];
+        j->s->gid[slot] = x;
+        roots += x == slot;
+    }
+    j->first_id[chunk] = roots;
+    return MCSG_OK;
+}
+
+/* Pass 2: each root's number into parent (no longer needed as such). */
+static mcsg_status number_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const slots_job *j = user;
+    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
+    uint32_t id = j->first_id[chunk];
+    (void)err;
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+        if (j->s->gid[slot] == slot)
+            j->nb->parent[slot] = id++;
+    return MCSG_OK;
+}
+
+/* Pass 3: every slot takes its root's number. */
+static mcsg_status renumber_chunk(void *user, size_t chunk, mcsg_error *err)
+{
+    const slots_job *j = user;
+    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
+    (void)err;
+    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+        j->s->gid[slot] = j->nb->parent[j->s->gid[slot]];
+    return MCSG_OK;
+}
+
+static mcsg_status number_roots(const mci_ctx *ctx, mci_scene *s, numbering *nb, uint32_t *count,
+                                mcsg_error *err)
+{
+    size_t chunks = (nb->total + HASH_CHUNK - 1) / HASH_CHUNK;
+    slots_job j = {s, nb, mci_malloc_array(ctx, chunks + 1, sizeof *j.first_id)};
+    mcsg_status st = j.first_id ? mci_parallel_for(ctx, chunks, root_chunk, &j, err)
+                                : mci_fail_nomem(err, "numbering points");
+    *count = 0;
+    for (size_t c = 0; st == MCSG_OK && c < chunks; c++) { /* counts -> first numbers */
+        uint32_t roots = j.first_id[c];
+        j.first_id[c] = *count;
+        *count += roots;
+    }
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, chunks, number_chunk, &j, err);
+    if (st == MCSG_OK)
+        st = mci_parallel_for(ctx, chunks, renumber_chunk, &j, err);
+    mci_free(ctx, j.first_id);
+    return st;
+}
+
+mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error *err)
+{
+    numbering nb = {ctx, NULL, NULL, NULL, 0};
+    uint32_t id = 0;
+    bool ok;
+    mcsg_status st;
+    double t0 = mci_seconds_now();
+    for (size_t k = 0; k < s->arr_count; k++)
+        nb.total += s->arrs[k].point_count;
+    if (nb.total >= UINT32_MAX)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many intersection points (%zu)", nb.total);
+    s->gid_start = mci_malloc_array(ctx, s->arr_count + 1, sizeof *s->gid_start);
+    s->explicit_slot = nb.explicit_slot = mci_malloc_array(ctx, nb.total + 1, 1);
+    nb.table = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.table);
+    nb.parent = mci_malloc_array(ctx, nb.total + 1, sizeof *nb.parent);
+    ok = s->gid_start && s->explicit_slot && nb.table && nb.parent;
+    for (size_t k = 0, slot = 0; ok && k < s->arr_count; k++) {
+        s->gid_start[k] = (uint32_t)slot;
+        slot += s->arrs[k].point_count;
+    }
+    if (ok)
+        s->gid_start[s->arr_count] = (uint32_t)nb.total;
+    st = ok ? fill_slots(ctx, s, &nb, err) : mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK)
+        st = join_same_definitions(ctx, &nb, err);
+    if (st == MCSG_OK)
+        st = join_equal_points(ctx, &nb, err);
+    /* Allocated last: the joins' tables were this step's peak. */
+    if (st == MCSG_OK && !(s->gid = mci_malloc_array(ctx, nb.total + 1, sizeof *s->gid)))
+        st = mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK)
+        st = number_roots(ctx, s, &nb, &id, err);
+    s->point_count = st == MCSG_OK ? id : 0;
+    mci_free(ctx, nb.table);
+    mci_free(ctx, nb.parent);
+    s->stats.seconds_merge = mci_seconds_now() - t0;
+    return st;
+}
+

@@ -1,0 +1,29 @@
+/*
+ * Exact ray shooting (csg/rays.c): a point's label with respect to a closed mesh.
+ */
+#ifndef MESHCSG_CSG_RAYS_H
+#define MESHCSG_CSG_RAYS_H
+
+#include "csg/csgtree.h"
+#include "csg/octree.h"
+#include "exact/kernel.h"
+
+/* Where point p is with respect to the closed mesh m, by an exact ray along +x,
+ * symbolically perturbed so that rays through edges and vertices are decided
+ * consistently: IN, OUT, or UNKNOWN when p lies on m's surface. */
+mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m);
+
+/* Reusable buffers for mci_ray_label_octree (zero-initialise; free when done). */
+typedef struct mci_ray_scratch {
+    uint32_t *faces, *stack;
+    size_t face_count, face_capacity, stack_capacity;
+} mci_ray_scratch;
+
+void mci_ray_scratch_free(const mci_ctx *ctx, mci_ray_scratch *s);
+
+/* mci_ray_label for the leaf m of octree o, testing only m's faces in the cells the ray
+ * passes through (paper §5.2). Returns false when out of memory (*label unset). */
+bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                          uint32_t m, mci_ray_scratch *s, mci_label *label);
+
+#endif
