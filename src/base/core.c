@@ -121,15 +121,33 @@ char *mci_strdup(const mci_ctx *ctx, const char *s)
     return copy;
 }
 
-mcsg_status mci_fail(mcsg_error *err, mcsg_status status, const char *fmt, ...)
+/* "PREFIX: " (nothing without a prefix) and the formatted text, truncated to size. */
+static void format_line(char *out, size_t size, const char *prefix, const char *fmt,
+                        va_list ap)
+{
+    int n = prefix ? snprintf(out, size, "%s: ", prefix) : 0;
+    if (n < 0)
+        n = 0;
+    if ((size_t)n < size)
+        vsnprintf(out + n, size - (size_t)n, fmt, ap);
+}
+
+mcsg_status mci_vfail(mcsg_error *err, mcsg_status status, const char *prefix,
+                      const char *fmt, va_list ap)
 {
     if (err) {
-        va_list ap;
-        va_start(ap, fmt);
         err->status = status;
-        vsnprintf(err->message, sizeof err->message, fmt, ap);
-        va_end(ap);
+        format_line(err->message, sizeof err->message, prefix, fmt, ap);
     }
+    return status;
+}
+
+mcsg_status mci_fail(mcsg_error *err, mcsg_status status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    mci_vfail(err, status, NULL, fmt, ap);
+    va_end(ap);
     return status;
 }
 
@@ -138,16 +156,22 @@ mcsg_status mci_fail_nomem(mcsg_error *err, const char *what)
     return mci_fail(err, MCSG_ERR_NOMEM, "out of memory while %s", what);
 }
 
-void mci_log(const mci_ctx *ctx, mcsg_log_level level, const char *fmt, ...)
+void mci_vlog(const mci_ctx *ctx, mcsg_log_level level, const char *prefix, const char *fmt,
+              va_list ap)
 {
     char line[1024];
-    va_list ap;
     if (!ctx->log)
         return;
-    va_start(ap, fmt);
-    vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
+    format_line(line, sizeof line, prefix, fmt, ap);
     ctx->log(ctx->log_user, level, line);
+}
+
+void mci_log(const mci_ctx *ctx, mcsg_log_level level, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    mci_vlog(ctx, level, NULL, fmt, ap);
+    va_end(ap);
 }
 
 bool mci_buf_reserve(const mci_ctx *ctx, mci_buf *buf, size_t extra)

@@ -92,6 +92,14 @@ mcsg_status mci_fail_nomem(mcsg_error *err, const char *what);
 /* Send one formatted line to the log callback, if any. */
 void mci_log(const mci_ctx *ctx, mcsg_log_level level, const char *fmt, ...) MCI_PRINTF(3, 4);
 
+/* mci_fail and mci_log from a va_list, the text preceded by "PREFIX: " when prefix is not
+ * NULL: what the modules' own error and warning helpers (with file, line and column, or
+ * byte offset) build on. */
+mcsg_status mci_vfail(mcsg_error *err, mcsg_status status, const char *prefix,
+                      const char *fmt, va_list ap);
+void mci_vlog(const mci_ctx *ctx, mcsg_log_level level, const char *prefix, const char *fmt,
+              va_list ap);
+
 /* A growable array of bytes (or of fixed-size elements, managed by the caller). */
 typedef struct mci_buf {
     unsigned char *data;

@@ -284,6 +284,31 @@ mcsg_status mci_parallel_for(const mci_ctx *ctx, size_t count, mci_task_fn fn, v
     return mci_parallel_for_order(ctx, count, NULL, fn, user, err);
 }
 
+/* The end of chunk `chunk` of `size` items among n items (the last chunk may be short). */
+static size_t mci_chunk_end(size_t n, size_t chunk, size_t size)
+{
+    return n - chunk * size < size ? n : (chunk + 1) * size;
+}
+
+typedef struct range_loop {
+    mci_range_fn fn;
+    void *user;
+    size_t n, chunk;
+} range_loop;
+
+static mcsg_status range_task(void *user, size_t index, mcsg_error *err)
+{
+    const range_loop *r = user;
+    return r->fn(r->user, index * r->chunk, mci_chunk_end(r->n, index, r->chunk), err);
+}
+
+mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
+                                    mci_range_fn fn, void *user, mcsg_error *err)
+{
+    range_loop r = {fn, user, n, chunk};
+    return mci_parallel_for(ctx, (n + chunk - 1) / chunk, range_task, &r, err);
+}
+
 mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint32_t *order,
                                    mci_task_fn fn, void *user, mcsg_error *err)
 {

@@ -40,12 +40,14 @@ uint32_t *mci_heaviest_first(const mci_ctx *ctx, const uint32_t *cost, size_t n)
 typedef uint32_t (*mci_cost_fn)(const void *user, size_t index);
 mcsg_status mci_parallel_for_heaviest_first(const mci_ctx *ctx, size_t count, mci_cost_fn cost,
                                             mci_task_fn fn, void *user, mcsg_error *err);
-/* The end of chunk `chunk` of `size` items among n items (the last chunk may be short):
- * parallel steps split their items into fixed chunks, independent of the thread count. */
-static inline size_t mci_chunk_end(size_t n, size_t chunk, size_t size)
-{
-    return n - chunk * size < size ? n : (chunk + 1) * size;
-}
+/* A loop over items [0, n) in fixed chunks of `chunk` items (the last may be short),
+ * chunks in parallel: fn(user, begin, end, err) for each chunk's items [begin, end).
+ * The chunks do not depend on the thread count, so neither do the results; the error
+ * reported is the first failing chunk's, as mci_parallel_for. Parallel steps over many
+ * small items use this instead of a task per item. */
+typedef mcsg_status (*mci_range_fn)(void *user, size_t begin, size_t end, mcsg_error *err);
+mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
+                                    mci_range_fn fn, void *user, mcsg_error *err);
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 

@@ -203,13 +203,11 @@ typedef struct round_job {
     rounded *r;
 } round_job;
 
-static mcsg_status round_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status round_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const round_job *j = user;
-    size_t ids = j->e->scene.point_count + j->e->cl.new_vertex_count;
-    size_t end = mci_chunk_end(ids, chunk, ROUND_CHUNK);
     (void)err;
-    for (size_t id = chunk * ROUND_CHUNK; id < end; id++)
+    for (size_t id = begin; id < end; id++)
         if (j->r->dense[id] != MCI_NONE)
             vertex_coordinates(j->e, j->rep, (uint32_t)id, j->r->xyz + 3 * (size_t)j->r->dense[id]);
     return MCSG_OK;
@@ -232,8 +230,8 @@ static mcsg_status round_vertices(const eval_state *e, rounded *r, mcsg_error *e
     ok = ok && r->xyz && r->canon;
     if (ok) {
         round_job job = {e, rep, r};
-        mcsg_status st = mci_parallel_for(&e->ctx, (ids + ROUND_CHUNK - 1) / ROUND_CHUNK,
-                                          round_chunk, &job, err);
+        mcsg_status st =
+            mci_parallel_for_ranges(&e->ctx, ids, ROUND_CHUNK, round_chunk, &job, err);
         if (st != MCSG_OK) {
             mci_free(&e->ctx, rep);
             return st;

@@ -201,13 +201,12 @@ typedef struct crease_job {
     face_facts *ff;
 } crease_job;
 
-static mcsg_status crease_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status crease_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const crease_job *j = user;
     const mci_scene *s = j->s;
-    size_t end = mci_chunk_end(s->face_count, chunk, MCI_FACE_CHUNK);
     (void)err;
-    for (uint32_t f = (uint32_t)(chunk * MCI_FACE_CHUNK); f < end; f++) {
+    for (uint32_t f = (uint32_t)begin; f < end; f++) {
         const mci_plane *plane;
         j->ff->plane_rep[f] = f;
         if (!j->in_hits[f])
@@ -243,8 +242,8 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const mci
     }
     {
         crease_job job = {s, planes, in_hits, ff};
-        if (mci_parallel_for(ctx, (s->face_count + MCI_FACE_CHUNK - 1) / MCI_FACE_CHUNK, crease_chunk,
-                             &job, NULL) != MCSG_OK) { /* cannot happen: no task fails */
+        if (mci_parallel_for_ranges(ctx, s->face_count, MCI_FACE_CHUNK, crease_chunk, &job,
+                                    NULL) != MCSG_OK) { /* cannot happen: no task fails */
             mci_free(ctx, in_hits);
             free_face_facts(ctx, ff);
             return false;
@@ -575,12 +574,11 @@ typedef struct lack_job {
  * `lacking` from both threads, and the step ran slower on two threads than on one. */
 enum { LACK_CHUNK = 256 };
 
-static mcsg_status find_lacking(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status find_lacking(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const lack_job *j = user;
-    size_t end = mci_chunk_end(j->s->arr_count, chunk, LACK_CHUNK);
     (void)err;
-    for (size_t k = chunk * LACK_CHUNK; k < end; k++) {
+    for (size_t k = begin; k < end; k++) {
         const mci_face_arr *arr = &j->s->arrs[k];
         bool lacking = false;
         for (size_t p = 3; p < arr->point_count && !lacking; p++)
@@ -631,8 +629,7 @@ static mcsg_status share_edge_points(const mci_ctx *ctx, mci_scene *s, const ver
     if (st == MCSG_OK && !(job.lacking = mci_calloc_array(ctx, s->arr_count + 1, 1)))
         st = mci_fail_nomem(err, "arranging faces");
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, (s->arr_count + LACK_CHUNK - 1) / LACK_CHUNK, find_lacking,
-                              &job, err);
+        st = mci_parallel_for_ranges(ctx, s->arr_count, LACK_CHUNK, find_lacking, &job, err);
     if (st == MCSG_OK)
         st = reserve_shared(ctx, s, job.lacking, err);
     for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
@@ -854,12 +851,11 @@ static uint8_t face_contact(const mci_scene *s, const struct mci_scene_pending *
 
 enum { CONTACT_CHUNK = 1024 };
 
-static mcsg_status contact_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status contact_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     mci_scene *s = user;
-    size_t end = mci_chunk_end(s->arr_count, chunk, CONTACT_CHUNK);
     (void)err;
-    for (size_t k = chunk * CONTACT_CHUNK; k < end; k++)
+    for (size_t k = begin; k < end; k++)
         s->arr_contact[k] = face_contact(s, s->pending, s->pending->face_of[k]);
     return MCSG_OK;
 }
@@ -889,8 +885,7 @@ mcsg_status mci_scene_prepare_arrangements(const mci_ctx *ctx, mci_scene *s, mci
         return mci_fail_nomem(err, "arranging faces");
     }
     s->vertex_points = pd->vt.points; /* the arrangements refer to them */
-    return mci_parallel_for(ctx, (s->arr_count + CONTACT_CHUNK - 1) / CONTACT_CHUNK,
-                            contact_chunk, s, err);
+    return mci_parallel_for_ranges(ctx, s->arr_count, CONTACT_CHUNK, contact_chunk, s, err);
 }
 
 /* Building the stored ends that arranged faces use: in parallel chunks of definitions,
@@ -904,12 +899,11 @@ typedef struct build_job {
 
 enum { BUILD_CHUNK = 4096 };
 
-static mcsg_status build_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status build_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const build_job *j = user;
-    size_t end = mci_chunk_end(j->hits->def_count, chunk, BUILD_CHUNK);
     (void)err;
-    for (size_t i = chunk * BUILD_CHUNK; i < end; i++) {
+    for (size_t i = begin; i < end; i++) {
         const mci_end_def *d = &j->hits->defs[i];
         if (j->slot[i] != MCI_NONE) /* the pair test built it once: it exists */
             (void)mci_point_lpi(&j->block[j->slot[i]], d->v[0], d->v[1],
@@ -947,8 +941,8 @@ static mcsg_status build_points(const mci_ctx *ctx, mci_scene *s, mci_hit_list *
             slot[i] = (uint32_t)n++;
     s->hit_blocks[0] = job.block = mci_malloc_array(ctx, n + 1, sizeof *job.block);
     s->hit_block_count = 1;
-    st = job.block ? mci_parallel_for(ctx, (hits->def_count + BUILD_CHUNK - 1) / BUILD_CHUNK,
-                                      build_chunk, &job, err)
+    st = job.block ? mci_parallel_for_ranges(ctx, hits->def_count, BUILD_CHUNK, build_chunk,
+                                             &job, err)
                    : mci_fail_nomem(err, "arranging faces");
     for (size_t h = 0; st == MCSG_OK && h < hits->count; h++)
         for (int k = 0; k < 2; k++)

@@ -55,12 +55,11 @@ typedef struct same_job {
     size_t part_start[HASH_PARTS + 1];
 } same_job;
 
-static mcsg_status hash_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status hash_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const same_job *j = user;
-    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
     (void)err;
-    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
+    for (size_t slot = begin; slot < end; slot++) {
         j->hash[slot] = definition_hash(j->nb->table[slot]);
         j->nb->explicit_slot[slot] = j->nb->table[slot]->kind == MCI_POINT_EXPLICIT;
     }
@@ -101,7 +100,7 @@ static mcsg_status join_same_definitions(const mci_ctx *ctx, numbering *nb, mcsg
                   mci_malloc_array(ctx, nb->total + 1, sizeof *j.by_part), {0}};
     mcsg_status st = j.hash && j.by_part ? MCSG_OK : mci_fail_nomem(err, "numbering points");
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, (nb->total + HASH_CHUNK - 1) / HASH_CHUNK, hash_chunk, &j, err);
+        st = mci_parallel_for_ranges(ctx, nb->total, HASH_CHUNK, hash_chunk, &j, err);
     if (st == MCSG_OK) { /* a stable counting sort of the slots by part */
         size_t at[HASH_PARTS] = {0};
         for (size_t slot = 0; slot < nb->total; slot++)
@@ -143,12 +142,11 @@ typedef struct bounds_job {
 } bounds_job;
 
 /* The certified boxes (the cost of this step: LPI and TPI bounds), in parallel. */
-static mcsg_status bound_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status bound_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const bounds_job *j = user;
-    size_t end = mci_chunk_end(j->n, chunk, HASH_CHUNK);
     (void)err;
-    for (size_t i = chunk * HASH_CHUNK; i < end; i++) {
+    for (size_t i = begin; i < end; i++) {
         boxed_slot *item = &j->items[i];
         double lo[3], hi[3];
         mci_point_bounds(j->nb->table[item->slot], lo, hi);
@@ -232,7 +230,7 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
         if (nb->parent[slot] == slot) /* not a copy of an earlier definition */
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, (j.n + HASH_CHUNK - 1) / HASH_CHUNK, bound_chunk, &j, err);
+        st = mci_parallel_for_ranges(ctx, j.n, HASH_CHUNK, bound_chunk, &j, err);
     if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
         st = mci_fail_nomem(err, "numbering points");
     if (st == MCSG_OK) {
@@ -257,13 +255,12 @@ typedef struct slots_job {
     uint32_t *first_id; /* per chunk of slots: the number of its first root */
 } slots_job;
 
-static mcsg_status fill_slot_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status fill_slot_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const slots_job *j = user;
     const mci_scene *s = j->s;
-    size_t end = mci_chunk_end(s->arr_count, chunk, SLOT_ARR_CHUNK);
     (void)err;
-    for (size_t k = chunk * SLOT_ARR_CHUNK; k < end; k++)
+    for (size_t k = begin; k < end; k++)
         for (uint32_t p = 0, slot = s->gid_start[k]; p < s->arrs[k].point_count; p++, slot++) {
             j->nb->table[slot] = s->arrs[k].points[p];
             j->nb->parent[slot] = slot;
@@ -274,50 +271,46 @@ static mcsg_status fill_slot_chunk(void *user, size_t chunk, mcsg_error *err)
 static mcsg_status fill_slots(const mci_ctx *ctx, mci_scene *s, numbering *nb, mcsg_error *err)
 {
     slots_job j = {s, nb, NULL};
-    return mci_parallel_for(ctx, (s->arr_count + SLOT_ARR_CHUNK - 1) / SLOT_ARR_CHUNK,
-                            fill_slot_chunk, &j, err);
+    return mci_parallel_for_ranges(ctx, s->arr_count, SLOT_ARR_CHUNK, fill_slot_chunk, &j, err);
 }
 
 /* Pass 1: gid[slot] = its root (parent is only read: no path compression on the threads),
  * and the chunk's count of roots in first_id. */
-static mcsg_status root_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status root_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const slots_job *j = user;
     const uint32_t *parent = j->nb->parent;
-    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
     uint32_t roots = 0;
     (void)err;
-    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++) {
+    for (size_t slot = begin; slot < end; slot++) {
         uint32_t x = (uint32_t)slot;
         while (parent[x] != x)
             x = parent[x];
         j->s->gid[slot] = x;
         roots += x == slot;
     }
-    j->first_id[chunk] = roots;
+    j->first_id[begin / HASH_CHUNK] = roots;
     return MCSG_OK;
 }
 
 /* Pass 2: each root's number into parent (no longer needed as such). */
-static mcsg_status number_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status number_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const slots_job *j = user;
-    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
-    uint32_t id = j->first_id[chunk];
+    uint32_t id = j->first_id[begin / HASH_CHUNK];
     (void)err;
-    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+    for (size_t slot = begin; slot < end; slot++)
         if (j->s->gid[slot] == slot)
             j->nb->parent[slot] = id++;
     return MCSG_OK;
 }
 
 /* Pass 3: every slot takes its root's number. */
-static mcsg_status renumber_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status renumber_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const slots_job *j = user;
-    size_t end = mci_chunk_end(j->nb->total, chunk, HASH_CHUNK);
     (void)err;
-    for (size_t slot = chunk * HASH_CHUNK; slot < end; slot++)
+    for (size_t slot = begin; slot < end; slot++)
         j->s->gid[slot] = j->nb->parent[j->s->gid[slot]];
     return MCSG_OK;
 }
@@ -327,8 +320,9 @@ static mcsg_status number_roots(const mci_ctx *ctx, mci_scene *s, numbering *nb,
 {
     size_t chunks = (nb->total + HASH_CHUNK - 1) / HASH_CHUNK;
     slots_job j = {s, nb, mci_malloc_array(ctx, chunks + 1, sizeof *j.first_id)};
-    mcsg_status st = j.first_id ? mci_parallel_for(ctx, chunks, root_chunk, &j, err)
-                                : mci_fail_nomem(err, "numbering points");
+    mcsg_status st = j.first_id
+                         ? mci_parallel_for_ranges(ctx, nb->total, HASH_CHUNK, root_chunk, &j, err)
+                         : mci_fail_nomem(err, "numbering points");
     *count = 0;
     for (size_t c = 0; st == MCSG_OK && c < chunks; c++) { /* counts -> first numbers */
         uint32_t roots = j.first_id[c];
@@ -336,9 +330,9 @@ static mcsg_status number_roots(const mci_ctx *ctx, mci_scene *s, numbering *nb,
         *count += roots;
     }
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, chunks, number_chunk, &j, err);
+        st = mci_parallel_for_ranges(ctx, nb->total, HASH_CHUNK, number_chunk, &j, err);
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, chunks, renumber_chunk, &j, err);
+        st = mci_parallel_for_ranges(ctx, nb->total, HASH_CHUNK, renumber_chunk, &j, err);
     mci_free(ctx, j.first_id);
     return st;
 }

@@ -55,13 +55,11 @@ typedef struct plane_job {
     mci_plane_cache *c;
 } plane_job;
 
-static mcsg_status plane_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status plane_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const plane_job *j = user;
-    size_t n = j->s->face_count;
-    size_t end = mci_chunk_end(n, chunk, MCI_FACE_CHUNK);
     (void)err;
-    for (size_t f = chunk * MCI_FACE_CHUNK; f < end; f++)
+    for (size_t f = begin; f < end; f++)
         if (j->c->slot[f] != MCI_NONE)
             mci_scene_face_plane(j->s, (uint32_t)f, &j->c->planes[j->c->slot[f]]);
     return MCSG_OK;
@@ -91,8 +89,8 @@ static bool cache_planes(const mci_ctx *ctx, const mci_scene *s, const uint64_t 
         return false;
     job.s = s;
     job.c = c;
-    return mci_parallel_for(ctx, (s->face_count + MCI_FACE_CHUNK - 1) / MCI_FACE_CHUNK, plane_chunk,
-                            &job, NULL) == MCSG_OK;
+    return mci_parallel_for_ranges(ctx, s->face_count, MCI_FACE_CHUNK, plane_chunk, &job,
+                                   NULL) == MCSG_OK;
 }
 
 /* The pair tests run in fixed-size chunks, each with its own hit list; the lists are
@@ -131,12 +129,11 @@ static bool trim_hits(const mci_ctx *ctx, mci_hit_list *h)
 
 /* Every coplanar pair is kept, touching or not: faces that only share an edge still
  * exchange the points on it. */
-static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status intersect_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     pair_job *j = user;
-    pair_chunk *c = &j->chunks[chunk];
-    size_t end = (chunk + 1) * PAIR_CHUNK < j->count ? (chunk + 1) * PAIR_CHUNK : j->count;
-    size_t pairs = end - chunk * PAIR_CHUNK;
+    pair_chunk *c = &j->chunks[begin / PAIR_CHUNK];
+    size_t pairs = end - begin;
     mci_hit_list *h = &c->hits;
     /* Room for a hit per pair and two ends each, trimmed after: growing by doubling
      * copied every chunk's records about twice, and room never written takes no memory
@@ -145,11 +142,11 @@ static mcsg_status intersect_chunk(void *user, size_t chunk, mcsg_error *err)
         !mci_grow_array(j->ctx, (void **)&h->defs, &h->def_capacity, 2 * pairs,
                         sizeof *h->defs, 1))
         return mci_fail_nomem(err, "intersecting faces");
-    for (size_t i = chunk * PAIR_CHUNK; i < end; i++) {
+    for (size_t i = begin; i < end; i++) {
         uint32_t f = (uint32_t)(j->pairs[i] >> 32), g = (uint32_t)j->pairs[i];
         mci_tt_result r;
-        mci_triangle_intersection_defined(mci_cached_plane(j->cache, f), mci_cached_plane(j->cache, g),
-                                          &r);
+        mci_triangle_intersection_defined(mci_cached_plane(j->cache, f),
+                                          mci_cached_plane(j->cache, g), &r);
         c->crossing += r.kind == MCI_TT_SEGMENT;
         c->points += r.kind == MCI_TT_POINT;
         c->coplanar += r.kind == MCI_TT_COPLANAR && r.overlap;
@@ -302,8 +299,8 @@ void mci_plane_cache_free(const mci_ctx *ctx, mci_plane_cache *c)
 /* The hits of the candidate pairs, and in *cache the planes of their faces (the
  * arrangements use them again). */
 mcsg_status mci_intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t *pairs,
-                                   size_t count, mci_plane_cache *cache, mci_hit_list *hits,
-                                   mcsg_error *err)
+                                size_t count, mci_plane_cache *cache, mci_hit_list *hits,
+                                mcsg_error *err)
 {
     size_t n = (count + PAIR_CHUNK - 1) / PAIR_CHUNK;
     pair_job job = {ctx, pairs, count, cache, mci_calloc_array(ctx, n + 1, sizeof *job.chunks)};
@@ -311,7 +308,7 @@ mcsg_status mci_intersect_pairs(const mci_ctx *ctx, mci_scene *s, const uint64_t
                          ? MCSG_OK
                          : mci_fail_nomem(err, "intersecting faces");
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, n, intersect_chunk, &job, err);
+        st = mci_parallel_for_ranges(ctx, count, PAIR_CHUNK, intersect_chunk, &job, err);
     if (st == MCSG_OK)
         st = join_chunks(ctx, s, job.chunks, n, hits, err);
     for (size_t c = 0; job.chunks && c < n; c++) {

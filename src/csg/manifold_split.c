@@ -49,11 +49,6 @@ typedef struct splitter {
     size_t *extra;            /* per chunk: new vertices; then the first new id */
 } splitter;
 
-static size_t chunk_end(const splitter *sp, size_t chunk)
-{
-    return mci_chunk_end(sp->m->vertex_count, chunk, VERTEX_CHUNK);
-}
-
 static const double *vertex(const mcsg_mesh *m, uint32_t v)
 {
     return m->vertices + 3 * (size_t)v;
@@ -303,21 +298,14 @@ static uint32_t run_to(const splitter *sp, uint32_t u, uint32_t v, size_t *count
     return first;
 }
 
-static uint32_t find(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x)
-        x = parent[x] = parent[parent[x]];
-    return x;
-}
-
 /* Whether the pairs of an edge u-v (from[k]: u -> v, paired) get vertex copies that
  * separate them: each pair's umbrellas at u and at v differ from every other pair's. */
 static bool pairs_separate(const splitter *sp, const uint32_t *from, size_t pairs)
 {
     uint32_t at_u[32], at_v[32];
     for (size_t k = 0; k < pairs; k++) {
-        at_u[k] = find(sp->parent, from[k]);
-        at_v[k] = find(sp->parent, next_in_triangle(from[k]));
+        at_u[k] = mci_find_root(sp->parent, from[k]);
+        at_v[k] = mci_find_root(sp->parent, next_in_triangle(from[k]));
         for (size_t j = 0; j < k; j++)
             if (at_u[j] == at_u[k] && at_v[j] == at_v[k])
                 return false;
@@ -432,11 +420,12 @@ static size_t pair_at_vertex(splitter *sp, size_t chunk, uint32_t u, pairing how
     return counted;
 }
 
-static mcsg_status pair_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status pair_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     splitter *sp = user;
+    size_t chunk = begin / VERTEX_CHUNK;
     (void)err;
-    for (uint32_t u = (uint32_t)(chunk * VERTEX_CHUNK); u < chunk_end(sp, chunk); u++)
+    for (uint32_t u = (uint32_t)begin; u < end; u++)
         sp->reordered_edges[chunk] += pair_at_vertex(sp, chunk, u, BY_ANGLE);
     return MCSG_OK;
 }
@@ -469,7 +458,8 @@ static bool pair_edges(splitter *sp)
 {
     for (size_t s = 0; s < 3 * sp->m->triangle_count; s++)
         sp->mate[s] = MCI_NONE;
-    if (mci_parallel_for(sp->ctx, sp->chunks, pair_chunk, sp, NULL) != MCSG_OK)
+    if (mci_parallel_for_ranges(sp->ctx, sp->m->vertex_count, VERTEX_CHUNK, pair_chunk, sp,
+                                NULL) != MCSG_OK)
         return false;
     pair_reordered(sp);
     return true;
@@ -497,8 +487,8 @@ static void group_corners(const splitter *sp, const uint32_t *corners, size_t n,
             uint32_t other = sp->mate[at_x[e]], d;
             if (other == MCI_NONE || (d = corner_at(m, other, x)) == MCI_NONE)
                 continue;
-            d = find(parent, d);
-            c = find(parent, c);
+            d = mci_find_root(parent, d);
+            c = mci_find_root(parent, c);
             if (c != d)
                 parent[c > d ? c : d] = c < d ? c : d;
         }
@@ -529,21 +519,21 @@ static bool one_umbrella(const splitter *sp, const uint32_t *corners, size_t n)
     return false;
 }
 
-static mcsg_status group_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status group_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     splitter *sp = user;
     const uint32_t *start = sp->start, *corner = sp->corner;
-    size_t extra = 0;
+    size_t chunk = begin / VERTEX_CHUNK, extra = 0;
     (void)err;
-    for (size_t v = chunk * VERTEX_CHUNK; v < chunk_end(sp, chunk); v++) {
+    for (size_t v = begin; v < end; v++) {
         uint32_t first_root;
         if (start[v] == start[v + 1] ||
             one_umbrella(sp, corner + start[v], start[v + 1] - start[v]))
             continue;
         group_corners(sp, corner + start[v], start[v + 1] - start[v], sp->parent);
-        first_root = find(sp->parent, corner[start[v]]);
+        first_root = mci_find_root(sp->parent, corner[start[v]]);
         for (uint32_t k = start[v]; k < start[v + 1]; k++) {
-            uint32_t root = find(sp->parent, corner[k]);
+            uint32_t root = mci_find_root(sp->parent, corner[k]);
             if (root != first_root && sp->copy[root] == MCI_NONE) {
                 sp->copy[root] = 0;
                 extra++;
@@ -556,17 +546,17 @@ static mcsg_status group_chunk(void *user, size_t chunk, mcsg_error *err)
 
 /* Give the chunk's extra umbrellas their vertices, numbered from extra[chunk] on in vertex
  * and corner order, with the coordinates of the vertex they copy. */
-static mcsg_status number_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status number_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     splitter *sp = user;
     mcsg_mesh *m = sp->m;
     const uint32_t *start = sp->start, *corner = sp->corner;
-    size_t next = sp->extra[chunk];
+    size_t next = sp->extra[begin / VERTEX_CHUNK];
     (void)err;
-    for (size_t v = chunk * VERTEX_CHUNK; v < chunk_end(sp, chunk); v++) {
-        uint32_t first_root = start[v] < start[v + 1] ? find(sp->parent, corner[start[v]]) : 0;
+    for (size_t v = begin; v < end; v++) {
+        uint32_t first_root = start[v] < start[v + 1] ? mci_find_root(sp->parent, corner[start[v]]) : 0;
         for (uint32_t k = start[v]; k < start[v + 1]; k++) {
-            uint32_t c = corner[k], root = find(sp->parent, c);
+            uint32_t c = corner[k], root = mci_find_root(sp->parent, c);
             if (root == first_root)
                 continue;
             if (sp->copy[root] == 0) {
@@ -585,7 +575,7 @@ static void group(splitter *sp)
 {
     for (size_t c = 0; c < 3 * sp->m->triangle_count; c++)
         sp->parent[c] = (uint32_t)c, sp->copy[c] = MCI_NONE;
-    mci_parallel_for(sp->ctx, sp->chunks, group_chunk, sp, NULL);
+    mci_parallel_for_ranges(sp->ctx, sp->m->vertex_count, VERTEX_CHUNK, group_chunk, sp, NULL);
 }
 
 /* Once grouped: the edges with over two triangles that vertex copies would not separate
@@ -630,7 +620,7 @@ static bool split_vertices(splitter *sp, size_t *added)
         !(grown = mci_realloc_array(sp->ctx, m->vertices, nv + extra, 3 * sizeof(double))))
         return false;
     m->vertices = grown;
-    mci_parallel_for(sp->ctx, sp->chunks, number_chunk, sp, NULL);
+    mci_parallel_for_ranges(sp->ctx, sp->m->vertex_count, VERTEX_CHUNK, number_chunk, sp, NULL);
     m->vertex_count = nv + extra;
     *added = extra;
     return true;

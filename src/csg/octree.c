@@ -305,13 +305,11 @@ static void exact_box(const double *const v[3], double box[6])
     }
 }
 
-static mcsg_status box_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status box_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const box_job *j = user;
-    uint32_t faces = j->t->face_base[j->t->leaf_count];
-    uint32_t end = (uint32_t)mci_chunk_end(faces, chunk, FACE_CHUNK);
     (void)err;
-    for (uint32_t f = (uint32_t)(chunk * FACE_CHUNK); f < end; f++) {
+    for (uint32_t f = (uint32_t)begin; f < end; f++) {
         const double *v[3] = {mci_octree_face_vertex(j->t, f, 0),
                               mci_octree_face_vertex(j->t, f, 1),
                               mci_octree_face_vertex(j->t, f, 2)};
@@ -331,7 +329,7 @@ static float *face_boxes(const mci_ctx *ctx, const mci_octree *t)
     uint32_t faces = t->face_base[t->leaf_count];
     box_job job = {t, mci_malloc_array(ctx, (size_t)faces + 1, 6 * sizeof *job.box)};
     if (job.box)
-        mci_parallel_for(ctx, (faces + FACE_CHUNK - 1) / FACE_CHUNK, box_chunk, &job, NULL);
+        mci_parallel_for_ranges(ctx, faces, FACE_CHUNK, box_chunk, &job, NULL);
     return job.box;
 }
 
@@ -438,18 +436,12 @@ typedef struct mask_job {
     uint8_t *mask;
 } mask_job;
 
-static void masks(const mask_job *j, size_t first, size_t end)
-{
-    for (size_t k = first; k < end; k++)
-        j->mask[k] = children_touched(j->b, j->cell, j->child, j->mid, j->faces[k]);
-}
-
-static mcsg_status mask_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status masks(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const mask_job *j = user;
-    size_t n = j->cell->count;
     (void)err;
-    masks(j, chunk * FACE_CHUNK, mci_chunk_end(n, chunk, FACE_CHUNK));
+    for (size_t k = begin; k < end; k++)
+        j->mask[k] = children_touched(j->b, j->cell, j->child, j->mid, j->faces[k]);
     return MCSG_OK;
 }
 
@@ -477,10 +469,9 @@ static mcsg_status split_cell(level_job *j, size_t i, bool parallel, mcsg_error 
     for (int c = 0; c < 8; c++)
         child_box(cell, c, out->mid, &child[c]);
     if (parallel)
-        st = mci_parallel_for(j->b->ctx, (cell->count + FACE_CHUNK - 1) / FACE_CHUNK, mask_chunk,
-                              &m, err);
+        st = mci_parallel_for_ranges(j->b->ctx, cell->count, FACE_CHUNK, masks, &m, err);
     else
-        masks(&m, 0, cell->count);
+        masks(&m, 0, cell->count, NULL);
     for (uint32_t k = 0; st == MCSG_OK && k < cell->count; k++)
         for (unsigned bits = m.mask[k]; bits; bits &= bits - 1)
             out->counts[lowest_bit[bits]]++;
@@ -788,13 +779,12 @@ typedef struct pair_job {
     pair_chunk_list *chunks;
 } pair_job;
 
-static mcsg_status collect_chunk(void *user, size_t chunk, mcsg_error *err)
+static mcsg_status collect_chunk(void *user, size_t begin, size_t end, mcsg_error *err)
 {
     const pair_job *j = user;
-    pair_chunk_list *out = &j->chunks[chunk];
-    size_t end = (chunk + 1) * PAIR_CELLS_PER_CHUNK;
+    pair_chunk_list *out = &j->chunks[begin / PAIR_CELLS_PER_CHUNK];
     bool ok = true;
-    for (size_t k = chunk * PAIR_CELLS_PER_CHUNK; ok && k < end && k < j->cell_count; k++)
+    for (size_t k = begin; ok && k < end; k++)
         ok = collect_cell_pairs(j->ctx, j->tree, j->box, &j->fc, &j->tree->cells[j->cells[k]],
                                 (uint32_t)k, out);
     mci_free(j->ctx, out->faces);
@@ -1003,7 +993,8 @@ mcsg_status mci_octree_candidate_pairs(const mci_ctx *ctx, const mci_octree *tre
     if (!job.box || !job.cells || !job.chunks)
         st = mci_fail_nomem(err, "collecting candidate pairs");
     if (st == MCSG_OK)
-        st = mci_parallel_for(ctx, chunk_count, collect_chunk, &job, err);
+        st = mci_parallel_for_ranges(ctx, job.cell_count, PAIR_CELLS_PER_CHUNK, collect_chunk,
+                                     &job, err);
     mci_free(ctx, job.cells);
     mci_free(ctx, job.fc.start);
     mci_free(ctx, job.fc.cell);

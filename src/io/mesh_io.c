@@ -21,26 +21,35 @@
 /* ---------------------------------------------------------------------------------- */
 /* Errors                                                                              */
 
+mcsg_status mci_io_vfail(const mci_io_source *src, mcsg_status status, bool binary,
+                         size_t where, const char *fmt, va_list ap)
+{
+    char prefix[MCSG_ERROR_MESSAGE_SIZE];
+    if (binary)
+        snprintf(prefix, sizeof prefix, "%s: byte %zu", src->name, where);
+    else
+        snprintf(prefix, sizeof prefix, "%s:%zu", src->name, where);
+    return mci_vfail(src->err, status, prefix, fmt, ap);
+}
+
 mcsg_status mci_io_fail_line(const mci_io_source *src, mcsg_status status, size_t line,
                              const char *fmt, ...)
 {
-    char what[MCSG_ERROR_MESSAGE_SIZE];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
+    mci_io_vfail(src, status, false, line, fmt, ap);
     va_end(ap);
-    return mci_fail(src->err, status, "%s:%zu: %s", src->name, line, what);
+    return status;
 }
 
 mcsg_status mci_io_fail_byte(const mci_io_source *src, mcsg_status status, size_t offset,
                              const char *fmt, ...)
 {
-    char what[MCSG_ERROR_MESSAGE_SIZE];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
+    mci_io_vfail(src, status, true, offset, fmt, ap);
     va_end(ap);
-    return mci_fail(src->err, status, "%s: byte %zu: %s", src->name, offset, what);
+    return status;
 }
 
 mcsg_status mci_io_fail_build(const mci_io_source *src, mcsg_status status, bool binary,

@@ -29,6 +29,9 @@ mcsg_status mci_io_fail_line(const mci_io_source *src, mcsg_status status, size_
 /* "NAME: byte OFFSET: message" (binary formats). Returns `status`. */
 mcsg_status mci_io_fail_byte(const mci_io_source *src, mcsg_status status, size_t offset,
                              const char *fmt, ...) MCI_PRINTF(4, 5);
+/* Either of the two from a va_list: at byte `where` when binary, else at line `where`. */
+mcsg_status mci_io_vfail(const mci_io_source *src, mcsg_status status, bool binary,
+                         size_t where, const char *fmt, va_list ap);
 /* Report a failure of the mesh builder (MCSG_ERR_NOMEM or MCSG_ERR_LIMIT) at a line
  * (binary == false) or byte offset (binary == true). Returns `status`. */
 mcsg_status mci_io_fail_build(const mci_io_source *src, mcsg_status status, bool binary,

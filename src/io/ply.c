@@ -502,14 +502,11 @@ static mcsg_status fail_body(const ply_reader *r, size_t where, const char *fmt,
 
 static mcsg_status fail_body(const ply_reader *r, size_t where, const char *fmt, ...)
 {
-    char what[MCSG_ERROR_MESSAGE_SIZE];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
+    mci_io_vfail(r->src, MCSG_ERR_PARSE, is_binary(r), where, fmt, ap);
     va_end(ap);
-    if (is_binary(r))
-        return mci_io_fail_byte(r->src, MCSG_ERR_PARSE, where, "%s", what);
-    return mci_io_fail_line(r->src, MCSG_ERR_PARSE, where, "%s", what);
+    return MCSG_ERR_PARSE;
 }
 
 /* Where a value read from byte `start` was: that offset (binary), or the line of the

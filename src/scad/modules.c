@@ -76,25 +76,24 @@ typedef struct call_args {
 mcsg_status scad_fail_at(const char *name, uint32_t line, uint32_t col, mcsg_error *err,
                          mcsg_status status, const char *fmt, ...)
 {
-    char what[MCSG_ERROR_MESSAGE_SIZE];
+    char where[MCSG_ERROR_MESSAGE_SIZE];
     va_list ap;
+    snprintf(where, sizeof where, "%s:%u:%u", name, line, col);
     va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
+    mci_vfail(err, status, where, fmt, ap);
     va_end(ap);
-    return mci_fail(err, status, "%s:%u:%u: %s", name, line, col, what);
+    return status;
 }
 
 void scad_warn_at(const mci_ctx *ctx, const char *name, uint32_t line, uint32_t col,
                   const char *fmt, ...)
 {
-    char what[900];
+    char where[MCSG_ERROR_MESSAGE_SIZE];
     va_list ap;
-    if (!ctx->log)
-        return;
+    snprintf(where, sizeof where, "%s:%u:%u", name, line, col);
     va_start(ap, fmt);
-    vsnprintf(what, sizeof what, fmt, ap);
+    mci_vlog(ctx, MCSG_LOG_WARNING, where, fmt, ap);
     va_end(ap);
-    mci_log(ctx, MCSG_LOG_WARNING, "%s:%u:%u: %s", name, line, col, what);
 }
 
 static int param_slot(scad_module module, const char *name, uint32_t len)
