@@ -7,7 +7,6 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "base/core.h"
 #include "base/parallel.h"
 #include "base/sort.h"
 

@@ -7,8 +7,8 @@
 #ifndef MESHCSG_CSG_ARRANGE_H
 #define MESHCSG_CSG_ARRANGE_H
 
-#include "exact/kernel.h"
 #include "base/core.h"
+#include "exact/kernel.h"
 
 /* Where a point of a face lies. */
 enum {

@@ -1,16 +1,77 @@
 /*
- * mcsg_eval: the whole pipeline in one pass over the tree. Positive tree and CSGlists
- * (csgtree.c), intersection stage over the primitives (intersect.c), tessellation of the
- * split faces (arrange.c, triangulate.c), classification (classify.c), and assembly:
- * output vertices are the scene's exact points, welded by their global numbers, and
- * rounded to double only here.
+ * mcsg_eval: the whole pipeline, in one pass over the tree (no intermediate result of an
+ * inner node is ever built), exact until the output vertices are rounded at the end.
+ *
+ * The method is Rui Wang, Xudong Jiang, Hongbo Fu, Bin Sheng, Enhua Wu, "Efficient
+ * Non-incremental Constructive Solid Geometry Evaluation for Triangular Meshes" (published
+ * in Graphical Models 97 (2018) 1-16, doi:10.1016/j.gmod.2018.03.001, under the authors
+ * Bin Sheng, Ping Li, Hongbo Fu, Lizhuang Ma, Enhua Wu), cited below by section; meshcsg
+ * makes its every decision an exact predicate.
+ *
+ * Key: stage -> function -> file -> paper. In the order run() calls them.
+ *
+ *   positive tree, CSGlists   mci_ptree_build             csgtree.c          §5.1, §5.3
+ *   input contract            mci_check_leaves            leaf_check.c       -
+ *   copies of a leaf          find_copies                 eval.c             -
+ *   octree                    mci_octree_build            octree.c           §3.1
+ *   candidate pairs           mci_octree_candidate_pairs  octree.c           §3.1, §4.1
+ *   pair tests                mci_intersect_pairs         intersect_pairs.c  §4.1
+ *     one pair, exactly       mci_triangle_intersection_defined
+ *                                                         exact/tri_tri.c    §4.1
+ *   faces dropped whole       mci_decide_whole_faces      whole_faces.c      §5.2, §5.3
+ *   per-face records          mci_scene_arrange           intersect_arrange.c
+ *                                                                            §4.2
+ *   splitting at crossings    mci_scene_split             intersect_arrange.c,
+ *                                                         arrange.c          §4.2
+ *   global point identity     mci_scene_number_points     intersect_numbering.c
+ *                                                                            -
+ *   tessellation              mci_arr_triangulate         arrange.c,
+ *                                                         triangulate.c      §5.4
+ *   classification            mci_classify_leaf           classify*.c        §5.2, §5.5
+ *     first seeds (rays)      mci_ray_label_octree        rays.c             §5.2, §5.5
+ *     across a separator      mci_local_label             local_test.c       Prop. 2
+ *     trimmed CSGlist         mci_csglist_trim_sparse     csgtree.c          §5.3
+ *     output tessellation     mci_arr_retessellate        retessellate.c     §5.4
+ *   assembly                  assemble                    eval.c             -
+ *     rounding                mci_point_round             exact/kernel.c     -
+ *     folds and flat ones     mci_cancel_opposite_triangles,
+ *                             mci_split_flat_triangles    rounding_repair.c  -
+ *     touching parts          mci_split_touching          manifold_split.c   -
+ *     void shells             mci_drop_void_shells        void_shells.c      -
+ *
+ * Glossary.
+ *   leaf        a mesh of the CSG tree (mcsg_tree), as the user gave it.
+ *   primitive   a leaf of the positive tree (differences pushed into complemented
+ *               leaves, paper Eq. 4) that the root reaches and that has triangles;
+ *               numbered 0 .. n-1. Code says "leaf" for primitive where no confusion
+ *               arises.
+ *   face        an input triangle of a primitive; global face ids number all faces.
+ *   touched     a face that meets another primitive's surface: it gets an
+ *               arrangement (mci_face_arr).
+ *   LPI, TPI    the two kinds of implicit points: a line (an edge) meeting a plane,
+ *               three planes meeting. Points are exact definitions, never coordinates
+ *               (docs/exact-arithmetic.md).
+ *   piece       a triangle of a touched face's tessellation, or an untouched face.
+ *   separator   an elementary edge of an arrangement: it lies on another primitive's
+ *               surface, so labels may change across it.
+ *   region      the pieces of one primitive joined across every edge that is not a
+ *               separator: its labels are constant (the paper's intra-primitive group).
+ *   label       where something lies with respect to a primitive: IN, OUT, or on its
+ *               surface with the same (SAME) or opposite (OPPO) orientation.
+ *   wall        the border of a face dropped whole: a region's labels come only from
+ *               its own side of it.
+ *   dropped whole   a touched face that the result drops entirely, known from its
+ *               labels with respect to the primitives it does not meet: it is neither
+ *               split nor tessellated.
+ *   copy, stand-in  a primitive whose mesh is the same arrays as an earlier one's: the
+ *               earlier one (its stand-in) is evaluated for both.
  */
-#include "csg/classify.h"
 #include "base/parallel.h"
+#include "csg/classify.h"
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
-#include "csg/void_shells.h"
 #include "csg/rounding_repair.h"
+#include "csg/void_shells.h"
 #include "csg/whole_faces.h"
 
 #include <stdlib.h>

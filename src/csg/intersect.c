@@ -6,9 +6,9 @@
  * (intersect_numbering.c). This file runs the steps, frees the scene, and gives the
  * public mcsg_intersect its curves.
  */
-#include "csg/intersect_internal.h"
 #include "base/parallel.h"
 #include "base/sort.h"
+#include "csg/intersect_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

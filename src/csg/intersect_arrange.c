@@ -5,9 +5,8 @@
  * both tessellations have them: no T-junctions), and the splitting of every arrangement
  * at its crossings. mci_scene_arrange and mci_scene_split (intersect.h) run the steps.
  */
-#include "csg/intersect_internal.h"
 #include "base/parallel.h"
-#include "base/sort.h"
+#include "csg/intersect_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

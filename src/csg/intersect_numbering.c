@@ -2,9 +2,9 @@
  * One number per distinct point of all arrangements (mci_scene_number_points): exact
  * identity over the whole scene, not welding by distance.
  */
-#include "csg/intersect_internal.h"
 #include "base/parallel.h"
 #include "base/sort.h"
+#include "csg/intersect_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

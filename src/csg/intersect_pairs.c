@@ -5,8 +5,8 @@
  * is computed once, and the edge-plane points that the two faces along an edge both
  * find are one definition.
  */
-#include "csg/intersect_internal.h"
 #include "base/parallel.h"
+#include "csg/intersect_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

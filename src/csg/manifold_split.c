@@ -20,12 +20,9 @@
  * would share both ends' umbrellas, so that no copy could separate them.
  */
 #include "csg/manifold_split.h"
-#include "exact/predicates.h"
 #include "base/parallel.h"
-
-#include "exact/big.h"
 #include "exact/kernel.h"
-#include "csg/intersect.h"
+#include "exact/predicates.h"
 
 #include <string.h>
 

@@ -8,11 +8,10 @@
  * listing both: candidate pairs from leaf cells are complete.
  */
 #include "csg/octree.h"
-#include "exact/predicates.h"
 #include "base/parallel.h"
 #include "base/sort.h"
-#include "exact/big.h"
 #include "exact/kernel.h"
+#include "exact/predicates.h"
 
 #include <math.h>
 #include <stdlib.h>

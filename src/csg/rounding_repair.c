@@ -10,11 +10,9 @@
  * left as it is and counted).
  */
 #include "csg/rounding_repair.h"
-#include "exact/predicates.h"
 #include "base/sort.h"
+#include "exact/predicates.h"
 
-#include "exact/big.h"
-#include "csg/intersect.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -17,10 +17,9 @@
  * Not detected: coplanar triangles with one common vertex whose edges overlap along a
  * segment while their interiors stay apart.
  */
-#include "exact/tri_tri.h"
-#include "exact/predicates.h"
-#include "exact/big.h"
 #include "csg/octree.h"
+#include "exact/predicates.h"
+#include "exact/tri_tri.h"
 
 #include <string.h>
 

@@ -5,8 +5,8 @@
 #ifndef MESHCSG_CSG_TRIANGULATE_H
 #define MESHCSG_CSG_TRIANGULATE_H
 
-#include "exact/kernel.h"
 #include "base/core.h"
+#include "exact/kernel.h"
 
 /* The face and what to put into it. points[0..2] are the face's corners, counter-
  * clockwise in the face's orientation; every other point must lie in the closed face

@@ -20,8 +20,8 @@
  * decided here goes through the whole classification as before.
  */
 #include "csg/whole_faces.h"
-#include "csg/leaf_boxes.h"
 #include "base/parallel.h"
+#include "csg/leaf_boxes.h"
 #include "csg/rays.h"
 
 #include <string.h>

@@ -11,7 +11,6 @@
 #include "io/mesh_io.h"
 #include "base/parallel.h"
 
-#include "base/numparse.h"
 
 #include <float.h>
 #include <math.h>

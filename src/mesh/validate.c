@@ -8,11 +8,9 @@
  * non-manifold, twice in the same direction inconsistent.
  * Degeneracy and the sign of the volume are decided with exact predicates (exact/predicates.h).
  */
-#include "base/core.h"
-#include "exact/predicates.h"
-#include "base/sort.h"
 #include "mesh/validate.h"
-#include "exact/big.h"
+#include "base/sort.h"
+#include "exact/predicates.h"
 
 #include <float.h>
 #include <limits.h>

@@ -16,8 +16,8 @@
  * updated in place, and the heap is capped in proportion to the text's size, so that
  * hostile text cannot make evaluation allocate more than a constant factor of itself.
  */
-#include "scad/degree_trig.h"
 #include "base/numparse.h"
+#include "scad/degree_trig.h"
 #include "scad/scad.h"
 
 #include <math.h>

@@ -21,10 +21,10 @@
  * The empty set is always a union node without children (e.g. cube(0), an empty mesh
  * from import or polyhedron, a leaf under a flattening transform).
  */
-#include "scad/degree_trig.h"
 #include "base/numparse.h"
-#include "scad/scad.h"
 #include "mesh/tree.h"
+#include "scad/degree_trig.h"
+#include "scad/scad.h"
 
 #include <math.h>
 #include <stdio.h>

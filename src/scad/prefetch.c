@@ -10,8 +10,8 @@
  * the call that uses the mesh, from the calling thread and in program order. A file
  * named by several calls is read once; each call but the last gets a copy.
  */
-#include "scad/scad.h"
 #include "base/parallel.h"
+#include "scad/scad.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -19,8 +19,8 @@
  * Triangle counts: cube 12, sphere 2n(rings-1) + 2(n-2), cylinder 2n + 2(n-2),
  * cone n + (n-2).
  */
-#include "scad/degree_trig.h"
 #include "base/core.h"
+#include "scad/degree_trig.h"
 
 #include <limits.h>
 #include <math.h>

@@ -16,7 +16,6 @@
  *    single child, a union node for several, the empty set (a childless union) for none.
  */
 #include "scad/scad.h"
-#include "mesh/tree.h"
 
 #include <string.h>
 
