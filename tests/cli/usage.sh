@@ -64,4 +64,14 @@ contains "8 vertices, 12 triangles"
 cp "$WORK/c.scad" "$WORK/-dash.scad"
 (cd "$WORK" && "$CLI" eval -t 1 -- -dash.scad >/dev/null 2>&1) && passed=$((passed + 1)) ||
   { echo "FAIL: -- did not end the options"; failed=$((failed + 1)); }
+
+# The README shows `meshcsg --help` verbatim: it must not drift from the tables.
+readme=${MCSG_TEST_DATA:?}/../../README.md
+if [ -f "$readme" ]; then
+  shown=$(awk '/^## Command line/ { section = 1 } section && /^```$/ { if (inside) exit; inside = 1; next }
+               inside { print }' "$readme")
+  if [ "$shown" = "$("$CLI" --help)" ]; then passed=$((passed + 1))
+  else echo "FAIL: README.md's command-line block differs from meshcsg --help:"
+    diff <(printf '%s\n' "$shown") <("$CLI" --help) | head -20; failed=$((failed + 1)); fi
+fi
 finish
