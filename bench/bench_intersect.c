@@ -1,5 +1,5 @@
 /*
- * The whole intersection stage (issue 4) on the benchmark scenes: octree, candidate
+ * The whole intersection stage on the benchmark scenes: octree, candidate
  * pairs, exact triangle-triangle intersection, per-face arrangements, numbering of all
  * points, and the triangulation of every touched face with all its constraints. Scenes
  * as in bench_octree (the ring built in memory exactly as ../shared/scenes does; a

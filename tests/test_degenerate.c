@@ -1,5 +1,5 @@
 /*
- * Degenerate-case corpus (issue 6 item 1), first part: scenes built to hit the special
+ * Degenerate-case corpus, first part: scenes built to hit the special
  * cases of exact CSG, each with its expected volume (exact where the geometry allows,
  * otherwise an identity that must hold: |A u B| + |A n B| = |A| + |B|, independence of
  * operand order, scaling by s^3). Every output must be closed, consistently oriented,
