@@ -21,9 +21,9 @@
  * locale. printf itself is the fallback only: the 15, 16 or 17 digits come from an exact
  * 128-bit product m 5^k 2^j, correctly rounded, and whether they read back is decided from
  * the same product and a bound on the gap between doubles, or on exact integers where the
- * bound cannot tell (printf's multi-precision path cost ~5,000 instructions per number,
- * most of the time of writing a mesh). Digits are written eight at a time by fixed-point
- * multiplication, without divisions.
+ * bound cannot tell (printf's multi-precision path cost thousands of instructions per
+ * number, most of the time of writing a mesh). Digits are written eight at a time by
+ * fixed-point multiplication, without divisions.
  */
 #include "base/numparse.h"
 
@@ -553,8 +553,8 @@ static inline const char *accumulate_digits(const char *p, const char *end, uint
  * count, trailing ones do), accumulated as they are read, and an exponent within the
  * 64- and 128-bit paths. Returns the first byte after the number, or NULL when the
  * general scanner must decide (more digits, no digit, a far exponent). Mesh files are
- * mostly 17-digit numbers: storing each digit and converting afterwards cost some 600
- * instructions per number. */
+ * mostly 17-digit numbers: storing each digit and converting afterwards cost hundreds
+ * of instructions per number. */
 static const char *scan_short(const char *s, const char *end, double *value)
 {
     uint64_t m = 0; /* wraps past 19 digits, and is then not used */

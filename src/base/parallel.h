@@ -9,9 +9,9 @@
 #include "base/core.h"
 
 /* Worker threads kept waiting for the parallel loops of one public call (or of many,
- * through mcsg_options.pool): starting a thread per loop cost 0.05-5 ms per loop on the
- * two-core test machine (the new thread waited for a sleeping processor), which the
- * short loops could not repay. Workers spin briefly between loops, then sleep.
+ * through mcsg_options.pool): starting a thread per loop cost up to milliseconds per
+ * loop (the new thread waited for a sleeping processor), which the short loops could
+ * not repay. Workers spin briefly between loops, then sleep.
  * mci_pool_start does nothing when ctx has a pool already (the options'), with one
  * thread, or when threads or memory are short (loops then start their own threads);
  * mci_pool_stop joins and frees the workers it started. A loop started while the pool

@@ -2,7 +2,7 @@
  * A type-specialised introsort, instantiated per element type. qsort calls its
  * comparison through a pointer and merges through a buffer; the arrangements and
  * triangulations sort hundreds of thousands of short arrays (10-50 items), where that
- * overhead was most of the cost (~2% of ring-800's instructions).
+ * overhead was most of the cost.
  *
  * MCI_DEFINE_SORT(name, type, less) defines
  *     static inline void name(type *items, size_t n);

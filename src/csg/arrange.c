@@ -96,7 +96,7 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
     if (arr->axis < 0)
         return mci_fail(err, MCSG_ERR_INVALID_MESH, "face %u is degenerate", face);
     /* Only coplanar faces use auxiliary vertices (72 bytes for the corners' alone, in
-     * every arrangement, were 3% of ring-800's peak). */
+     * every arrangement, showed in the peak memory of dense scenes). */
     arr->aux_capacity = max_coplanar ? 3 + 3 * (uint32_t)max_coplanar : 0;
     if (max_coplanar)
         arr->aux = mci_malloc_array(ctx, arr->aux_capacity, sizeof *arr->aux);
@@ -122,7 +122,7 @@ mcsg_status mci_arr_init(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
 }
 
 /* What merging the three corners would give: they stay in place, located, with no
- * line (without the merge's allocation and sort: 44K of ring-800's 92K touched faces
+ * line (without the merge's allocation and sort: in dense scenes many touched faces
  * are dropped whole). */
 mcsg_status mci_arr_init_corners(const mci_ctx *ctx, mci_face_arr *arr, uint32_t face,
                                  const double *a, const double *b, const double *c,
@@ -643,7 +643,7 @@ static mcsg_status merge_points(const mci_ctx *ctx, mci_face_arr *arr, arr_cut *
 {
     size_t n = arr->point_count, kept = 0;
     /* One block for the key table, the two id arrays of the sort and the id map (four
-     * allocations per merge were a tenth of the merge's cost on small faces). */
+     * allocations per merge were a sizeable part of the merge's cost on small faces). */
     point_key *table = mci_malloc_array(ctx, n + 1, sizeof *table + 3 * sizeof(uint32_t));
     uint32_t *idx = table ? (uint32_t *)(void *)(table + n + 1) : NULL;
     uint32_t *tmp = idx ? idx + n + 1 : NULL;

@@ -77,8 +77,8 @@ typedef struct mci_face_arr {
     uint32_t *adj;       /* ... and the side across each side (mci_cdt_output.adj) */
     uint32_t face;       /* global face id */
     int axis, sign;      /* projection (mci_plane_projection_axis) */
-    /* Counts in 32 bits (point ids are 32-bit anyway): one header per touched face,
-     * 92K on ring-800, 192 bytes each instead of 232. */
+    /* Counts in 32 bits (point ids are 32-bit anyway): one header per touched face
+     * (tens of thousands in dense scenes), each some 40 bytes smaller. */
     uint32_t where_count; /* points classified in where[] */
     uint32_t point_count, point_capacity;
     uint32_t segment_count, segment_capacity;
@@ -114,7 +114,7 @@ void mci_arr_free_segments(const mci_ctx *ctx, mci_face_arr *arr);
 
 /* Room for `points` points and `segments` segments in all (when more than now), so that
  * adding a counted number of them does not grow the arrays step by step (doubling left
- * a third of the arrangements' memory unused). False when out of memory. */
+ * much of the arrangements' memory unused). False when out of memory. */
 bool mci_arr_reserve(const mci_ctx *ctx, mci_face_arr *arr, size_t points, size_t segments);
 
 /* p made stable, for a point built on the stack that is to be added: the stored corner

@@ -136,7 +136,8 @@ static bool separator_on_leaf(const mci_leaf_work *w, size_t k, uint32_t m)
     return false;
 }
 
-/* memchr first: the ring of ring-800 has ~800 candidates, all needed and labelled. */
+/* memchr first: a leaf that hundreds of others cross (the ring of a ring of spheres) has
+ * as many candidates, all needed and labelled. */
 static bool has_unknown_label(const mci_leaf_work *w, uint32_t r)
 {
     const uint8_t *lab = w->labels + (size_t)r * w->ncand, *end = lab + w->ncand, *at = lab;

@@ -172,7 +172,7 @@ static bool is_wall(mci_leaf_work *w, size_t slot, uint64_t key)
 }
 
 /* Pairing by vertex, when the leaf's vertex ids are dense (a model's own vertices,
- * numbered together; sorting 1.2 million edge keys took most of bunny400k's
+ * numbered together; sorting millions of edge keys took most of a large model's
  * classification). The border slots are listed by their start vertex (a counting sort
  * over the ids from the smallest); each slot u -> v finds its opposite among v's. The
  * outcome is the sort's when every edge has exactly two sides, one each way, or one side

@@ -229,7 +229,8 @@ static bool labels_from_inside(mci_leaf_work *w, uint32_t r)
 
 /* Whether region r is kept, for this leaf or its copy k (-1: its labels do not tell). */
 /* The blist on region r's own labels (mci_blist_accepts without spreading them over the
- * leaves first: the ring of ring-800 has ~800 candidates, and a walk reads a few). */
+ * leaves first: a leaf that hundreds of others cross has as many candidates, and a walk
+ * reads a few). */
 static int region_blist_accepts(const mci_leaf_work *w, uint32_t r)
 {
     const uint8_t *lab = w->labels + (size_t)r * w->ncand;

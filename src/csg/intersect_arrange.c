@@ -263,9 +263,9 @@ static bool compute_face_facts(const mci_ctx *ctx, const mci_scene *s, const mci
 
 /* One explicit point per vertex of an arranged face, which every arrangement with that
  * vertex refers to (a vertex is a corner of six faces and an end of many hits: copies
- * took a sixth of ring-800's arrangement memory). `slot` maps global vertex ids (leaf
- * by leaf, from `first`) to points; it lives while arranging, the points as long as the
- * arrangements (mci_scene.vertex_points). */
+ * took much of the arrangement memory of dense scenes). `slot` maps global vertex ids
+ * (leaf by leaf, from `first`) to points; it lives while arranging, the points as long
+ * as the arrangements (mci_scene.vertex_points). */
 typedef struct vertex_table {
     size_t *first;  /* per leaf, its vertex 0's global id */
     uint32_t *slot; /* per global vertex: 1 + index in points, or 0 */
@@ -289,7 +289,7 @@ static void free_vertex_map(const mci_ctx *ctx, vertex_table *vt)
 
 /* Slots for the corners of the arranged faces (face_of: in face order), and their
  * points. Only the arranged faces are visited, and the slot map starts zeroed (no pass
- * over every vertex: the 3.2M-face scene arranges 0.4% of its faces). */
+ * over every vertex: a large model minus a shifted copy arranges few of its faces). */
 static bool build_vertex_table(const mci_ctx *ctx, const mci_scene *s, const uint32_t *face_of,
                                vertex_table *vt)
 {
@@ -675,7 +675,7 @@ typedef struct split_job {
 } split_job;
 
 /* The segments are freed once split: later steps read only the elementary edges, and
- * the segments were a tenth of ring-800's peak. */
+ * the segments were a sizeable part of the dense scenes' peak memory. */
 static mcsg_status split_one(void *user, size_t k, mcsg_error *err)
 {
     const split_job *j = user;
@@ -693,7 +693,7 @@ static mcsg_status split_one(void *user, size_t k, mcsg_error *err)
 /* touch_start / touch_leaf from the hits (each face's list once per leaf, in hit
  * order). A leaf is listed for face f when its mark is not f + 1 yet: a plate's face
  * meets thousands of leaves (its holes), which a search of the face's list made
- * quadratic (drill_plate_64: 1.6G instructions). */
+ * quadratic. */
 static bool record_touches(const mci_ctx *ctx, mci_scene *s, const mci_hit_list *hits,
                            const uint32_t *start, const uint32_t *list)
 {

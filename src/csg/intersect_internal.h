@@ -12,8 +12,8 @@
 /* A hit keeps its end points compactly: an input vertex (most contacts of meshes that
  * share vertices or faces) as its address, other points (edge lines crossing a plane)
  * by their definition. A full point is 176 bytes, and is built only once the faces
- * dropped whole are known (a fifth of the crossings of a dense scene lie between two
- * such faces), and every crossing is found twice (by the two faces along the edge). */
+ * dropped whole are known (many crossings of a dense scene lie between two such
+ * faces), and every crossing is found twice (by the two faces along the edge). */
 typedef struct mci_pair_hit {
     uint32_t f, g;
     uint8_t kind; /* mci_tt_kind */

@@ -119,7 +119,7 @@ static mcsg_status join_same_definitions(const mci_ctx *ctx, numbering *nb, mcsg
 }
 
 /* The certified box rounded outward to floats: the table of these is the peak of the
- * dense scenes' runs (ring-800: 238K roots), and a larger box only adds pairs to test. */
+ * dense scenes' runs, and a larger box only adds pairs to test. */
 typedef struct boxed_slot {
     float lo[3], hi[3];
     uint32_t slot;
@@ -188,8 +188,8 @@ static bool boxes_meet_in_yz(const boxed_slot *a, const boxed_slot *b)
  * a run of equal low x every item overlaps the first in x, and the run is in y order, so
  * its scan stops at the first item beyond the first's y range. Axis-aligned input puts
  * hundreds of points on one x (a column of a grid of holes), which a sweep on x alone
- * compared pairwise (box_grid_64: quadratic per column). The joins do not depend on the
- * order, only on the pairs. */
+ * compared pairwise (quadratic per column). The joins do not depend on the order, only
+ * on the pairs. */
 static void join_overlapping(numbering *nb, const boxed_slot *items, const uint64_t *order,
                              const uint32_t *run_end, size_t n)
 {
@@ -219,7 +219,7 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
     bounds_job j = {nb, NULL, NULL, 0};
     uint32_t *run_end;
     mcsg_status st;
-    /* Sized for the roots only: most slots are copies (ring-800: 797K slots). */
+    /* Sized for the roots only: most slots are copies. */
     for (uint32_t slot = 0; slot < nb->total; slot++)
         roots += nb->parent[slot] == slot;
     j.items = mci_malloc_array(ctx, roots + 1, sizeof *j.items);
@@ -246,7 +246,7 @@ static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_err
 /* The table and the identity parents, on the threads in chunks of arrangements
  * (gid_start set); then, after the joins, the numbers: roots (first occurrences) are
  * numbered in slot order through per-chunk counts, so the numbering does not depend on
- * the threads. Both loops ran on one thread: 797K slots on ring-800. */
+ * the threads. Both loops once ran on one thread: a serial pass over every slot. */
 enum { SLOT_ARR_CHUNK = 4096 };
 
 typedef struct slots_job {

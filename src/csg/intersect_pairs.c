@@ -74,7 +74,7 @@ static bool cache_planes(const mci_ctx *ctx, const mci_scene *s, const uint64_t 
     if (!c->slot)
         return false;
     /* Slots in face order: faces in pairs are marked, then numbered (a numbering in
-     * order of first appearance branched on every one of the 1.5M face ids). */
+     * order of first appearance branched on every face id of every pair). */
     for (size_t f = 0; f < s->face_count; f++)
         c->slot[f] = MCI_NONE;
     for (size_t i = 0; i < count; i++) {

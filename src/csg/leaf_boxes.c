@@ -65,7 +65,7 @@ static void sweep_box_pairs(const double (*box)[6], const box_end *order, size_t
 }
 
 /* Once per evaluation instead of every box against every other per leaf: a plate minus
- * 4,096 holes tested 16.8M pairs of boxes in each of two passes. */
+ * thousands of holes tested millions of pairs of boxes in each of two passes. */
 bool mci_box_overlaps(const mci_ctx *ctx, const double (*box)[6], size_t n, uint32_t **start,
                       uint32_t **list)
 {

@@ -17,9 +17,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* 48 rather than 24: fewer cells to build for some 10% more candidate pairs, now that a
- * pair apart is rejected cheaply (ring-300 -3%, 700 spheres -4.5%, bunny x bunny -3%
- * instructions, cylinder +0.2%; same pairs that intersect, same outputs). */
+/* 48 rather than 24: fewer cells to build for a few more candidate pairs, now that a
+ * pair apart is rejected cheaply (same pairs that intersect, same outputs). */
 #define DEFAULT_MAX_CELL_FACES 48
 #define DEFAULT_MAX_DEPTH 14
 #define NO_CHILD UINT32_MAX
@@ -149,10 +148,8 @@ static bool index_faces(const mci_ctx *ctx, mci_octree *t, const uint8_t *skip_l
 
 /* The root is a cube (its box grown along the shorter axes), so that cells stay cubes at
  * every depth. Splitting a flat scene's box in all three axes made flat cells that faces
- * cross many at a time: on a ring eight times as long (bench's constant-density ring,
- * 800 spheres) the tree had 48K cells and the octree step grew 14x for 8x the faces; as a
- * cube 31K cells, -6% instructions in all (cylinder minus 28 -7%, ring-800 -0.4%; flat
- * small scenes up to +1.7%). A side that overflows keeps the box as it is. */
+ * cross many at a time: on a long ring of spheres, more cells, and an octree step that
+ * grew much faster than the faces. A side that overflows keeps the box as it is. */
 static void make_cube(mci_cell *root)
 {
     double side = 0;
@@ -287,7 +284,7 @@ static bool face_touches_cell(const double *const v[3], const double box[6],
 /* Face boxes in parallel chunks of faces (each face writes its own six numbers), in
  * floats rounded outward: they only choose which children to test and which pairs to
  * reject, for which a box holding the face will do, and half the bytes halve the time
- * of the passes that read one per face and level (bunny400k: 4M reads). */
+ * of the passes that read one per face and level. */
 enum { FACE_CHUNK = 16384 };
 
 typedef struct box_job {
@@ -564,9 +561,9 @@ static mcsg_status build_level(builder *b, uint32_t **level, size_t *count, mcsg
 }
 
 /* Once the tree is built only the leaf cells' lists are read (candidate pairs, rays);
- * the split cells' lists repeat every face once per level (bunny400k: 4.1M entries, of
- * which the leaves hold 1M) and are dropped. The lists lie in cell order, so the leaves'
- * lists move down in place. The cells, grown by doubling, are trimmed too. */
+ * the split cells' lists repeat every face once per level (most of the entries) and are
+ * dropped. The lists lie in cell order, so the leaves' lists move down in place. The
+ * cells, grown by doubling, are trimmed too. */
 static bool keep_leaf_lists(const mci_ctx *ctx, mci_octree *t)
 {
     size_t kept = 0;
@@ -686,7 +683,7 @@ typedef struct cell_face {
 
 /* Each face's critical leaf cells (their positions among the critical leaves, in
  * increasing order): a pair of faces that share several cells is collected in the first
- * of them only. Collected once per shared cell, ring-800's 762K pairs were 1.5M, and the
+ * of them only. Collected once per shared cell, many pairs came more than once, and the
  * sort that joined the copies ran on all of them. */
 typedef struct face_cells {
     uint32_t *start; /* per face: its range [start[f], start[f + 1]) of cell */
@@ -834,7 +831,7 @@ static bool list_face_cells(const mci_ctx *ctx, const mci_octree *tree, const ui
  * each pair in the bucket of its first face's range (contiguous ranges, so bucket order
  * is key order), then each bucket is sorted on its own, on the threads, and its repeats
  * (pairs whose first shared cell was not decided: see first_shared_cell) dropped. One
- * radix sort over all pairs ran on one thread: 22 ms of the step's 47 on two threads. */
+ * radix sort over all pairs ran on one thread: a large serial part of the step. */
 enum { PAIRS_PER_BUCKET = 2048 };
 
 typedef struct bucket_job {
@@ -868,7 +865,7 @@ static int bucket_shift(uint32_t faces, size_t pairs)
  * FILL_GROUPS groups of consecutive chunks; each group counts its pairs per bucket, the
  * counts give each group its place in each bucket (groups in order within a bucket: the
  * order of one pass over the chunks), then each group moves its pairs and frees its
- * chunks' lists. One pass on one thread was a serial 6 ms of ring-800's step. */
+ * chunks' lists. One pass on one thread was a serial stretch of the step. */
 enum { FILL_GROUPS = 16 };
 
 typedef struct fill_job {

@@ -145,7 +145,8 @@ static bool collect_ray_faces(const mci_ctx *ctx, const mci_octree *o, uint32_t 
             continue;
         }
         /* The leaf's run in the cell's increasing list (cells hold faces of many
-         * leaves: ring-800's rays scanned 30M face ids for the few of one leaf). */
+         * leaves: scanning whole lists, a dense scene's rays read tens of millions of
+         * face ids for the few of one leaf). */
         for (uint32_t i = first_at_least(o->face_ids, c->first, c->first + c->count, first);
              i < c->first + c->count && o->face_ids[i] < end; i++) {
             if (!mci_grow_array(ctx, (void **)&s->faces, &s->face_capacity, n + 1,

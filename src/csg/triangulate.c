@@ -260,20 +260,19 @@ static bool roughly_in_circle(const cdt *c, uint32_t p, uint32_t a, uint32_t b, 
 
 /* At most this many flips per inserted point. Inside a round hole the corners and the
  * points where the walls' diagonals cross the plate lie on or just inside one circle,
- * and every new corner flipped its way across the hole: 10.5 flips per point on
- * drill_plate_32, against 2.8 on random points. Six keep the edges local where it
- * matters (drill_plate_32 -10.7% instructions, box_grid_32 +2.4% against no limit). */
+ * and every new corner flipped its way across the hole: several times the flips per
+ * point of random points. Six keep the edges local where it matters (a plate with round
+ * holes gains more than one with square holes loses, against no limit). */
 enum { FLIPS_PER_POINT = 6 };
 
 /* After p was inserted: flip the edges opposite p while the point across lies in the
  * circle of p's triangle (Lawson), so that the triangulation stays close to Delaunay.
  * Without this, early points kept long edges across the whole face: a plate with
  * thousands of holes had every hole's edges crossed by dozens of them, and the walks
- * and constraint recovery went quadratic (box_grid_64, a perforated plate). Each flip
- * adds an edge at p, and edges at p are never flipped here, so the loop ends whatever
- * the rough test says (and FLIPS_PER_POINT ends it sooner); a flip is made only where
- * the quadrilateral is strictly convex (exact tests). No constraint exists yet while
- * points are inserted. */
+ * and constraint recovery went quadratic. Each flip adds an edge at p, and edges at p
+ * are never flipped here, so the loop ends whatever the rough test says (and
+ * FLIPS_PER_POINT ends it sooner); a flip is made only where the quadrilateral is
+ * strictly convex (exact tests). No constraint exists yet while points are inserted. */
 static bool make_delaunayish(cdt *c, uint32_t p)
 {
     int flips = 0;
@@ -401,9 +400,9 @@ static void insertion_order(const mci_cdt_input *in, uint64_t *order)
 
 /* Faces with fewer points to insert keep the plain insertion: their walks and recovery
  * stay short, and the circle tests and their flips would cost more than they save
- * (ring-800 +2.6%, 700 spheres +3.6% instructions when every face had them; from 128
- * points on, the benchmark scenes are within 0.1% of no flips at all, and the plates
- * with grids of holes keep the whole gain). */
+ * (as on the dense scenes when every face had them; from 128 points on, the benchmark
+ * scenes cost as much as with no flips at all, and the plates with grids of holes keep
+ * the whole gain). */
 enum { FLIPPED_INSERTION_POINTS = 128 };
 
 static mcsg_status insert_points(cdt *c, mcsg_error *err)

@@ -9,7 +9,7 @@
  * Those labels alone often decide the face: buried in a leaf that a union adds, or
  * outside one that an intersection keeps, it is dropped whatever the leaves crossing it
  * say. Such a face needs no arrangement, no tessellation with its constraints, and no
- * classification of its pieces: on ring + 800 spheres, 44K of 92K touched faces.
+ * classification of its pieces: in dense scenes, a large share of the touched faces.
  *
  * For a leaf P and each leaf M that P's trimmed CSGlist reads (mci_blist), the faces of
  * P that do not meet M are joined by their shared vertices (union-find on vertex

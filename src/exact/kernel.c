@@ -608,7 +608,7 @@ static bool same_projection(const double *p, const double *q, int axis)
  * coordinate (a cap, a box's face), or along some axis they project to at most two
  * points (they lie on at most two lines parallel to the axis: a cylinder's side, an
  * extrusion's wall). The filters cannot decide these zeros, and the exact stage costs
- * thousands of instructions each (cylinder_28_holes: 9,596 crease tests). */
+ * thousands of instructions each. */
 static bool coplanar_by_coordinates(const double *a, const double *b, const double *c,
                                     const double *d)
 {
@@ -650,9 +650,9 @@ static int orient3d_vertex_beyond_filter(const double *x, const mci_plane *plane
 /* The same predicate for an input vertex, without building a point. A vertex equal to
  * one that defines the plane lies on it: the common case of shared and duplicated
  * vertices (identical operands), which the filter cannot decide (the value is 0). */
-/* The filter first: a sign it gives is exact, and most calls (3.8M pair tests' corner
- * sides on ring-800) are decided by it; a vertex at one of the plane's corners, whose
- * zero the filter cannot confirm, is then caught before the exact stage. */
+/* The filter first: a sign it gives is exact, and most calls (the pair tests' corner
+ * sides) are decided by it; a vertex at one of the plane's corners, whose zero the
+ * filter cannot confirm, is then caught before the exact stage. */
 int mci_orient3d_vertex(const double *x, const mci_plane *plane)
 {
     int s = mci_orient3d_vertex_filtered(x, plane);
@@ -742,8 +742,8 @@ static bool plane_along_axis(const double *const v[3], int k)
  * along k, where both points are the one crossing of the projected line and plane, so
  * they agree on both axes other than k. Such pairs (a cylinder's top and bottom cap
  * edges cut by one side of a hole: equal x and y, different z) left every filter
- * undecided, and the exact stage took ~13,000 instructions a coordinate (4,582
- * comparisons on cylinder_28_holes, all of this kind). */
+ * undecided, and the exact stage took over ten thousand instructions a coordinate (on a
+ * cylinder with holes, every comparison that reached it was of this kind). */
 static bool equal_by_projection(const mci_point *a, const mci_point *b, int axis)
 {
     if (a->kind != MCI_POINT_LPI || b->kind != MCI_POINT_LPI || a->v[2] != b->v[2] ||

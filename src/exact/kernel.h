@@ -287,7 +287,7 @@ void mci_point_round(const mci_point *p, double out[3]);
 /* A box certainly containing the point (possibly infinite when the cached W is too
  * uncertain): the cached box, a single value on the exactly known axes. For culling
  * only: decisions stay with the predicates. Inline: the arrangements' sweeps and merges
- * and the point numbering ask it ~1.5M times on ring-800. */
+ * and the point numbering ask it millions of times. */
 static inline void mci_point_bounds(const mci_point *p, double lo[3], double hi[3])
 {
     for (int k = 0; k < 3; k++) {
@@ -325,7 +325,7 @@ int mci_orient2d_projected_dd(const mci_point *p, const mci_point *q, const mci_
                               int axis);
 /* The same stage for orient3d of four input vertices (det[b - a, c - a, d - a], the
  * sign of mci_orient3d_vertices): the rounded coordinates of a UV sphere's quad are
- * nearly coplanar, and the exact stage cost some 6,000 instructions per crease test. */
+ * nearly coplanar, and the exact stage cost thousands of instructions per crease test. */
 int mci_orient3d_vertices_dd(const double *a, const double *b, const double *c,
                              const double *d);
 /* The double-double stage of mci_point_round, for every kind of point: rounds each

@@ -5,8 +5,8 @@
  * Why: points of a face that are nearly but not exactly collinear (the crossings of a
  * face with the two triangles of a UV sphere's quad, planar before rounding) leave the
  * double filter undecided although the determinant is far from zero at twice the
- * precision; the exact stage costs some 30,000 instructions per call there, this one a
- * few thousand.
+ * precision; the exact stage costs tens of thousands of instructions per call there,
+ * this one a few thousand.
  *
  * A value is hi + lo with an error bound e: the true value lies within e of hi + lo.
  * The algorithms are those of Joldes, Muller and Popescu (2017, "Tight and rigorous error

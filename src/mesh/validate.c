@@ -229,8 +229,8 @@ static bool sort_vertex_run(const mci_ctx *ctx, edge_use *run, size_t n)
 
 /* Edge uses stably by key into `out`: a counting sort by the smaller vertex (canonical
  * ids are below vertex_count), then each vertex's few uses by the larger one. A 16-bit
- * radix sort took four passes over the uses plus a copy back after each (bunny400k:
- * 2.4 million uses, a third of the check). */
+ * radix sort took four passes over the uses plus a copy back after each (much of the
+ * check of a large model). */
 static bool sort_edges(const check_state *s, const edge_use *in, size_t n, edge_use *out)
 {
     size_t nv = s->mesh->vertex_count;
