@@ -1,10 +1,10 @@
 /*
- * First-seed rays (src/csg/classify.c): the ray test through the octree must give the same
+ * First-seed rays (src/csg/rays.c): the ray test through the octree must give the same
  * label as the brute-force test over every face of the leaf, for points anywhere,
  * including points whose rays graze vertices and edges exactly (integer grids) and
  * points on the surface (UNKNOWN); and the labels must be right for boxes, where
  * membership is known. Also the leaves' box overlaps (the candidates of every leaf's
- * classification) against every pair of boxes.
+ * classification; src/csg/leaf_boxes.c) against every pair of boxes.
  */
 #include "testlib.h"
 #include "csg/leaf_boxes.h"

@@ -1,7 +1,8 @@
 /*
  * Sorting and lookup of integer keys (sort.h): introsorts instantiated from
- * sort_template.h (qsort's comparison callback dominated short sorts) and
- * least-significant-digit radix sorts for long arrays.
+ * sort_template.h (qsort's comparison callback dominated short sorts), an in-place
+ * most-significant-digit radix sort for long arrays of keyed items, and a
+ * least-significant-digit radix sort through a buffer for 64-bit keys.
  */
 #include "base/sort.h"
 #include "base/sort_template.h"

@@ -3,9 +3,12 @@
  *
  * Cells are closed boxes; children split their parent at the rounded midpoint, and
  * siblings share the split coordinate exactly, so the leaf cells tile the root box.
- * A face is listed in every cell its triangle touches, decided exactly
- * (mci_triangle_touches_box), so any point common to two faces lies in a leaf cell
- * listing both: candidate pairs from leaf cells are complete.
+ * A face is listed in every cell its triangle touches, and possibly in a few more: a
+ * separating-axis test in doubles drops a face only when an axis separates it from the
+ * cell by more than a bound on the rounding error (the exact test,
+ * mci_triangle_touches_box, is kept for the tests). So any point common to two faces lies
+ * in a leaf cell listing both: candidate pairs from leaf cells are complete, and an extra
+ * listing only costs a pair that the exact pair test rejects.
  */
 #include "csg/octree.h"
 #include "base/parallel.h"
@@ -441,9 +444,9 @@ static mcsg_status masks(void *user, size_t begin, size_t end, mcsg_error *err)
     return MCSG_OK;
 }
 
-/* The faces of the parent that touch each child. When no child has fewer faces than
- * the parent (many faces through one point, e.g. the centre of a cylinder's cap fan),
- * splitting cannot help: the cell stays a leaf. One pass computes each face's children
+/* The faces of the parent that touch each child. When some child would keep all of the
+ * parent's faces (many faces through one point, e.g. the centre of a cylinder's cap
+ * fan), splitting cannot help: the cell stays a leaf. One pass computes each face's children
  * (on the threads when the level has a cell or two: the root holds every face), a
  * second lists the faces child after child, in the parent's order. */
 static mcsg_status split_cell(level_job *j, size_t i, bool parallel, mcsg_error *err)

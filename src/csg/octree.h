@@ -1,7 +1,8 @@
 /*
  * Adaptive octree over the faces of all CSG leaves (paper §3.1), built on the bounding
  * box of the whole scene. A face belongs to every cell its triangle touches (closed
- * sets), decided exactly. A cell is critical when it holds faces of two or more leaves;
+ * sets; a certified floating-point test may list it in a few more, never fewer). A cell
+ * is critical when it holds faces of two or more leaves;
  * only critical cells with many faces are subdivided. Candidate pairs for the
  * intersection stage are the pairs of faces of different leaves that share a critical
  * cell and whose bounding boxes overlap, each reported once.
