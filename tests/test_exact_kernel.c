@@ -1,10 +1,11 @@
 /*
- * Tests of the exact plane-based kernel (src/exact/kernel.h) against an independent exact
- * reference written here with GMP from the geometric definitions: an LPI by solving
- * n.(p + t(q - p) - a) = 0 for t, a TPI by rational Gaussian elimination, and each
- * predicate as the sign of its defining expression on exact coordinates. The reference
- * shares no formula with the kernel (no Cramer numerators, no cached approximations), so
- * agreement means that both are right, not that both copy one mistake.
+ * Tests of the exact plane-based kernel (src/exact/kernel.h) against the independent
+ * exact reference of exact_reference.h (GMP, from the geometric definitions: an LPI by
+ * solving for the line parameter, a TPI by rational Gaussian elimination, each predicate
+ * as the sign of its defining expression on exact coordinates), on the scenarios of
+ * exact_scenarios.h. This file holds the checks of each kernel answer against the
+ * reference, the tables of counts, and a few direct tests (bit helpers, orient3d of
+ * vertices, LPIs equal by projection).
  *
  * Every case checks three things: the combined predicate equals the reference; the exact
  * stage equals the reference (on every case, not only where the filter gives up); the
@@ -21,11 +22,13 @@
  *                   ways; points on a common line; exactly parallel and singular
  *                   configurations. Each is followed by "+ulp" runs with an input
  *                   coordinate moved by one ulp.
- * MCSG_TEST_SCALE (default 1) multiplies the number of scenarios; MCSG_TEST_SEED sets the
- * random seed. The tables at the end count the cases and the filter's decisions.
+ * MCSG_TEST_SCALE (default 1, 0.5 under the sanitizers) multiplies the number of
+ * scenarios; MCSG_TEST_SEED sets the random seed. The tables at the end count the cases and the filter's decisions.
  */
 #include "exact/big.h"
 #include "exact/kernel.h"
+#include "exact_reference.h"
+#include "exact_scenarios.h"
 #include "testlib.h"
 
 #include <float.h>
@@ -39,203 +42,12 @@
 #define MAXV        48
 #define MAXPL       16
 #define MAXPT       28
+#define MAXLP       6 /* lines where two planes meet (order_on_plane_line) */
+#define MAXLE       4 /* edge lines (order_on_edge_line) */
+#define MAXLINES    (MAXLP + MAXLE)
 #define MAX_CLASSES 40
 #define MAX_PRINTED 12     /* mismatches printed in full; all are counted */
-#define NONE        (-100) /* "this stage does not exist" in a result triple */
-
-/* ---------------------------------------------------------------- random numbers */
-
-static uint64_t rng_state = 0x5eed2024u;
-
-static uint64_t rng_next(void) /* splitmix64 */
-{
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-static double rng_unit(void) { return (double)(rng_next() >> 11) * 0x1p-53; }
-
-static int rng_int(int lo, int hi) /* inclusive */
-{
-    return lo + (int)(rng_next() % (uint64_t)(hi - lo + 1));
-}
-
-static bool rng_chance(double p) { return rng_unit() < p; }
-
-static double rng_sign(void) { return (rng_next() & 1) ? -1.0 : 1.0; }
-
-/* ---------------------------------------------------------------- coordinate regimes */
-
-enum { R_UNIT, R_INT, R_EXP, R_MIX, R_FAR, R_FARGRID, R_SCALES, R_BITS, R_COUNT };
-static const char *const regime_names[R_COUNT] = {
-    "unit", "smallint", "exp", "mix", "far", "fargrid", "scales", "bits"};
-
-/* The "bits" regime's integer width for the current scenario (set per scenario). */
-static int bits_width = 1;
-
-/* A b-bit integer times 2^-20, often at the extremes +-(2^b - 1) and +-2^(b-1): the
- * exact stage's 128-bit path is taken when a degree bound proves the polynomial fits,
- * and widths from 1 to 40 bits (half of them up to 8, where the degree-20 predicates
- * change paths) put every predicate on both sides of that bound, with the largest
- * intermediates it admits. */
-static double draw_bits(void)
-{
-    int64_t top = ((int64_t)1 << bits_width) - 1, x;
-    switch (rng_int(0, 3)) {
-    case 0:
-        x = top;
-        break;
-    case 1:
-        x = (int64_t)1 << (bits_width - 1);
-        break;
-    default:
-        x = (int64_t)(rng_unit() * (double)(top + 1));
-        break;
-    }
-    return rng_sign() * ldexp((double)x, -20);
-}
-
-/* One coordinate. smallint and fargrid make exact coplanarity frequent; exp spans the
- * whole double range (subnormals included); mix puts 1e-300, 1e300, 3.4e38 and 1e-3 in
- * one case; far clusters points 1e6 from the origin; bits: see draw_bits. */
-static double draw_coord(int regime)
-{
-    static const double mix[] = {0, 1e-300, 1e300, 3.4e38, 1e-3, 1};
-    switch (regime) {
-    case R_UNIT:
-        return 2 * rng_unit() - 1;
-    case R_INT:
-        return rng_int(-6, 6);
-    case R_EXP:
-        return rng_chance(0.03) ? 0
-                                : rng_sign() * ldexp(1 + rng_unit(), rng_int(-1074, 1023));
-    case R_MIX:
-        return rng_sign() * mix[rng_int(0, 5)] * (rng_chance(0.5) ? 1 : 1 + rng_unit());
-    case R_FAR:
-        return 1e6 + (2 * rng_unit() - 1) * 1e-3;
-    case R_FARGRID:
-        return 1e6 + rng_int(-4, 4) * 0x1p-30;
-    default: /* R_BITS */
-        return draw_bits();
-    }
-}
-
-/* A vertex. "scales" mixes a 50-unit part with coordinates like 1e-17 that should have
- * been 0, per vertex. */
-static void draw_vertex(int regime, double out[3])
-{
-    static const double scales[] = {50, 1e-17, 1};
-    double s = scales[rng_int(0, 2)];
-    for (int k = 0; k < 3; k++) {
-        if (regime != R_SCALES)
-            out[k] = draw_coord(regime);
-        else
-            out[k] = rng_chance(0.1) ? 0 : s * (2 * rng_unit() - 1);
-    }
-}
-
-/* x moved by n ulps in a random direction (stays finite). */
-static double nudge(double x, int n)
-{
-    double dir = rng_chance(0.5) ? INFINITY : -INFINITY;
-    for (int i = 0; i < n; i++) {
-        double y = nextafter(x, dir);
-        if (!isfinite(y))
-            break;
-        x = y;
-    }
-    return x;
-}
-
-/* ---------------------------------------------------------------- scenarios */
-
-typedef struct point_def {
-    mci_point_kind kind;
-    int v[2];  /* explicit: v[0]; LPI: line v[0], v[1] */
-    int pl[3]; /* LPI: plane pl[0]; TPI: pl[0..2] */
-} point_def;
-
-typedef struct scenario {
-    int cls; /* class index (class_id) */
-    int nv, npl, npt;
-    double v[MAXV][3];
-    int plv[MAXPL][3];
-    point_def pt[MAXPT];
-    /* Pairs of planes through a common line and pairs of vertices on that line: the
-     * order_on_plane_line / order_on_edge_line queries (run where the reference confirms
-     * that both points lie on the line). */
-    int nlp, line_planes[6][2];
-    int nle, line_edges[4][2];
-    /* The generator's claim, checked against the reference before the kernel is trusted
-     * with it: the points group[] lie on all planes onpl[] (and are all equal if
-     * group_equal). Cleared in perturbed copies. */
-    int ngroup, group[MAXPT];
-    int nonpl, onpl[MAXPL];
-    bool group_equal;
-} scenario;
-
-static int sc_vertex(scenario *s, const double x[3])
-{
-    if (s->nv >= MAXV)
-        abort();
-    memcpy(s->v[s->nv], x, sizeof s->v[0]);
-    return s->nv++;
-}
-
-static int sc_plane(scenario *s, int a, int b, int c)
-{
-    if (s->npl >= MAXPL)
-        abort();
-    s->plv[s->npl][0] = a;
-    s->plv[s->npl][1] = b;
-    s->plv[s->npl][2] = c;
-    return s->npl++;
-}
-
-/* A plane through a, b, c in a random one of its three rotations (same orientation). */
-static int sc_plane_rotated(scenario *s, int a, int b, int c)
-{
-    int r = rng_int(0, 2), t[3] = {a, b, c};
-    return sc_plane(s, t[r], t[(r + 1) % 3], t[(r + 2) % 3]);
-}
-
-static int sc_point(scenario *s, mci_point_kind kind, int v0, int v1, int p0, int p1,
-                    int p2)
-{
-    if (s->npt >= MAXPT)
-        abort();
-    s->pt[s->npt] = (point_def){kind, {v0, v1}, {p0, p1, p2}};
-    return s->npt++;
-}
-
-static int sc_explicit(scenario *s, int v)
-{
-    return sc_point(s, MCI_POINT_EXPLICIT, v, v, 0, 0, 0);
-}
-
-static int sc_lpi(scenario *s, int l0, int l1, int pl)
-{
-    return sc_point(s, MCI_POINT_LPI, l0, l1, pl, pl, pl);
-}
-
-static int sc_tpi(scenario *s, int p0, int p1, int p2)
-{
-    return sc_point(s, MCI_POINT_TPI, 0, 0, p0, p1, p2);
-}
-
-static void sc_line_planes(scenario *s, int p0, int p1)
-{
-    s->line_planes[s->nlp][0] = p0;
-    s->line_planes[s->nlp++][1] = p1;
-}
-
-static void sc_line_edge(scenario *s, int v0, int v1)
-{
-    s->line_edges[s->nle][0] = v0;
-    s->line_edges[s->nle++][1] = v1;
-}
+#define NONE        (-100) /* no such stage in a result triple; no reference result */
 
 /* ---------------------------------------------------------------- classes and counts */
 
@@ -266,326 +78,8 @@ typedef struct pstat {
 } pstat;
 
 static pstat stats[MAX_CLASSES][PR_COUNT];
-static char class_names[MAX_CLASSES][24];
 static long class_scenarios[MAX_CLASSES];
 static double class_seconds[MAX_CLASSES];
-static int nclasses;
-
-static int class_id(const char *prefix, const char *name)
-{
-    char buf[24];
-    snprintf(buf, sizeof buf, "%s%s", prefix, name);
-    for (int i = 0; i < nclasses; i++)
-        if (strcmp(class_names[i], buf) == 0)
-            return i;
-    if (nclasses >= MAX_CLASSES)
-        abort();
-    memcpy(class_names[nclasses], buf, sizeof buf);
-    return nclasses++;
-}
-
-/* ---------------------------------------------------------------- exact reference */
-
-/* Rational 3-vectors. */
-typedef struct qvec {
-    mpq_t c[3];
-} qvec;
-
-/* A point as homogeneous integers: X_k = n[k] / d with d > 0. */
-typedef struct zpoint {
-    mpz_t n[3], d;
-} zpoint;
-
-/* A plane: n = (b - a) x (c - a) and a, rational; and h, a positive integer multiple of
- * (n, -n.a), so that sign(h.(X, 1)) is the side of X. */
-typedef struct zplane {
-    qvec n, a;
-    mpz_t h[4];
-} zplane;
-
-static void qvec_init(qvec *v)
-{
-    for (int k = 0; k < 3; k++)
-        mpq_init(v->c[k]);
-}
-
-static void qvec_clear(qvec *v)
-{
-    for (int k = 0; k < 3; k++)
-        mpq_clear(v->c[k]);
-}
-
-static void qvec_set_d(qvec *r, const double *x)
-{
-    for (int k = 0; k < 3; k++)
-        mpq_set_d(r->c[k], x[k]); /* exact for every finite double */
-}
-
-static void qvec_sub(qvec *r, const qvec *a, const qvec *b)
-{
-    for (int k = 0; k < 3; k++)
-        mpq_sub(r->c[k], a->c[k], b->c[k]);
-}
-
-static void qvec_cross(qvec *r, const qvec *a, const qvec *b) /* r must not alias */
-{
-    mpq_t t;
-    mpq_init(t);
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        mpq_mul(r->c[k], a->c[i], b->c[j]);
-        mpq_mul(t, a->c[j], b->c[i]);
-        mpq_sub(r->c[k], r->c[k], t);
-    }
-    mpq_clear(t);
-}
-
-static void qvec_dot(mpq_t r, const qvec *a, const qvec *b)
-{
-    mpq_t t;
-    mpq_init(t);
-    mpq_mul(r, a->c[0], b->c[0]);
-    for (int k = 1; k < 3; k++) {
-        mpq_mul(t, a->c[k], b->c[k]);
-        mpq_add(r, r, t);
-    }
-    mpq_clear(t);
-}
-
-/* out[k] = in[k] * L with L > 0 the lcm of the denominators: integers with the signs and
- * ratios of in[]. *scale = L. */
-static void to_integers(mpz_t *out, mpz_ptr scale, mpq_t *in, int count)
-{
-    mpz_set_ui(scale, 1);
-    for (int k = 0; k < count; k++)
-        mpz_lcm(scale, scale, mpq_denref(in[k]));
-    for (int k = 0; k < count; k++) {
-        mpz_divexact(out[k], scale, mpq_denref(in[k]));
-        mpz_mul(out[k], out[k], mpq_numref(in[k]));
-    }
-}
-
-static void zpoint_from_qvec(zpoint *p, qvec *x) { to_integers(p->n, p->d, x->c, 3); }
-
-static void ref_plane_set(zplane *p, const double *a, const double *b, const double *c)
-{
-    qvec qb, qc;
-    mpq_t coef[4];
-    mpz_t scale;
-    qvec_init(&qb);
-    qvec_init(&qc);
-    mpz_init(scale);
-    for (int k = 0; k < 4; k++)
-        mpq_init(coef[k]);
-    qvec_set_d(&p->a, a);
-    qvec_set_d(&qb, b);
-    qvec_set_d(&qc, c);
-    qvec_sub(&qb, &qb, &p->a);
-    qvec_sub(&qc, &qc, &p->a);
-    qvec_cross(&p->n, &qb, &qc);
-    for (int k = 0; k < 3; k++)
-        mpq_set(coef[k], p->n.c[k]);
-    qvec_dot(coef[3], &p->n, &p->a);
-    mpq_neg(coef[3], coef[3]);
-    to_integers(p->h, scale, coef, 4);
-    for (int k = 0; k < 4; k++)
-        mpq_clear(coef[k]);
-    mpz_clear(scale);
-    qvec_clear(&qb);
-    qvec_clear(&qc);
-}
-
-/* Line p q meets the plane where n.(p + t u - a) = 0, u = q - p: t = n.(a - p) / n.u.
- * Returns false when n.u = 0 (no single point). *w = n.u. */
-static bool ref_lpi(qvec *x, mpq_ptr w, const double *p, const double *q, const zplane *pl)
-{
-    qvec qp, u, ap;
-    mpq_t t;
-    bool ok;
-    qvec_init(&qp);
-    qvec_init(&u);
-    qvec_init(&ap);
-    mpq_init(t);
-    qvec_set_d(&qp, p);
-    qvec_set_d(&u, q);
-    qvec_sub(&u, &u, &qp);
-    qvec_dot(w, &pl->n, &u);
-    ok = mpq_sgn(w) != 0;
-    if (ok) {
-        qvec_sub(&ap, &pl->a, &qp);
-        qvec_dot(t, &pl->n, &ap);
-        mpq_div(t, t, w);
-        for (int k = 0; k < 3; k++) {
-            mpq_mul(x->c[k], t, u.c[k]);
-            mpq_add(x->c[k], x->c[k], qp.c[k]);
-        }
-    }
-    mpq_clear(t);
-    qvec_clear(&qp);
-    qvec_clear(&u);
-    qvec_clear(&ap);
-    return ok;
-}
-
-/* Forward elimination with row swaps on m = [N | rhs]; false if singular. *det gets the
- * determinant of N (product of the pivots, sign flipped per swap). */
-static bool eliminate(mpq_t m[3][4], mpq_ptr det)
-{
-    mpq_t f, t;
-    bool ok = true;
-    mpq_init(f);
-    mpq_init(t);
-    mpq_set_ui(det, 1, 1);
-    for (int col = 0; col < 3 && ok; col++) {
-        int piv = col;
-        while (piv < 3 && mpq_sgn(m[piv][col]) == 0)
-            piv++;
-        ok = piv < 3;
-        if (!ok)
-            break;
-        if (piv != col) {
-            for (int j = 0; j < 4; j++)
-                mpq_swap(m[piv][j], m[col][j]);
-            mpq_neg(det, det);
-        }
-        mpq_mul(det, det, m[col][col]);
-        for (int row = col + 1; row < 3; row++) {
-            mpq_div(f, m[row][col], m[col][col]);
-            for (int j = col; j < 4; j++) {
-                mpq_mul(t, f, m[col][j]);
-                mpq_sub(m[row][j], m[row][j], t);
-            }
-        }
-    }
-    if (!ok)
-        mpq_set_ui(det, 0, 1);
-    mpq_clear(f);
-    mpq_clear(t);
-    return ok;
-}
-
-/* x from the upper-triangular system left by eliminate(). */
-static void back_substitute(qvec *x, mpq_t m[3][4])
-{
-    mpq_t t;
-    mpq_init(t);
-    for (int row = 2; row >= 0; row--) {
-        mpq_set(x->c[row], m[row][3]);
-        for (int j = row + 1; j < 3; j++) {
-            mpq_mul(t, m[row][j], x->c[j]);
-            mpq_sub(x->c[row], x->c[row], t);
-        }
-        mpq_div(x->c[row], x->c[row], m[row][row]);
-    }
-    mpq_clear(t);
-}
-
-/* The point on three planes: solve n_k . x = n_k . a_k. Returns false when the normals
- * are dependent; *det = det[n1; n2; n3]. */
-static bool ref_tpi(qvec *x, mpq_ptr det, const zplane *p0, const zplane *p1,
-                    const zplane *p2)
-{
-    const zplane *pl[3] = {p0, p1, p2};
-    mpq_t m[3][4];
-    bool ok;
-    for (int r = 0; r < 3; r++) {
-        for (int j = 0; j < 4; j++)
-            mpq_init(m[r][j]);
-        for (int j = 0; j < 3; j++)
-            mpq_set(m[r][j], pl[r]->n.c[j]);
-        qvec_dot(m[r][3], &pl[r]->n, &pl[r]->a);
-    }
-    ok = eliminate(m, det);
-    if (ok)
-        back_substitute(x, m);
-    for (int r = 0; r < 3; r++)
-        for (int j = 0; j < 4; j++)
-            mpq_clear(m[r][j]);
-    return ok;
-}
-
-/* r = a[k] * b.d - b[k] * a.d: the k-th coordinate of a - b times a.d * b.d > 0. */
-static void zdiff(mpz_t r, const zpoint *a, const zpoint *b, int k)
-{
-    mpz_mul(r, a->n[k], b->d);
-    mpz_submul(r, b->n[k], a->d);
-}
-
-static int ref_orient3d(const zpoint *p, const zplane *pl)
-{
-    mpz_t s;
-    int r;
-    mpz_init(s);
-    mpz_mul(s, pl->h[3], p->d);
-    for (int k = 0; k < 3; k++)
-        mpz_addmul(s, pl->h[k], p->n[k]);
-    r = mpz_sgn(s);
-    mpz_clear(s);
-    return r;
-}
-
-static int ref_compare_coord(const zpoint *a, const zpoint *b, int axis)
-{
-    mpz_t s;
-    int r;
-    mpz_init(s);
-    zdiff(s, a, b, axis);
-    r = mpz_sgn(s);
-    mpz_clear(s);
-    return r;
-}
-
-static int ref_compare_lex(const zpoint *a, const zpoint *b)
-{
-    for (int k = 0; k < 3; k++) {
-        int c = ref_compare_coord(a, b, k);
-        if (c)
-            return c;
-    }
-    return 0;
-}
-
-/* 2D cross product of (q - p) and (r - p) in coordinates (i, j). */
-static int ref_orient2d(const zpoint *p, const zpoint *q, const zpoint *r, int axis)
-{
-    int i = (axis + 1) % 3, j = (axis + 2) % 3, s;
-    mpz_t ui, uj, vi, vj;
-    mpz_inits(ui, uj, vi, vj, NULL);
-    zdiff(ui, q, p, i);
-    zdiff(uj, q, p, j);
-    zdiff(vi, r, p, i);
-    zdiff(vj, r, p, j);
-    mpz_mul(ui, ui, vj);
-    mpz_submul(ui, uj, vi);
-    s = mpz_sgn(ui);
-    mpz_clears(ui, uj, vi, vj, NULL);
-    return s;
-}
-
-/* sign((a - b) . dir) */
-static int ref_dot_dir(const zpoint *a, const zpoint *b, mpz_t *dir)
-{
-    mpz_t s, t;
-    int r;
-    mpz_inits(s, t, NULL);
-    for (int k = 0; k < 3; k++) {
-        zdiff(t, a, b, k);
-        mpz_addmul(s, t, dir[k]);
-    }
-    r = mpz_sgn(s);
-    mpz_clears(s, t, NULL);
-    return r;
-}
-
-/* A positive multiple of n1 x n2. */
-static void ref_plane_line_dir(mpz_t *dir, const zplane *p1, const zplane *p2)
-{
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        mpz_mul(dir[k], p1->h[i], p2->h[j]);
-        mpz_submul(dir[k], p1->h[j], p2->h[i]);
-    }
-}
 
 /* ---------------------------------------------------------------- workspace */
 
@@ -595,47 +89,45 @@ static struct {
     mci_plane kpl[MAXPL];
     mci_point kpt[MAXPT];
     bool ok[MAXPT]; /* both kernel and reference constructed the point */
-    zplane rpl[MAXPL];
-    zpoint rpt[MAXPT];
-    zpoint rv[MAXV]; /* the input vertices */
-    qvec rx[MAXPT];  /* rational coordinates */
-    mpq_t rw[MAXPT]; /* W as the header defines it: n.u (LPI), det (TPI) */
+    ref_plane rpl[MAXPL];
+    ref_point rpt[MAXPT];
+    ref_point rv[MAXV]; /* the input vertices */
+    ref_vec rx[MAXPT];  /* rational coordinates */
+    mpq_t rw[MAXPT];    /* W as the header defines it: n.u (LPI), det (TPI) */
+    /* The scenario's lines (query.line): whether each exists, and which points lie on
+     * it, decided once per point rather than once per pair the point is in. */
+    ref_line rline[MAXLINES];
+    bool line_ok[MAXLINES], on_line[MAXLINES][MAXPT];
 } ws;
-
-static void zpoint_init(zpoint *p) { mpz_inits(p->n[0], p->n[1], p->n[2], p->d, NULL); }
-
-static void zpoint_clear(zpoint *p) { mpz_clears(p->n[0], p->n[1], p->n[2], p->d, NULL); }
 
 static void ws_init(void)
 {
-    for (int i = 0; i < MAXPL; i++) {
-        qvec_init(&ws.rpl[i].n);
-        qvec_init(&ws.rpl[i].a);
-        mpz_inits(ws.rpl[i].h[0], ws.rpl[i].h[1], ws.rpl[i].h[2], ws.rpl[i].h[3], NULL);
-    }
+    for (int i = 0; i < MAXPL; i++)
+        ref_plane_init(&ws.rpl[i]);
     for (int i = 0; i < MAXPT; i++) {
-        zpoint_init(&ws.rpt[i]);
-        qvec_init(&ws.rx[i]);
+        ref_point_init(&ws.rpt[i]);
+        ref_vec_init(&ws.rx[i]);
         mpq_init(ws.rw[i]);
     }
     for (int i = 0; i < MAXV; i++)
-        zpoint_init(&ws.rv[i]);
+        ref_point_init(&ws.rv[i]);
+    for (int i = 0; i < MAXLINES; i++)
+        ref_line_init(&ws.rline[i]);
 }
 
 static void ws_clear(void)
 {
-    for (int i = 0; i < MAXPL; i++) {
-        qvec_clear(&ws.rpl[i].n);
-        qvec_clear(&ws.rpl[i].a);
-        mpz_clears(ws.rpl[i].h[0], ws.rpl[i].h[1], ws.rpl[i].h[2], ws.rpl[i].h[3], NULL);
-    }
+    for (int i = 0; i < MAXPL; i++)
+        ref_plane_clear(&ws.rpl[i]);
     for (int i = 0; i < MAXPT; i++) {
-        zpoint_clear(&ws.rpt[i]);
-        qvec_clear(&ws.rx[i]);
+        ref_point_clear(&ws.rpt[i]);
+        ref_vec_clear(&ws.rx[i]);
         mpq_clear(ws.rw[i]);
     }
     for (int i = 0; i < MAXV; i++)
-        zpoint_clear(&ws.rv[i]);
+        ref_point_clear(&ws.rv[i]);
+    for (int i = 0; i < MAXLINES; i++)
+        ref_line_clear(&ws.rline[i]);
 }
 
 /* ---------------------------------------------------------------- reporting */
@@ -643,6 +135,7 @@ static void ws_clear(void)
 typedef struct query {
     int pred;
     int pt[3], pl[2], lv[2], axis;
+    int line; /* the line orders: line_planes[line], or line_edges[line - MAXLP] */
 } query;
 
 static const char *vstr(const double *x)
@@ -750,22 +243,13 @@ static long uninformative_bounds; /* cached values with bound +inf or NaN */
  * trivially: every filter comparison |v| > e fails on it, so the exact stage decides. */
 static bool fv_holds(mci_fv f, mpq_srcptr x)
 {
-    mpq_t d, e;
-    bool ok;
     if (isnan(f.e) || (isinf(f.e) && f.e > 0)) {
         uninformative_bounds++;
         return true;
     }
     if (!isfinite(f.v) || !isfinite(f.e) || f.e < 0)
         return false;
-    mpq_inits(d, e, NULL);
-    mpq_set_d(d, f.v);
-    mpq_sub(d, d, x);
-    mpq_abs(d, d);
-    mpq_set_d(e, f.e);
-    ok = mpq_cmp(d, e) <= 0;
-    mpq_clears(d, e, NULL);
-    return ok;
+    return ref_within(f.v, f.e, x);
 }
 
 static void print_bound(const char *what, int k, mci_fv f, mpq_srcptr x)
@@ -789,7 +273,7 @@ static bool plane_bounds_ok(int p, bool print)
 
 static void check_plane_bounds(const scenario *s, int p)
 {
-    query q = {PR_BOUNDS, {0, 0, 0}, {p, p}, {0, 0}, 0};
+    query q = {PR_BOUNDS, {0, 0, 0}, {p, p}, {0, 0}, 0, 0};
     int got[3] = {plane_bounds_ok(p, false), NONE, NONE};
     check_case(s, &q, got, 1);
     if (!got[0] && printed_mismatches <= MAX_PRINTED) {
@@ -830,7 +314,7 @@ static bool point_bounds_ok(int i, bool print)
 
 static void check_point_bounds(const scenario *s, int i)
 {
-    query q = {PR_BOUNDS, {i, 0, 0}, {0, 0}, {0, 0}, 0};
+    query q = {PR_BOUNDS, {i, 0, 0}, {0, 0}, {0, 0}, 0, 0};
     int got[3] = {point_bounds_ok(i, false), NONE, NONE};
     check_case(s, &q, got, 1);
     if (!got[0] && printed_mismatches <= MAX_PRINTED) {
@@ -847,32 +331,13 @@ static int box_printed;
 /* lo <= x (upper: x <= hi), exactly. An infinite bound on its own side always holds. */
 static bool box_bound_holds(double b, mpq_srcptr x, bool upper)
 {
-    mpq_t q;
     int c;
     if (isinf(b) && (b > 0) == upper)
         return true;
     if (!isfinite(b))
         return false;
-    mpq_init(q);
-    mpq_set_d(q, b);
-    c = mpq_cmp(q, x);
-    mpq_clear(q);
+    c = ref_cmp_d(b, x);
     return upper ? c >= 0 : c <= 0;
-}
-
-/* x - b rounded to a double (the size of a miss), or NaN when b is not finite. */
-static double box_gap(mpq_srcptr x, double b)
-{
-    mpq_t d;
-    double g;
-    if (!isfinite(b))
-        return NAN;
-    mpq_init(d);
-    mpq_set_d(d, b);
-    mpq_sub(d, x, d);
-    g = mpq_get_d(d);
-    mpq_clear(d);
-    return g;
 }
 
 /* The box of mci_point_bounds contains the exact point; counts infinite and tight boxes
@@ -892,7 +357,7 @@ static void check_point_box(const scenario *s, int i)
             print_point(s, "of", i);
             fprintf(stderr, "  base %a, y = %a +- %a, w = %a +- %a; exact - lo = %a, "
                     "exact - hi = %a\n", p->v[0][k], p->y[k].v, p->y[k].e, p->w.v,
-                    p->w.e, box_gap(x, lo[k]), box_gap(x, hi[k]));
+                    p->w.e, ref_gap(x, lo[k]), ref_gap(x, hi[k]));
         }
         infinite |= isinf(lo[k]) || isinf(hi[k]);
         tight &= hi[k] - lo[k] <= 1e-10 * (fabs(lo[k]) + fabs(hi[k])) + 1e-300;
@@ -907,28 +372,6 @@ static void check_point_box(const scenario *s, int i)
 /* ---------------------------------------------------------------- correct rounding */
 
 static long rounded_coordinates;
-
-/* r is a nearest double to x: x lies between the midpoints to r's neighbours. */
-static bool is_nearest_double(double r, mpq_srcptr x)
-{
-    double below = nextafter(r, -INFINITY), above = nextafter(r, INFINITY);
-    mpq_t lo, hi, t;
-    bool ok;
-    if (!isfinite(r))
-        return false;
-    mpq_inits(lo, hi, t, NULL);
-    mpq_set_d(lo, r);
-    mpq_set_d(t, below);
-    mpq_add(lo, lo, t);
-    mpq_div_2exp(lo, lo, 1);
-    mpq_set_d(hi, r);
-    mpq_set_d(t, above);
-    mpq_add(hi, hi, t);
-    mpq_div_2exp(hi, hi, 1);
-    ok = (!isfinite(below) || mpq_cmp(lo, x) <= 0) && (!isfinite(above) || mpq_cmp(x, hi) <= 0);
-    mpq_clears(lo, hi, t, NULL);
-    return ok;
-}
 
 /* mci_point_round gives the nearest double on every axis; mci_point_approx is finite. */
 /* The double-double rounding stage on its own, from the approximation and from a guess
@@ -950,9 +393,9 @@ static void check_point_round_dd(const scenario *s, int i, const double approx[3
             if ((left >> k) & 1)
                 continue;
             dd_rounded++;
-            CHECK_MSG(is_nearest_double(r[k], ws.rx[i].c[k]), "mci_point_round_dd (%s) axis "
-                      "%d: %a, exact %a", class_names[s->cls], k, r[k],
-                      mpq_get_d(ws.rx[i].c[k]));
+            CHECK_MSG(ref_is_nearest_double(r[k], ws.rx[i].c[k]),
+                      "mci_point_round_dd (%s) axis %d: %a, exact %a", class_names[s->cls],
+                      k, r[k], mpq_get_d(ws.rx[i].c[k]));
         }
     }
 }
@@ -965,8 +408,9 @@ static void check_point_round(const scenario *s, int i)
     for (int k = 0; k < 3; k++) {
         if (fabs(mpq_get_d(ws.rx[i].c[k])) > 0x1p1020)
             continue; /* near or beyond the double range: not a point of any mesh */
-        CHECK_MSG(is_nearest_double(r[k], ws.rx[i].c[k]), "mci_point_round (%s) axis %d: "
-                  "%a, exact %a", class_names[s->cls], k, r[k], mpq_get_d(ws.rx[i].c[k]));
+        CHECK_MSG(ref_is_nearest_double(r[k], ws.rx[i].c[k]),
+                  "mci_point_round (%s) axis %d: %a, exact %a", class_names[s->cls], k, r[k],
+                  mpq_get_d(ws.rx[i].c[k]));
         CHECK_MSG(isfinite(a[k]), "mci_point_approx (%s) axis %d: %a", class_names[s->cls],
                   k, a[k]);
         rounded_coordinates++;
@@ -983,7 +427,7 @@ static void build_point(const scenario *s, int i)
     bool kok = true, rok = true;
     if (d->kind == MCI_POINT_EXPLICIT) {
         mci_point_explicit(kp, s->v[d->v[0]]);
-        qvec_set_d(&ws.rx[i], s->v[d->v[0]]);
+        ref_vec_set_d(&ws.rx[i], s->v[d->v[0]]);
     } else if (d->kind == MCI_POINT_LPI) {
         kok = mci_point_lpi(kp, s->v[d->v[0]], s->v[d->v[1]], &ws.kpl[d->pl[0]]);
         rok = ref_lpi(&ws.rx[i], ws.rw[i], s->v[d->v[0]], s->v[d->v[1]], &ws.rpl[d->pl[0]]);
@@ -994,14 +438,14 @@ static void build_point(const scenario *s, int i)
     }
     if (d->kind != MCI_POINT_EXPLICIT) {
         query q = {
-            d->kind == MCI_POINT_LPI ? PR_LPI : PR_TPI, {i, 0, 0}, {0, 0}, {0, 0}, 0};
+            d->kind == MCI_POINT_LPI ? PR_LPI : PR_TPI, {i, 0, 0}, {0, 0}, {0, 0}, 0, 0};
         int got[3] = {kok, NONE, NONE};
         check_case(s, &q, got, rok);
     }
     ws.ok[i] = kok && rok;
     if (!ws.ok[i])
         return;
-    zpoint_from_qvec(&ws.rpt[i], &ws.rx[i]);
+    ref_point_set_vec(&ws.rpt[i], &ws.rx[i]);
     if (d->kind != MCI_POINT_EXPLICIT)
         check_point_bounds(s, i);
     check_point_box(s, i);
@@ -1010,10 +454,8 @@ static void build_point(const scenario *s, int i)
 
 static void build(const scenario *s)
 {
-    for (int i = 0; i < s->nv; i++) {
-        qvec_set_d(&ws.rx[0], s->v[i]);
-        zpoint_from_qvec(&ws.rv[i], &ws.rx[0]);
-    }
+    for (int i = 0; i < s->nv; i++)
+        ref_point_set_d(&ws.rv[i], s->v[i]);
     for (int p = 0; p < s->npl; p++) {
         const double *a = s->v[s->plv[p][0]], *b = s->v[s->plv[p][1]],
                      *c = s->v[s->plv[p][2]];
@@ -1023,6 +465,25 @@ static void build(const scenario *s)
     }
     for (int i = 0; i < s->npt; i++)
         build_point(s, i);
+}
+
+/* The scenario's lines in the reference, and which of the usable points lie on each:
+ * decided here once per point, as queries_pairs orders every pair on every line. */
+static void build_lines(const scenario *s, const int *idx, int n)
+{
+    for (int l = 0; l < s->nlp; l++) {
+        const ref_plane *p1 = &ws.rpl[s->line_planes[l][0]];
+        const ref_plane *p2 = &ws.rpl[s->line_planes[l][1]];
+        ws.line_ok[l] = ref_line_set_planes(&ws.rline[l], p1, p2);
+        for (int i = 0; i < n; i++)
+            ws.on_line[l][idx[i]] = ref_on_planes(&ws.rpt[idx[i]], p1, p2);
+    }
+    for (int l = 0; l < s->nle; l++) {
+        const ref_point *l0 = &ws.rv[s->line_edges[l][0]], *l1 = &ws.rv[s->line_edges[l][1]];
+        ws.line_ok[MAXLP + l] = ref_line_set_points(&ws.rline[MAXLP + l], l0, l1);
+        for (int i = 0; i < n; i++)
+            ws.on_line[MAXLP + l][idx[i]] = ref_on_line(&ws.rpt[idx[i]], l0, l1);
+    }
 }
 
 /* ---------------------------------------------------------------- running queries */
@@ -1068,62 +529,21 @@ static void kernel_eval(const scenario *s, const query *q, int got[3])
     }
 }
 
-/* sign((a - b) . (n1 x n2)) if a and b lie on both planes and those are not parallel,
- * else NONE. */
-static int ref_order_plane_line(const zpoint *a, const zpoint *b, const zplane *p1,
-                                const zplane *p2)
+/* The order of the query's points along its line, or NONE unless the line exists and
+ * both points lie on it. */
+static int ref_line_order(const query *q)
 {
-    mpz_t dir[3];
-    int r = NONE;
-    bool on = !ref_orient3d(a, p1) && !ref_orient3d(a, p2) && !ref_orient3d(b, p1) &&
-              !ref_orient3d(b, p2);
-    mpz_inits(dir[0], dir[1], dir[2], NULL);
-    ref_plane_line_dir(dir, p1, p2);
-    if (on && (mpz_sgn(dir[0]) || mpz_sgn(dir[1]) || mpz_sgn(dir[2])))
-        r = ref_dot_dir(a, b, dir);
-    mpz_clears(dir[0], dir[1], dir[2], NULL);
-    return r;
-}
-
-/* Whether p lies on the line through l0 != l1: collinear in all three projections. */
-static bool ref_on_line(const zpoint *p, const zpoint *l0, const zpoint *l1)
-{
-    return ref_orient2d(l0, l1, p, 0) == 0 && ref_orient2d(l0, l1, p, 1) == 0 &&
-           ref_orient2d(l0, l1, p, 2) == 0;
-}
-
-/* sign((a - b) . (l1 - l0)) if l0 != l1 and a, b lie on their line, else NONE. */
-static int ref_order_edge_line(const zpoint *a, const zpoint *b, const zpoint *l0,
-                               const zpoint *l1)
-{
-    mpz_t dir[3];
-    int r = NONE;
-    if (ref_compare_lex(l0, l1) == 0 || !ref_on_line(a, l0, l1) || !ref_on_line(b, l0, l1))
+    int a = q->pt[0], b = q->pt[1], l = q->line;
+    if (!ws.line_ok[l] || !ws.on_line[l][a] || !ws.on_line[l][b])
         return NONE;
-    mpz_inits(dir[0], dir[1], dir[2], NULL);
-    for (int k = 0; k < 3; k++)
-        zdiff(dir[k], l1, l0, k);
-    r = ref_dot_dir(a, b, dir);
-    mpz_clears(dir[0], dir[1], dir[2], NULL);
-    return r;
-}
-
-static int ref_line_direction_sign(const zplane *p1, const zplane *p2, int axis)
-{
-    mpz_t dir[3];
-    int r;
-    mpz_inits(dir[0], dir[1], dir[2], NULL);
-    ref_plane_line_dir(dir, p1, p2);
-    r = mpz_sgn(dir[axis]);
-    mpz_clears(dir[0], dir[1], dir[2], NULL);
-    return r;
+    return ref_order_on_line(&ws.rpt[a], &ws.rpt[b], &ws.rline[l]);
 }
 
 /* The reference result, or NONE where the predicate's precondition does not hold. */
 static int ref_eval(const query *q)
 {
-    const zpoint *a = &ws.rpt[q->pt[0]], *b = &ws.rpt[q->pt[1]], *c = &ws.rpt[q->pt[2]];
-    const zplane *p1 = &ws.rpl[q->pl[0]], *p2 = &ws.rpl[q->pl[1]];
+    const ref_point *a = &ws.rpt[q->pt[0]], *b = &ws.rpt[q->pt[1]], *c = &ws.rpt[q->pt[2]];
+    const ref_plane *p1 = &ws.rpl[q->pl[0]], *p2 = &ws.rpl[q->pl[1]];
     switch (q->pred) {
     case PR_ORIENT3D:
         return ref_orient3d(a, p1);
@@ -1137,10 +557,8 @@ static int ref_eval(const query *q)
         return ref_orient2d(a, b, c, q->axis);
     case PR_LINEDIR:
         return ref_line_direction_sign(p1, p2, q->axis);
-    case PR_ORDER_PL:
-        return ref_order_plane_line(a, b, p1, p2);
-    default: /* PR_ORDER_EDGE */
-        return ref_order_edge_line(a, b, &ws.rv[q->lv[0]], &ws.rv[q->lv[1]]);
+    default: /* PR_ORDER_PL, PR_ORDER_EDGE */
+        return ref_line_order(q);
     }
 }
 
@@ -1245,7 +663,7 @@ static void queries_orient3d(const scenario *s, const int *idx, int n)
 {
     for (int i = 0; i < n; i++)
         for (int p = 0; p < s->npl; p++) {
-            query q = {PR_ORIENT3D, {idx[i], 0, 0}, {p, p}, {0, 0}, 0};
+            query q = {PR_ORIENT3D, {idx[i], 0, 0}, {p, p}, {0, 0}, 0, 0};
             run_query(s, &q);
         }
 }
@@ -1261,6 +679,7 @@ static void queries_pairs(const scenario *s, const int *idx, int n)
                        {swap ? idx[j] : idx[i], swap ? idx[i] : idx[j], 0},
                        {0, 0},
                        {0, 0},
+                       0,
                        0};
             for (q.axis = 0; q.axis < 3; q.axis++)
                 run_query(s, &q);
@@ -1273,12 +692,14 @@ static void queries_pairs(const scenario *s, const int *idx, int n)
             for (int l = 0; l < s->nlp; l++) {
                 q.pl[0] = s->line_planes[l][0];
                 q.pl[1] = s->line_planes[l][1];
+                q.line = l;
                 run_query(s, &q);
             }
             q.pred = PR_ORDER_EDGE;
             for (int l = 0; l < s->nle; l++) {
                 q.lv[0] = s->line_edges[l][0];
                 q.lv[1] = s->line_edges[l][1];
+                q.line = MAXLP + l;
                 run_query(s, &q);
             }
         }
@@ -1286,7 +707,7 @@ static void queries_pairs(const scenario *s, const int *idx, int n)
 
 static void orient2d_all_axes(const scenario *s, int a, int b, int c)
 {
-    query q = {PR_ORIENT2D, {a, b, c}, {0, 0}, {0, 0}, 0};
+    query q = {PR_ORIENT2D, {a, b, c}, {0, 0}, {0, 0}, 0, 0};
     for (q.axis = 0; q.axis < 3; q.axis++)
         run_query(s, &q);
 }
@@ -1317,7 +738,7 @@ static void queries_linedir(const scenario *s)
 {
     for (int p = 0; p < s->npl; p++)
         for (int r = p + 1; r < s->npl; r++) {
-            query q = {PR_LINEDIR, {0, 0, 0}, {p, r}, {0, 0}, 0};
+            query q = {PR_LINEDIR, {0, 0, 0}, {p, r}, {0, 0}, 0, 0};
             for (q.axis = 0; q.axis < 3; q.axis++)
                 run_query(s, &q);
         }
@@ -1360,6 +781,7 @@ static void run_scenario(const scenario *s)
     build(s);
     check_claims(s);
     n = usable_points(s, idx);
+    build_lines(s, idx, n);
     queries_orient3d(s, idx, n);
     queries_pairs(s, idx, n);
     queries_orient2d(s, idx, n);
@@ -1386,456 +808,20 @@ static void run_with_perturbations(const scenario *base, int runs, int ulp_cls)
     }
 }
 
-/* ---------------------------------------------------------------- random scenarios */
-
-static int random_vertex(scenario *s, int regime)
-{
-    double x[3];
-    draw_vertex(regime, x);
-    return sc_vertex(s, x);
-}
-
-/* Random vertices; planes 0..2 share the line v0 v1 (in both orientations) so that
- * points on it can be ordered; LPIs and TPIs on that line and elsewhere. A few cases are
- * degenerate on purpose (repeated vertex in a plane, repeated plane in a TPI, p = q). */
-static void scenario_random(scenario *s, int regime)
-{
-    const int nv = 12;
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("random/", regime_names[regime]);
-    bits_width = rng_chance(0.5) ? rng_int(1, 8) : rng_int(9, 40);
-    for (int i = 0; i < nv; i++)
-        random_vertex(s, regime);
-    sc_plane(s, 0, 1, 2);
-    sc_plane(s, 1, 0, 3);
-    sc_plane(s, 4, 0, 1);
-    for (int p = 3; p < 8; p++) {
-        int a = rng_int(2, nv - 1), b = rng_int(2, nv - 1), c = rng_int(2, nv - 1);
-        if (!rng_chance(0.03))
-            while (b == a || c == a || c == b)
-                b = rng_int(2, nv - 1), c = rng_int(2, nv - 1);
-        sc_plane(s, a, b, c);
-    }
-    sc_explicit(s, 0);
-    sc_explicit(s, 1);
-    sc_explicit(s, rng_int(2, nv - 1));
-    sc_explicit(s, rng_int(2, nv - 1));
-    sc_lpi(s, 0, 1, rng_int(3, 7));
-    sc_lpi(s, 1, 0, rng_int(3, 7));
-    for (int k = 0; k < 3; k++) {
-        int a = rng_int(0, nv - 1), b = rng_chance(0.02) ? a : rng_int(0, nv - 1);
-        sc_lpi(s, a, b, rng_int(0, 7));
-    }
-    sc_tpi(s, 0, 1, rng_int(3, 7));
-    sc_tpi(s, 2, 0, rng_int(3, 7));
-    for (int k = 0; k < 3; k++) {
-        int a = rng_int(0, 7), b = rng_int(0, 7), c = rng_int(0, 7);
-        if (!rng_chance(0.03))
-            while (b == a || c == a || c == b)
-                b = rng_int(0, 7), c = rng_int(0, 7);
-        sc_tpi(s, a, b, c);
-    }
-    sc_line_planes(s, 0, 1);
-    sc_line_planes(s, 2, 0);
-    sc_line_edge(s, 0, 1);
-    sc_line_edge(s, 1, 0);
-}
-
-/* ---------------------------------------------------------------- nearly parallel */
-
-/* A copy of vertex v with n_coords of its coordinates nudged by 1..3 ulps. */
-static int nudged_vertex(scenario *s, int v, int n_coords)
-{
-    double x[3];
-    memcpy(x, s->v[v], sizeof x);
-    for (int k = 0; k < n_coords; k++) {
-        int a = rng_int(0, 2);
-        x[a] = nudge(x[a], rng_int(1, 3));
-    }
-    return sc_vertex(s, x);
-}
-
-/* q = p + (b - a) rounded: a line nearly parallel to any plane through a and b (exactly
- * parallel when the sum is exact). Falls back to a nudged p if the sum overflows. */
-static int parallel_end(scenario *s, int p, int a, int b)
-{
-    double x[3];
-    for (int k = 0; k < 3; k++) {
-        x[k] = s->v[p][k] + (s->v[b][k] - s->v[a][k]);
-        if (!isfinite(x[k]))
-            x[k] = nudge(s->v[p][k], 4);
-    }
-    return sc_vertex(s, x);
-}
-
-/* Planes that are copies of P0 = (v0, v1, v2) nudged by a few ulps: TPIs of nearly
- * parallel planes, LPIs of lines nearly parallel to planes. P0 and P2 share the line
- * v0 v1 exactly (P2's third vertex is a nudged v2), so points on it are ordered too. */
-static void scenario_near_parallel(scenario *s, int regime)
-{
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("nearpar/", regime_names[regime]);
-    bits_width = rng_chance(0.5) ? rng_int(1, 8) : rng_int(9, 40);
-    for (int i = 0; i < 8; i++)
-        random_vertex(s, regime);
-    int w0 = nudged_vertex(s, 0, 1), w1 = nudged_vertex(s, 1, 2),
-        w2 = nudged_vertex(s, 2, 1);
-    int w2b = nudged_vertex(s, 2, 1), q1 = parallel_end(s, 3, 0, 1);
-    int q2 = parallel_end(s, 6, 0, 2), q3 = nudged_vertex(s, parallel_end(s, 5, 1, 2), 1);
-    int p0 = sc_plane(s, 0, 1, 2), p1 = sc_plane_rotated(s, w0, w1, w2);
-    int p2 = sc_plane(s, 0, 1, w2b), p3 = sc_plane(s, 3, 4, 5), p4 = sc_plane(s, 5, 6, 7);
-    sc_tpi(s, p0, p1, p3);
-    sc_tpi(s, p0, p2, p3);
-    sc_tpi(s, p2, p0, p4);
-    sc_tpi(s, p1, p2, p4);
-    sc_tpi(s, p3, p0, p4);
-    sc_lpi(s, 3, q1, p0);
-    sc_lpi(s, 3, q1, p1);
-    sc_lpi(s, 6, q2, p2);
-    sc_lpi(s, 5, q3, p0);
-    sc_lpi(s, 0, 1, p1);
-    sc_lpi(s, 0, 1, p3);
-    sc_lpi(s, 1, 0, p4);
-    sc_explicit(s, 0);
-    sc_explicit(s, 1);
-    sc_explicit(s, 3);
-    sc_line_planes(s, p0, p2);
-    sc_line_edge(s, 0, 1);
-}
-
-/* ---------------------------------------------------------------- exact lattices */
-
-/* Points off[a] + i[a] * 2^k[a] per axis, i integer. Every integer combination of lattice
- * points computed in integers is an exact double while |off + i| < 2^53 (so the
- * adversarial constructions below are exact by design; check_claims verifies it).
- * Different scales per axis put 3.4e38, 1e-3 and 1e300 into one point. */
-typedef struct lattice {
-    const char *name;
-    int k[3];
-    int64_t off[3];
-    int count; /* scenarios per adversarial builder at scale 1 */
-} lattice;
-
-/* Lattices whose coordinates span a wide range of exponents (and any scenario with an
- * outlier) cost the exact stage far more, hence the smaller counts. */
-static const lattice lattices[] = {
-    {"int", {0, 0, 0}, {0, 0, 0}, 8},
-    {"far", {-20, -20, -20}, {1000000ll << 20, 1000000ll << 20, -(1000000ll << 20)}, 8},
-    {"farmix", {-10, -10, -3}, {-(3000000ll << 10), 500000ll << 10, 70000000ll << 3}, 8},
-    {"subnormal", {-1074, -1074, -1074}, {0, 0, 0}, 8},
-    {"subnormal-off", {-1074, -1074, -1074}, {1ll << 40, -(1ll << 41), 0}, 8},
-    {"huge", {985, 985, 985}, {0, 0, 0}, 2},
-    {"mixed-axes", {116, -22, 985}, {0, 0, 0}, 2},
-    {"mixed-axes2", {-997, 0, -1074}, {0, 1ll << 45, 0}, 2},
-    {"tiny-huge-far", {-1000, 900, -30}, {0, 0, 1000000ll << 30}, 2},
-};
-#define N_LATTICES (int)(sizeof lattices / sizeof lattices[0])
-
-typedef struct ivec {
-    int64_t c[3];
-} ivec;
-
-static ivec iv_rand(int64_t range)
-{
-    ivec r;
-    for (int k = 0; k < 3; k++)
-        r.c[k] = rng_int(-(int)range, (int)range);
-    return r;
-}
-
-/* a + s b */
-static ivec iv_axpy(ivec a, int64_t s, ivec b)
-{
-    for (int k = 0; k < 3; k++)
-        a.c[k] += s * b.c[k];
-    return a;
-}
-
-static ivec iv_sub(ivec a, ivec b) { return iv_axpy(a, -1, b); }
-
-static int lat_vertex(scenario *s, const lattice *L, ivec i)
-{
-    double x[3];
-    for (int k = 0; k < 3; k++)
-        x[k] = ldexp((double)(L->off[k] + i.c[k]), L->k[k]);
-    return sc_vertex(s, x);
-}
-
-/* A vertex far off the lattice (1e300, 3.4e38, 1e-300, ...), used only where it cannot
- * spoil exactness: as a plane's or line's other vertex next to the point of interest. */
-static int outlier_vertex(scenario *s)
-{
-    double x[3];
-    draw_vertex(R_MIX, x);
-    return sc_vertex(s, x);
-}
-
-/* A plane through lattice point X (vertex x), exactly, in one of three ways: X as a
- * vertex (the other two sometimes outliers); c = X + i(X - a) + j(X - b) (X inside the
- * span of a, b, c); X the centroid of a, b, c. */
-static int plane_through(scenario *s, const lattice *L, ivec X, int x, int64_t range,
-                         int kind)
-{
-    ivec a = iv_axpy(X, 1, iv_rand(range)), b = iv_axpy(X, 1, iv_rand(range));
-    if (kind == 0) {
-        bool far = rng_chance(0.3);
-        int vb = far ? outlier_vertex(s) : lat_vertex(s, L, a);
-        int vc = far ? outlier_vertex(s) : lat_vertex(s, L, b);
-        return sc_plane_rotated(s, x, vb, vc);
-    }
-    if (kind == 1) {
-        int i = rng_int(-2, 2), j = rng_int(-2, 2);
-        if (i == 0 && j == 0)
-            i = 1;
-        ivec c = iv_axpy(iv_axpy(X, i, iv_sub(X, a)), j, iv_sub(X, b));
-        return sc_plane_rotated(s, lat_vertex(s, L, a), lat_vertex(s, L, b),
-                                lat_vertex(s, L, c));
-    }
-    ivec u = iv_sub(a, X), v = iv_sub(b, X), c = iv_axpy(iv_sub(X, u), -1, v);
-    return sc_plane_rotated(s, lat_vertex(s, L, a), lat_vertex(s, L, b),
-                            lat_vertex(s, L, c));
-}
-
-/* A line through X: X the midpoint, outside the segment, an endpoint (either end), or
- * an endpoint with an outlier as the other. Returns the two vertices in l[]. */
-static void line_through(scenario *s, const lattice *L, ivec X, int x, int64_t range,
-                         int l[2])
-{
-    ivec d = iv_rand(range);
-    switch (rng_int(0, 4)) {
-    case 0:
-        l[0] = lat_vertex(s, L, iv_axpy(X, -1, d)),
-        l[1] = lat_vertex(s, L, iv_axpy(X, 1, d));
-        break;
-    case 1:
-        l[0] = lat_vertex(s, L, iv_axpy(X, 1, d)),
-        l[1] = lat_vertex(s, L, iv_axpy(X, 3, d));
-        break;
-    case 2:
-        l[0] = x, l[1] = lat_vertex(s, L, iv_axpy(X, 1, d));
-        break;
-    case 3:
-        l[0] = lat_vertex(s, L, iv_axpy(X, 1, d)), l[1] = x;
-        break;
-    default:
-        l[0] = x, l[1] = outlier_vertex(s);
-        break;
-    }
-}
-
-/* A plane through three random lattice points (rarely through anything of interest). */
-static int lat_random_plane(scenario *s, const lattice *L, int64_t range)
-{
-    int a = lat_vertex(s, L, iv_rand(range));
-    int b = lat_vertex(s, L, iv_rand(range));
-    int c = lat_vertex(s, L, iv_rand(range));
-    return sc_plane(s, a, b, c);
-}
-
-static int64_t lattice_range(void) { return rng_chance(0.3) ? 8 : 1024; }
-
-/* One point X defined many ways: explicit; LPIs of lines through X with planes through
- * X; TPIs of three planes through X. All must be equal and on all those planes. A few
- * unrelated points (one lattice step away, an LPI and a TPI with a plane missing X)
- * keep the comparisons honest. */
-static void scenario_same(scenario *s, const lattice *L)
-{
-    int64_t range = lattice_range();
-    ivec X = iv_rand(range);
-    int pl[6], lines[4][2], x;
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("same", "");
-    x = lat_vertex(s, L, X);
-    for (int k = 0; k < 6; k++)
-        s->onpl[s->nonpl++] = pl[k] = plane_through(s, L, X, x, range, k % 3);
-    for (int k = 0; k < 4; k++)
-        line_through(s, L, X, x, range, lines[k]);
-    s->group[s->ngroup++] = sc_explicit(s, x);
-    for (int k = 0; k < 4; k++)
-        s->group[s->ngroup++] = sc_lpi(s, lines[k][0], lines[k][1], pl[rng_int(0, 5)]);
-    for (int k = 0; k < 4; k++) {
-        int a = rng_int(0, 5), b = (a + rng_int(1, 5)) % 6, c = rng_int(0, 5);
-        while (c == a || c == b)
-            c = rng_int(0, 5);
-        s->group[s->ngroup++] = sc_tpi(s, pl[a], pl[b], pl[c]);
-    }
-    s->group_equal = true;
-    ivec step = {{0, 0, 0}};
-    step.c[rng_int(0, 2)] = rng_chance(0.5) ? 1 : -1;
-    int other = lat_random_plane(s, L, range);
-    sc_explicit(s, lat_vertex(s, L, iv_axpy(X, 1, step)));
-    sc_lpi(s, lines[0][0], lines[0][1], other);
-    sc_tpi(s, pl[0], other, pl[1]);
-}
-
-/* Points on one line L = e0 e1: lattice points, LPIs of L (given by two different vertex
- * pairs) with other planes, TPIs of two planes through L with a third. LPI(L, Q) and
- * TPI(P, P', Q) are the same point; order along L by planes and by edge. */
-static void scenario_line(scenario *s, const lattice *L)
-{
-    int64_t range = lattice_range();
-    ivec e0 = iv_rand(range), d = iv_rand(range / 2 + 1);
-    ivec f0 = iv_axpy(e0, rng_int(-3, 3), d), f1 = iv_axpy(e0, rng_int(2, 4), d);
-    int ve0, ve1, vf0, vf1, p[4], q[4];
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("line", "");
-    ve0 = lat_vertex(s, L, e0), ve1 = lat_vertex(s, L, iv_axpy(e0, 1, d));
-    vf0 = lat_vertex(s, L, f0), vf1 = lat_vertex(s, L, f1);
-    p[0] = sc_plane(s, ve0, ve1, lat_vertex(s, L, iv_rand(range)));
-    p[1] = sc_plane(s, ve1, ve0, lat_vertex(s, L, iv_rand(range)));
-    p[2] = sc_plane(s, vf0, lat_vertex(s, L, iv_rand(range)), vf1);
-    p[3] =
-        sc_plane(s, rng_chance(0.3) ? outlier_vertex(s) : lat_vertex(s, L, iv_rand(range)),
-                 vf1, ve0);
-    for (int k = 0; k < 3; k++)
-        q[k] = lat_random_plane(s, L, range);
-    int far = outlier_vertex(s);
-    q[3] = sc_plane_rotated(s, vf0, far, lat_vertex(s, L, iv_rand(range)));
-    for (int k = 0; k < 4; k++)
-        s->onpl[s->nonpl++] = p[k];
-    /* Every point of the scenario is on L: all form the group. */
-    sc_explicit(s, ve0);
-    sc_explicit(s, ve1);
-    sc_explicit(s, vf0);
-    sc_explicit(s, vf1);
-    sc_lpi(s, ve0, ve1, q[0]);
-    sc_lpi(s, vf0, vf1, q[0]);
-    sc_lpi(s, vf1, ve0, q[1]);
-    sc_lpi(s, ve1, vf0, q[2]);
-    sc_lpi(s, ve0, ve1, q[3]);
-    sc_tpi(s, p[0], p[1], q[0]);
-    sc_tpi(s, p[2], q[1], p[0]);
-    sc_tpi(s, q[2], p[3], p[1]);
-    sc_tpi(s, p[1], p[2], q[3]);
-    for (int k = 0; k < s->npt; k++)
-        s->group[s->ngroup++] = k;
-    sc_line_planes(s, p[0], p[1]);
-    sc_line_planes(s, p[2], p[0]);
-    sc_line_planes(s, p[1], p[3]);
-    sc_line_planes(s, p[3], p[2]);
-    sc_line_edge(s, ve0, ve1);
-    sc_line_edge(s, vf1, vf0);
-}
-
-/* Exactly degenerate configurations (constructors must say no) next to valid ones:
- * a line parallel to a plane and a line inside it (LPI), parallel planes and three planes
- * through one line (TPI). The +ulp runs turn them into near-degeneracies. */
-static void scenario_parallel(scenario *s, const lattice *L)
-{
-    int64_t range = lattice_range();
-    ivec a = iv_rand(range), b = iv_rand(range), c = iv_rand(range), t = iv_rand(range);
-    ivec p = iv_rand(range), e0 = iv_rand(range), e1 = iv_rand(range);
-    int i = rng_int(-2, 2), j = rng_int(1, 2), va, vb, vc;
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("par", "");
-    va = lat_vertex(s, L, a), vb = lat_vertex(s, L, b), vc = lat_vertex(s, L, c);
-    int P = sc_plane(s, va, vb, vc);
-    int Pt =
-        sc_plane(s, lat_vertex(s, L, iv_axpy(a, 1, t)), lat_vertex(s, L, iv_axpy(b, 1, t)),
-                 lat_vertex(s, L, iv_axpy(c, 1, t)));
-    int vp = lat_vertex(s, L, p);
-    int vq = lat_vertex(s, L, iv_axpy(iv_axpy(p, i, iv_sub(b, a)), j, iv_sub(c, a)));
-    int vin0 = lat_vertex(s, L, iv_axpy(a, j, iv_sub(c, b)));
-    int vin1 = lat_vertex(s, L, iv_axpy(iv_axpy(b, i, iv_sub(c, a)), -j, iv_sub(b, a)));
-    int ve0 = lat_vertex(s, L, e0), ve1 = lat_vertex(s, L, e1);
-    int R1 = sc_plane(s, ve0, ve1, lat_vertex(s, L, iv_rand(range)));
-    int R2 = sc_plane(s, lat_vertex(s, L, iv_rand(range)), ve1, ve0);
-    int R3 = sc_plane(s, ve1, lat_vertex(s, L, iv_axpy(e0, 2, iv_sub(e1, e0))),
-                      lat_vertex(s, L, iv_rand(range)));
-    int Q = lat_random_plane(s, L, range);
-    sc_lpi(s, vp, vq, P);
-    sc_lpi(s, vq, vp, Pt);
-    sc_lpi(s, vp, vq, Q);
-    sc_lpi(s, vin0, vin1, P);
-    sc_lpi(s, vin0, vin1, Q);
-    sc_lpi(s, ve0, ve1, R3);
-    sc_tpi(s, P, Pt, Q);
-    sc_tpi(s, R1, R2, R3);
-    sc_tpi(s, R1, R2, Q);
-    sc_tpi(s, P, R1, Q);
-    sc_tpi(s, Pt, R2, R3);
-    sc_explicit(s, va);
-    sc_explicit(s, vp);
-    sc_line_planes(s, R1, R2);
-    sc_line_planes(s, R3, R1);
-    sc_line_edge(s, ve0, ve1);
-}
-
-/* ---------------------------------------------------------------- axis-aligned grids */
-
-/* A grid coordinate: a multiple of 1/4 in [-64, 64] (a plate's holes and bars). */
-static double grid_coord(void)
-{
-    return rng_int(-256, 256) / 4.0;
-}
-
-/* A vertex on the grid with coordinate k set to c. */
-static int grid_vertex_at(scenario *s, int k, double c)
-{
-    double x[3] = {grid_coord(), grid_coord(), grid_coord()};
-    x[k] = c;
-    return sc_vertex(s, x);
-}
-
-/* What a plate with a grid of holes is made of: planes x_k = c (three vertices sharing
- * coordinate k; now and then collinear, so that the constructors must say no), lines
- * that are translates of one another along the plane (the holes' wall diagonals), and
- * their LPIs, which lie on one line of the plane: exact zeros in the orientations, on
- * inputs short enough for 128-bit integers once the plane's normal cancels (EVAL(lpi)).
- * A second aligned plane, a general one and TPIs through the aligned ones besides. */
-static void scenario_axis_grid(scenario *s)
-{
-    int k = rng_int(0, 2), i = (k + 1) % 3, j = (k + 2) % 3, pl[3], lines[4][2];
-    double c = grid_coord(), d[3], t[3] = {0, 0, 0};
-    memset(s, 0, sizeof *s);
-    s->cls = class_id("axisgrid", "");
-    int a = grid_vertex_at(s, k, c), b = grid_vertex_at(s, k, c);
-    int e = rng_chance(0.05) ? a : grid_vertex_at(s, k, c);
-    pl[0] = sc_plane_rotated(s, a, b, e);
-    pl[1] = sc_plane_rotated(s, grid_vertex_at(s, i, c), grid_vertex_at(s, i, c),
-                             grid_vertex_at(s, i, c));
-    pl[2] = sc_plane(s, random_vertex(s, R_INT), random_vertex(s, R_INT),
-                     grid_vertex_at(s, k, c));
-    for (int m = 0; m < 3; m++)
-        d[m] = rng_int(-8, 8) / 4.0;
-    if (d[k] == 0)
-        d[k] = 0.75;
-    t[i] = rng_int(-8, 8) / 4.0;
-    t[j] = rng_int(-8, 8) / 4.0;
-    double base[3] = {grid_coord() / 2, grid_coord() / 2, grid_coord() / 2};
-    for (int n = 0; n < 4; n++) {
-        double p0[3], p1[3];
-        for (int m = 0; m < 3; m++) {
-            p0[m] = base[m] + n * t[m];
-            p1[m] = p0[m] + d[m];
-        }
-        lines[n][0] = sc_vertex(s, p0);
-        lines[n][1] = sc_vertex(s, p1);
-    }
-    s->onpl[s->nonpl++] = pl[0];
-    for (int n = 0; n < 4; n++)
-        s->group[s->ngroup++] = sc_lpi(s, lines[n][rng_int(0, 1)], lines[n][0] ^ lines[n][1] ^
-                                       lines[n][rng_int(0, 1)], pl[0]);
-    s->group[s->ngroup++] = sc_explicit(s, a);
-    s->group[s->ngroup++] = sc_explicit(s, b);
-    sc_lpi(s, lines[0][0], lines[0][1], pl[1]);
-    sc_lpi(s, lines[1][0], lines[2][1], pl[2]);
-    sc_tpi(s, pl[0], pl[1], pl[2]);
-}
-
 /* ---------------------------------------------------------------- driver */
 
+/* MCSG_TEST_SCALE, else 1; under the sanitizers (5-10x slower, and there to find memory
+ * and undefined-behaviour errors, which half the scenarios reach as well) 0.5. */
 static double test_scale(void)
 {
     const char *env = getenv("MCSG_TEST_SCALE");
-    double f = env ? atof(env) : 1.0;
+    double f = env ? atof(env) : getenv("MCSG_SANITIZED") ? 0.5 : 1.0;
     return f > 0 ? f : 1.0;
 }
 
 static long scaled(long n) { return (long)((double)n * test_scale() + 0.5); }
 
-/* Scenarios per class at MCSG_TEST_SCALE=1, chosen so that the sanitizer (Debug) build
- * stays under 90 s. The exp and mix regimes (and the adversarial lattices with mixed
+/* Scenarios per class at scale 1 (the normal build: about 30 s). The exp and mix regimes (and the adversarial lattices with mixed
  * scales) make the exact stage work on integers of ~2000 bits, some 0.2 ms per case, so
  * they get fewer scenarios than the well-scaled regimes. */
 static const int random_counts[R_COUNT] = {220, 220, 25, 25, 220, 220, 220, 220};
@@ -1874,7 +860,7 @@ TEST(kernel_adversarial)
     double t = seconds();
     for (int b = 0; b < 3; b++) {
         int ulp_cls = class_id(names[b], "");
-        for (int l = 0; l < N_LATTICES; l++)
+        for (int l = 0; l < lattice_count; l++)
             for (long n = scaled(lattices[l].count); n > 0; n--) {
                 builders[b](&s, &lattices[l]);
                 run_with_perturbations(&s, b == 2 ? 6 : 3, ulp_cls);
@@ -2025,43 +1011,19 @@ TEST(bit_range)
     }
 }
 
-/* Exact det[b - a, c - a, d - a] of four doubles, by rationals. */
-static int ref_orient3d_doubles(const double *a, const double *b, const double *c,
-                                const double *d)
-{
-    const double *v[3] = {b, c, d};
-    mpq_t r[3][3], t, u, det;
-    int sign;
-    mpq_inits(t, u, det, NULL);
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++) {
-            mpq_init(r[i][k]);
-            mpq_set_d(r[i][k], v[i][k]);
-            mpq_set_d(t, a[k]);
-            mpq_sub(r[i][k], r[i][k], t);
-        }
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        mpq_mul(t, r[1][i], r[2][j]);
-        mpq_mul(u, r[1][j], r[2][i]);
-        mpq_sub(t, t, u);
-        mpq_mul(t, t, r[0][k]);
-        mpq_add(det, det, t);
-    }
-    sign = mpq_sgn(det);
-    for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            mpq_clear(r[i][k]);
-    mpq_clears(t, u, det, NULL);
-    return sign;
-}
-
-/* Four vertices in every order, against the reference, through both vertex forms. */
+/* Four vertices in every cyclic order, against the reference, through both vertex forms.
+ * The vertices are made exact integers once; each order's determinant is computed anew. */
 static void check_four_vertices(const double *const q[4], long *zeros)
 {
+    ref_point x[4];
+    for (int i = 0; i < 4; i++) {
+        ref_point_init(&x[i]);
+        ref_point_set_d(&x[i], q[i]);
+    }
     for (int r = 0; r < 4; r++) {
-        const double *a = q[r], *b = q[(r + 1) % 4], *c = q[(r + 2) % 4], *d = q[(r + 3) % 4];
-        int ref = ref_orient3d_doubles(a, b, c, d);
+        int i = (r + 1) % 4, j = (r + 2) % 4, k = (r + 3) % 4;
+        const double *a = q[r], *b = q[i], *c = q[j], *d = q[k];
+        int ref = ref_orient3d_points(&x[r], &x[i], &x[j], &x[k]);
         mci_plane plane;
         mci_plane_init(&plane, a, b, c);
         CHECK_MSG(mci_orient3d_vertices(a, b, c, d) == ref, "mci_orient3d_vertices: ref %d",
@@ -2069,6 +1031,8 @@ static void check_four_vertices(const double *const q[4], long *zeros)
         CHECK_MSG(mci_orient3d_vertex(d, &plane) == ref, "mci_orient3d_vertex: ref %d", ref);
         *zeros += ref == 0;
     }
+    for (int i = 0; i < 4; i++)
+        ref_point_clear(&x[i]);
 }
 
 /* The shapes the coordinate rule and the double-word stage of orient3d of vertices are
