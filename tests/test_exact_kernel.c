@@ -39,13 +39,6 @@
 #include <string.h>
 #include <time.h>
 
-#define MAXV        48
-#define MAXPL       16
-#define MAXPT       28
-#define MAXLP       6 /* lines where two planes meet (order_on_plane_line) */
-#define MAXLE       4 /* edge lines (order_on_edge_line) */
-#define MAXLINES    (MAXLP + MAXLE)
-#define MAX_CLASSES 40
 #define MAX_PRINTED 12     /* mismatches printed in full; all are counted */
 #define NONE        (-100) /* no such stage in a result triple; no reference result */
 
