@@ -135,8 +135,59 @@ def drill_plate(ms, n, radius=0.3, segments=24):
 
 
 # Exact volumes and shells of the generated scenes that reference.tsv does not list.
+def menger_sponge(level, digits=None):
+    """OpenSCAD's example024 (a Menger sponge of side 100 at `level`, turned to stand on a
+    corner, its lower half cut away) as the CSG text OpenSCAD's .csg export writes:
+    numbers with `digits` significant digits (6: the export, where faces meant to be
+    coplanar are ~1e-5 apart), or every double exactly (None)."""
+    fmt = (lambda x: '%.*g' % (digits, x)) if digits else (lambda x: repr(float(x)))
+    side = 100.0
+    a, b = math.radians(45), math.atan(1 / math.sqrt(2))
+    rot = [[math.cos(b), math.sin(b) * math.sin(a), math.sin(b) * math.cos(a)],
+           [0.0, math.cos(a), -math.sin(a)],
+           [-math.sin(b), math.cos(b) * math.sin(a), math.cos(b) * math.cos(a)]]
+    turns = [[[1, 0, 0], [0, 1, 0], [0, 0, 1]],   # rotate([0, 0, 0]), [0, 0, 90], [0, 90, 0]
+             [[0, -1, 0], [1, 0, 0], [0, 0, 1]],
+             [[0, 0, 1], [0, 1, 0], [-1, 0, 0]]]
+    out = []
+
+    def matrix(m, t=(0, 0, 0)):
+        rows = ['[%s, %s, %s, %s]' % (fmt(m[i][0]), fmt(m[i][1]), fmt(m[i][2]), fmt(t[i]))
+                for i in range(3)]
+        return 'multmatrix([%s, [0, 0, 0, 1]])' % ', '.join(rows)
+
+    def negative(size, level_left, indent):
+        l = size / 3
+        out.append('%scube(size = [%s, %s, %s], center = true);' % (
+            indent, fmt(side * 1.1), fmt(l), fmt(l)))
+        if level_left > 1:
+            for i in (-1, 0, 1):
+                for j in (-1, 0, 1):
+                    if i or j:
+                        out.append('%s%s {' % (indent, matrix(turns[0], (0, i * l, j * l))))
+                        negative(l, level_left - 1, indent + '  ')
+                        out.append('%s}' % indent)
+
+    out.append('difference() {')
+    out.append('  %s {' % matrix(rot))
+    out.append('    difference() {')
+    out.append('      cube(size = [%s, %s, %s], center = true);' % ((fmt(side),) * 3))
+    for t in turns:
+        out.append('      %s {' % matrix(t))
+        negative(side, level, '        ')
+        out.append('      }')
+    out.append('    }')
+    out.append('  }')
+    out.append('  translate([0, 0, %s]) cube(size = [%s, %s, %s], center = true);' % (
+        fmt(-side), fmt(2 * side), fmt(2 * side), fmt(2 * side)))
+    out.append('}')
+    return '\n'.join(out) + '\n'
+
+
 def analytic_references():
     ref = {}
+    for n in (2, 3, 4):  # half a Menger sponge of side 100; one shell
+        ref['menger_%d_exact' % n] = (0.5 * 100.0 ** 3 * (20 / 27) ** n, 1)
     for n in (32, 64):
         ref['box_grid_%d' % n] = (0.875 * n * n, 1)  # plate - holes (n^2 / 4) + bars (n^2 / 8)
         hole = 0.5 * 24 * 0.3 ** 2 * math.sin(2 * math.pi / 24)
@@ -170,6 +221,11 @@ def scene_builders(ms, models):
                  'bunny_and_bunny_same'):
         out.append((name, lambda name=name: from_models(name), 'model'))
     out.append(('spheres_overlap_700', spheres_overlap, '700 x 320 faces'))
+    for n in (2, 3, 4):
+        out.append(('menger_%d_6digits' % n, lambda n=n: menger_sponge(n, 6),
+                    'OpenSCAD example024 export, level %d' % n))
+        out.append(('menger_%d_exact' % n, lambda n=n: menger_sponge(n),
+                    'the same, exact numbers'))
     for faces in ('25k', '50k'):
         out.append(('bunny%s_minus_shifted' % faces,
                     lambda f=faces: model_minus_shifted(ms, models, 'bunny%s.obj' % f),
@@ -187,8 +243,12 @@ def ensure_scene(ms, cache, name, build):
     if os.path.exists(stamp) and open(stamp).read() == GENERATOR_VERSION:
         return d
     sys.stderr.write('generating %s\n' % name)
-    meshes, tree = build()
-    ms.emit(cache, name, meshes, tree)
+    built = build()
+    if isinstance(built, str):  # a CSG text of primitives: no leaf files
+        os.makedirs(d, exist_ok=True)
+        open(os.path.join(d, 'tree.scad'), 'w').write(built)
+    else:
+        ms.emit(cache, name, *built)
     open(stamp, 'w').write(GENERATOR_VERSION)
     return d
 

@@ -8,6 +8,7 @@
 #include "testlib.h"
 
 #include <float.h>
+#include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -244,6 +245,77 @@ TEST(models_minus_nearly_identical_copies)
     }
 }
 
+/* OpenSCAD's example024 (a Menger sponge of side 100, turned onto a corner, its lower half
+ * cut away) as its .csg export writes it, with six significant digits: faces meant to be
+ * coplanar are some 1e-5 apart, and the rotation's rounding makes them meet at angles
+ * near 1e-16, so their crossing points are nearly parallel planes' (wide certified boxes,
+ * which the kernel tightens exactly once). The exact volume of the text as written:
+ * the sponge's boxes in rationals (coordinate compression), times |det| of the rounded
+ * rotation, halved by central symmetry; OpenSCAD's own render is 1.8e-6 off it. */
+typedef struct text_buf {
+    char *s;
+    size_t len, cap;
+} text_buf;
+
+static void append(text_buf *b, const char *fmt, ...)
+{
+    va_list ap;
+    int n;
+    va_start(ap, fmt);
+    n = vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
+    va_end(ap);
+    if (n > 0 && (size_t)n < b->cap - b->len)
+        b->len += (size_t)n;
+    else
+        b->len = b->cap; /* full: the test below then fails to parse */
+}
+
+static void menger_negative(text_buf *b, double size, int level)
+{
+    double l = size / 3;
+    append(b, "cube(size = [%.6g, %.6g, %.6g], center = true);\n", 110.0, l, l);
+    for (int i = -1; level > 1 && i <= 1; i++)
+        for (int j = -1; j <= 1; j++) {
+            if (!i && !j)
+                continue;
+            append(b, "multmatrix([[1, 0, 0, 0], [0, 1, 0, %.6g], [0, 0, 1, %.6g], "
+                      "[0, 0, 0, 1]]) {\n", i * l, j * l);
+            menger_negative(b, l, level - 1);
+            append(b, "}\n");
+        }
+}
+
+TEST(menger_sponge_with_six_digit_numbers)
+{
+    static const char *const turns[] = {
+        "[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]",
+        "[[0, -1, 0, 0], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]",
+        "[[0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]]"};
+    text_buf b = {malloc(64 * 1024), 0, 64 * 1024};
+    outcome o;
+    double expected = 274348.7704270973;
+    if (!b.s)
+        return;
+    append(&b, "difference() {\nmultmatrix([[0.816497, 0.408248, 0.408248, 0], [0, 0.707107, "
+               "-0.707107, 0], [-0.57735, 0.57735, 0.57735, 0], [0, 0, 0, 1]]) difference() {"
+               "\ncube(size = [100, 100, 100], center = true);\n");
+    for (int t = 0; t < 3; t++) {
+        append(&b, "multmatrix(%s) {\n", turns[t]);
+        menger_negative(&b, 100, 2);
+        append(&b, "}\n");
+    }
+    append(&b, "}\ntranslate([0, 0, -100]) cube(size = [200, 200, 200], center = true);\n}\n");
+    CHECK(b.len < b.cap);
+    /* Parts of the result touch along an edge once rounded (not yet separated). */
+    if (solid(b.s, true, &o)) {
+        CHECK_MSG(fabs(o.volume - expected) <= 1e-12 * expected, "volume %.17g, expected %.17g",
+                  o.volume, expected);
+        CHECK_EQ_SIZE(o.report.components, 1);
+        mcsg_mesh_free(&o.mesh, NULL);
+    }
+    free(b.s);
+}
+
 int main(void)
 {
     RUN(coplanar_faces_stacked_and_offset);
@@ -254,6 +326,7 @@ int main(void)
     RUN(scales_and_far_from_the_origin);
     RUN(union_of_hundreds_of_overlapping_spheres);
     RUN(models_minus_nearly_identical_copies);
+    RUN(menger_sponge_with_six_digit_numbers);
     printf("outputs self-intersecting after rounding to doubles: %d of %d\n",
            self_intersecting_outputs, outputs);
     return test_summary();

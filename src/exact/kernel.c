@@ -23,6 +23,7 @@
 #include "exact/kernel.h"
 #include "exact/big.h"
 
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <string.h>
@@ -297,6 +298,37 @@ static void compute_bounds(const mci_point *p, double lo[3], double hi[3])
     }
 }
 
+/* A point of nearly parallel planes has a W that is tiny against its error bound, so
+ * its box is wide: every predicate on it would go to the exact stage, and every box test
+ * against it (sweeps, the point numbering) would pass. Its correctly rounded coordinates
+ * are computed once instead, exactly, and bound it within a unit in the last place each.
+ * "Wide" only chooses the cheaper path; both boxes are certified. */
+#define WIDE_BOX_RELATIVE 0x1p-26
+
+static void tighten_wide_box(mci_point *p)
+{
+    double rounded[3], largest = 0, r = 0;
+    for (int k = 0; k < 3; k++)
+        if (!((p->exact_axes >> k) & 1))
+            largest = mci_max(largest, fabs(p->c[k]));
+    if (!(p->r > largest * WIDE_BOX_RELATIVE))
+        return;
+    mci_point_round(p, rounded);
+    for (int k = 0; k < 3; k++) {
+        if ((p->exact_axes >> k) & 1)
+            continue;
+        if (!isfinite(rounded[k]) || fabs(rounded[k]) == DBL_MAX)
+            return; /* beyond the double range: keep the wide box */
+        /* the exact coordinate is within half the gap on its side of the rounded one */
+        r = mci_max(r, mci_max(mci_next_up(rounded[k]) - rounded[k],
+                               rounded[k] - mci_next_down(rounded[k])));
+    }
+    for (int k = 0; k < 3; k++)
+        if (!((p->exact_axes >> k) & 1))
+            p->c[k] = rounded[k];
+    p->r = r;
+}
+
 /* The cached box of a constructed point (see mci_point): centre and radius from the
  * certified bounds (infinite radius when they are), then the coordinates the definition
  * fixes exactly. */
@@ -316,6 +348,7 @@ static void set_box(mci_point *p, const double exact[3], unsigned exact_axes)
     for (int k = 0; k < 3; k++)
         if ((exact_axes >> k) & 1)
             p->c[k] = exact[k];
+    tighten_wide_box(p);
 }
 
 /* Axis k if the plane's three vertices share coordinate k (the plane is x_k = const),
