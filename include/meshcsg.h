@@ -123,6 +123,9 @@ typedef struct mcsg_options {
                                      self-intersections before evaluating (exact, costs
                                      about as much as an evaluation) and names the first
                                      such leaf with MCSG_ERR_INVALID_MESH */
+    int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
+                                   triangles that cross each other (exact, costs about as
+                                   much as an evaluation; see mcsg_output_check) */
     mcsg_pool *pool;          /* NULL: each call starts its own workers. Else the calls
                                  made with these options use this pool's workers (all
                                  of them, whenever threads is not 1; worth it for many
@@ -463,6 +466,29 @@ typedef struct mcsg_provenance {
     uint32_t face;
 } mcsg_provenance;
 
+/* What mcsg_eval found when it checked its result against the guarantees of
+ * docs/robustness.md. Every count is 0 when the result keeps them; the touching edges
+ * are allowed (the exact result itself touches there). */
+typedef struct mcsg_output_check {
+    size_t open_edges;           /* edges of one triangle (welded by coordinates) */
+    size_t misoriented_edges;    /* edges whose triangles face opposite ways */
+    size_t degenerate_triangles; /* triangles of zero area */
+    size_t index_nonmanifold_edges; /* vertex-index edges not used exactly once in each
+                                       direction (parts that touch have vertex copies) */
+    size_t welded_nonmanifold_edges; /* once vertices are welded by coordinates (as STL
+                                        readers, slicers and mesh libraries do), edges of
+                                        more than two triangles where the exact result
+                                        does not touch itself: rounding made them */
+    size_t touching_edges;       /* the same where the exact result touches itself (two
+                                    parts sharing an edge): allowed, not a failure */
+    size_t crossing_pairs;       /* pairs of triangles that cross each other, when
+                                    mcsg_options.check_output_crossings asked; else 0 */
+    int crossings_checked;       /* whether crossing_pairs was computed */
+} mcsg_output_check;
+
+/* Nonzero when the check found a broken guarantee (anything but touching edges). */
+int mcsg_output_check_failed(const mcsg_output_check *check);
+
 typedef struct mcsg_eval_stats {
     size_t primitives;        /* leaves with at least one triangle that the root reaches */
     size_t faces;             /* their triangles in total ... */
@@ -493,6 +519,8 @@ typedef struct mcsg_eval_stats {
     size_t touching_vertices_split;  /* vertex copies added where parts of the result
                                         touch along an edge or at a point, so that the
                                         output is edge- and vertex-manifold */
+    mcsg_output_check output_check; /* the result against its guarantees; a failure is
+                                       also logged as a warning */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */
@@ -517,6 +545,10 @@ typedef struct mcsg_eval_stats {
  * self-intersecting leaf the result is unspecified (a mesh that may not be the intended
  * set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal consistency check
  * trips on it (see docs/robustness.md).
+ * The result is checked before it is returned (stats->output_check): rounding to doubles
+ * can break a guarantee where the exact result has features below the spacing of
+ * doubles. Such a result is still returned with MCSG_OK (it is the best the rounding
+ * gives), the failure is logged as a warning, and mcsg_output_check_failed tells it.
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,

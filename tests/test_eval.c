@@ -741,6 +741,71 @@ TEST(intersect_reports_progress_and_can_cancel)
     mcsg_tree_free(tree);
 }
 
+/* The result's check (stats.output_check) agrees with independent checks of the output:
+ * mcsg_mesh_check (vertices welded by coordinates), the index-manifold test of testlib,
+ * and mcsg_mesh_self_intersections. Cases: results that rounding to doubles broke
+ * (tests/data/rounding: an edge of four triangles even by index; crossing triangles;
+ * OpenSCAD's example018 moved off the origin), cubes touching along an edge (allowed:
+ * the exact result touches itself there), and a clean result. Whatever the rounding
+ * does to these cases, the report must tell it: never a silent success. */
+static void check_output_report(const char *path, const char *text, int expect)
+{
+    mcsg_options opts = {0};
+    mcsg_tree *tree = NULL;
+    mcsg_mesh out;
+    mcsg_eval_stats st;
+    mcsg_check_report r;
+    mcsg_error err;
+    size_t pairs = 0;
+    const mcsg_output_check *c = &st.output_check;
+    opts.check_output_crossings = 1;
+    CHECK_OK(path ? mcsg_scad_read(test_data(path), NULL, &tree, &err)
+                  : mcsg_scad_read_memory(text, strlen(text), "case", NULL, NULL, &tree, &err),
+             &err);
+    if (!tree)
+        return;
+    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
+    CHECK_OK(mcsg_mesh_self_intersections(&out, NULL, &pairs, NULL, &err), &err);
+    CHECK_MSG(r.nonmanifold_edges == c->welded_nonmanifold_edges + c->touching_edges &&
+                  r.boundary_edges == c->open_edges &&
+                  r.inconsistent_edges == c->misoriented_edges &&
+                  r.degenerate_triangles == c->degenerate_triangles,
+              "%s: check %zu/%zu/%zu/%zu, report %zu+%zu/%zu/%zu/%zu", path ? path : text,
+              r.nonmanifold_edges, r.boundary_edges, r.inconsistent_edges,
+              r.degenerate_triangles, c->welded_nonmanifold_edges, c->touching_edges,
+              c->open_edges, c->misoriented_edges, c->degenerate_triangles);
+    CHECK(c->crossings_checked && c->crossing_pairs == pairs);
+    /* testlib's count includes vertices whose triangles are not one umbrella */
+    CHECK(c->index_nonmanifold_edges == 0 || test_index_manifold_defects(&out) > 0);
+    CHECK(!(r.nonmanifold_edges > c->touching_edges || pairs > 0) ||
+          mcsg_output_check_failed(c));
+    CHECK_MSG(expect < 0 || mcsg_output_check_failed(c) == expect, "%s: failed %d",
+              path ? path : text, mcsg_output_check_failed(c));
+    mcsg_mesh_free(&out, NULL);
+    mcsg_tree_free(tree);
+}
+
+TEST(output_check_tells_what_rounding_broke)
+{
+    check_output_report("rounding/nonmanifold-by-index-5-boxes/tree.scad", NULL, -1);
+    check_output_report("rounding/crossing-after-rounding-3-cubes/tree.scad", NULL, -1);
+    check_output_report("rounding/example018-moved.scad", NULL, -1);
+    check_output_report(NULL, "union() { cube(1); translate([1, 1, 0]) cube(1); }", 0);
+    check_output_report(NULL, "difference() { cube(2); translate([1, 1, 1]) sphere(1); }", 0);
+    {
+        mcsg_tree *tree = parse("union() { cube(1); translate([1, 1, 0]) cube(1); }");
+        mcsg_mesh out;
+        mcsg_eval_stats st;
+        mcsg_error err;
+        if (tree && mcsg_eval(tree, NULL, &out, NULL, &st, &err) == MCSG_OK) {
+            CHECK(st.output_check.touching_edges == 1 && !st.output_check.crossings_checked);
+            mcsg_mesh_free(&out, NULL);
+        }
+        mcsg_tree_free(tree);
+    }
+}
+
 /* A cube with one change: a triangle dropped, flipped, repeated, or a vertex moved. */
 static const double contract_cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
                                          0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
@@ -856,6 +921,7 @@ int main(void)
     RUN(allocation_failures_leak_nothing);
     RUN(progress_reports_steps_and_can_cancel);
     RUN(intersect_reports_progress_and_can_cancel);
+    RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
     return test_summary();
 }

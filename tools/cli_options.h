@@ -16,6 +16,7 @@
 
 #define CLI_EXIT_PROBLEM 1
 #define CLI_EXIT_USAGE 2
+#define CLI_EXIT_BROKEN_GUARANTEE 3 /* eval: the result was written but breaks a guarantee */
 
 typedef enum cli_kind {
     CLI_FLAG,   /* no value: sets an int to 1 */
@@ -37,7 +38,7 @@ typedef struct cli_option {
 typedef struct cli_values {
     const char *output;
     const char *format;
-    int self_intersections, stats, check_inputs;
+    int self_intersections, stats, check_inputs, check_crossings;
     long threads, spheres;
 } cli_values;
 

@@ -50,6 +50,7 @@ void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts)
         ctx->progress = opts->progress;
         ctx->progress_user = opts->progress_user;
         ctx->check_self_intersections = opts->check_self_intersections;
+        ctx->check_output_crossings = opts->check_output_crossings;
         ctx->pool = opts->pool;
     }
 }

@@ -45,6 +45,7 @@ typedef struct mci_ctx {
     mcsg_progress_fn progress;
     void *progress_user;
     int check_self_intersections;
+    int check_output_crossings;
     mci_pool *pool; /* worker threads: the options' (borrowed) or the call's own */
     bool owns_pool; /* started by mci_pool_start, stopped by mci_pool_stop */
 } mci_ctx;

@@ -38,6 +38,7 @@
  *                             mci_split_flat_triangles    rounding_repair.c  -
  *     touching parts          mci_split_touching          manifold_split.c   -
  *     void shells             mci_drop_void_shells        void_shells.c      -
+ *     guarantees checked      mci_check_output            output_check.c     -
  *
  * Glossary.
  *   leaf        a mesh of the CSG tree (mcsg_tree), as the user gave it.
@@ -70,6 +71,7 @@
 #include "csg/classify.h"
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
+#include "csg/output_check.h"
 #include "csg/rounding_repair.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
@@ -455,6 +457,17 @@ static mcsg_status drop_void_shells(eval_state *e, mcsg_mesh *out, uint32_t *kep
     return MCSG_OK;
 }
 
+/* The result against its guarantees, as the next program sees it (output_check.h). */
+static mcsg_status check_output(eval_state *e, const mcsg_mesh *out, const rounded *r,
+                                mcsg_error *err)
+{
+    mci_exact_result exact = {e->kept.tris, e->kept.count, r->dense, r->xyz};
+    mcsg_status st = mci_check_output(&e->ctx, out, &exact, &e->stats.output_check, err);
+    if (st == MCSG_OK)
+        mci_log_output_check(&e->ctx, &e->stats.output_check);
+    return st;
+}
+
 static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size_t n,
                                    mcsg_provenance **provenance, mcsg_error *err)
 {
@@ -489,6 +502,8 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
         st = split_touching(e, out, err);
     if (st == MCSG_OK)
         st = drop_void_shells(e, out, kept_tri, err);
+    if (st == MCSG_OK)
+        st = check_output(e, out, &r, err);
     if (st == MCSG_OK && provenance)
         st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
     if (st != MCSG_OK)

@@ -1,0 +1,32 @@
+/*
+ * The check of mcsg_eval's result against the guarantees of docs/robustness.md
+ * (csg/output_check.c), on the mesh as the next program sees it: with its vertex indices,
+ * and with its vertices welded by coordinates (STL has no indices; slicers, viewers and
+ * mesh libraries weld).
+ */
+#ifndef MESHCSG_CSG_OUTPUT_CHECK_H
+#define MESHCSG_CSG_OUTPUT_CHECK_H
+
+#include "base/core.h"
+
+/* The exact result before rounding: its triangles by exact vertex id, and where each id's
+ * rounded coordinates are (xyz + 3 * dense[id]). Read only where the welded mesh has an
+ * edge of more than two triangles, to tell whether the exact result touches itself
+ * there. */
+typedef struct mci_exact_result {
+    const uint32_t *tris;
+    size_t count;
+    const uint32_t *dense;
+    const double *xyz;
+} mci_exact_result;
+
+/* Fills *check for mesh m (see mcsg_output_check); crossings only when
+ * ctx->check_output_crossings. Fails only when out of memory. */
+mcsg_status mci_check_output(const mci_ctx *ctx, const mcsg_mesh *m,
+                             const mci_exact_result *exact, mcsg_output_check *check,
+                             mcsg_error *err);
+
+/* One warning line naming what the check found broken, if anything. */
+void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *check);
+
+#endif
