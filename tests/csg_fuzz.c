@@ -286,9 +286,120 @@ static void tilted_leaf(uint64_t *rng, csg_leaf_spec *l, int family_choice)
                                   r[3 * row + 2] * m[8 + col];
 }
 
+/* x with six significant digits, as OpenSCAD's .csg export writes it. */
+static double six_digits(double x)
+{
+    char text[32];
+    snprintf(text, sizeof text, "%.6g", x);
+    return strtod(text, NULL);
+}
+
+/* The placement shared by an export tree's leaves: a turn about the z axis and then the x
+ * axis by multiples of 15 degrees (45 often), and an offset far from the origin. */
+typedef struct export_frame {
+    double r[9], offset[3];
+    int style; /* 0: Menger-like boxes, 1: turned cubes, 2: a drilled plate */
+} export_frame;
+
+static void export_frame_init(uint64_t *rng, export_frame *f)
+{
+    static const double far[][3] = {{0, 0, 0}, {150, 150, 0}, {1000, -2000, 500}};
+    double a = PI / 12 * test_random_int(rng, 0, 23), b = PI / 4 * test_random_int(rng, 0, 3);
+    double ca = cos(a), sa = sin(a), cb = cos(b), sb = sin(b);
+    double rz[9] = {ca, -sa, 0, sa, ca, 0, 0, 0, 1};
+    for (int i = 0; i < 3; i++) { /* rx(b) * rz(a) */
+        f->r[i] = rz[i];
+        f->r[3 + i] = cb * rz[3 + i] - sb * rz[6 + i];
+        f->r[6 + i] = sb * rz[3 + i] + cb * rz[6 + i];
+    }
+    memcpy(f->offset, far[test_random_int(rng, 0, 2)], sizeof f->offset);
+    f->style = test_random_int(rng, 0, 2);
+}
+
+/* A local placement (rotation `turn`, translation t) composed with the frame, every entry
+ * written with six digits. */
+static void export_place(const export_frame *f, const double turn[9], const double t[3],
+                         double m[12])
+{
+    for (int row = 0; row < 3; row++) {
+        double moved = f->offset[row];
+        for (int col = 0; col < 3; col++) {
+            double e = 0;
+            for (int k = 0; k < 3; k++)
+                e += f->r[3 * row + k] * turn[3 * k + col];
+            m[4 * row + col] = six_digits(e);
+            moved += f->r[3 * row + col] * t[col];
+        }
+        m[4 * row + 3] = six_digits(moved);
+    }
+}
+
+/* Leaves come in groups of EXPORT_GROUP around one centre, the groups side by side on a
+ * grid, overlapping their neighbours: a group is one feature of a part (a sponge, a star
+ * of turned cubes, a drilled plate). One group of 65 concentric turned cubes makes an
+ * arrangement of 2 million pieces; parts are not built like that. */
+#define EXPORT_GROUP 6
+
+static void export_group_centre(const export_frame *f, int leaf, double t[3])
+{
+    static const double spacing[] = {110, 40, 100};
+    int group = leaf / EXPORT_GROUP;
+    t[0] = spacing[f->style] * (group % 4);
+    t[1] = spacing[f->style] * (group / 4);
+    t[2] = 0;
+}
+
+static void export_leaf(uint64_t *rng, const export_frame *f, int index, csg_leaf_spec *l)
+{
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    double turn[9], t[3] = {0, 0, 0}, centre[3], side = 100.0 / 3;
+    memcpy(turn, identity, sizeof turn);
+    memset(l, 0, sizeof *l);
+    l->shape = CSG_CUBE;
+    l->center = 1;
+    if (f->style == 0) { /* a beam of a Menger sponge's level 1 to 3, along some axis */
+        int level = test_random_int(rng, 1, 3), axis = test_random_int(rng, 0, 2);
+        double l3 = 100.0;
+        for (int k = 0; k < level; k++)
+            l3 /= 3;
+        for (int k = 0; k < 3; k++)
+            l->size[k] = six_digits(k == axis ? 110.0 : l3);
+        for (int k = 0; k < 3; k++)
+            if (k != axis)
+                t[k] = six_digits(l3 * 3 * test_random_int(rng, -1, 1) +
+                                  (level > 1 ? side * test_random_int(rng, -1, 1) : 0));
+        if (test_random_int(rng, 0, 5) == 0) /* the sponge's cube itself */
+            l->size[0] = l->size[1] = l->size[2] = 100, t[0] = t[1] = t[2] = 0;
+    } else if (f->style == 1) { /* cubes turned about one axis by 15k degrees */
+        double a = PI / 12 * test_random_int(rng, 0, 11), c = cos(a), s = sin(a);
+        int axis = test_random_int(rng, 0, 2), i = (axis + 1) % 3, j = (axis + 2) % 3;
+        turn[3 * i + i] = c, turn[3 * i + j] = -s, turn[3 * j + i] = s, turn[3 * j + j] = c;
+        for (int k = 0; k < 3; k++)
+            l->size[k] = six_digits(test_random_int(rng, 0, 1) ? 50.0 : 45.0);
+    } else { /* a plate, or a cylinder drilled through it */
+        if (test_random_int(rng, 0, 4) == 0) {
+            l->size[0] = l->size[1] = 100, l->size[2] = 10;
+        } else {
+            l->shape = CSG_CYLINDER;
+            l->h = 30;
+            l->r1 = l->r2 = six_digits(side / test_random_int(rng, 3, 9));
+            l->fn = test_random_int(rng, 6, 24);
+            t[0] = six_digits(side * test_random_int(rng, -1, 1) / test_random_int(rng, 1, 3));
+            t[1] = six_digits(side * test_random_int(rng, -1, 1) / test_random_int(rng, 1, 3));
+        }
+    }
+    export_group_centre(f, index, centre);
+    for (int k = 0; k < 3; k++)
+        t[k] += centre[k];
+    export_place(f, turn, t, l->m);
+}
+
 static void random_leaves(csg_tree_spec *t, uint64_t *rng)
 {
     int model_leaf = -1, tilt = test_random_int(rng, 0, 1);
+    export_frame frame;
+    if (t->family == CSG_EXPORT)
+        export_frame_init(rng, &frame);
     if (t->family == CSG_FREE && models_loaded && test_random_int(rng, 0, 2) == 0)
         model_leaf = test_random_int(rng, 0, t->leaf_count - 1);
     for (int i = 0; i < t->leaf_count; i++) {
@@ -300,6 +411,8 @@ static void random_leaves(csg_tree_spec *t, uint64_t *rng)
             grid_leaf(rng, l);
         } else if (t->family == CSG_TILTED) {
             tilted_leaf(rng, l, tilt);
+        } else if (t->family == CSG_EXPORT) {
+            export_leaf(rng, &frame, i, l);
         } else if (i == model_leaf) {
             csg_free_leaf(rng, l);
             place_model(rng, l);
@@ -369,10 +482,13 @@ static void random_operations(csg_tree_spec *t, uint64_t *rng)
 void csg_random_tree(csg_tree_spec *t, uint64_t seed)
 {
     uint64_t rng = seed;
-    int family = test_random_int(&rng, 0, 5);
+    int family = test_random_int(&rng, 0, 7);
     memset(t, 0, sizeof *t);
     t->seed = seed;
-    t->family = family < 3 ? CSG_FREE : family < 5 ? CSG_GRID : CSG_TILTED;
+    t->family = family < 3   ? CSG_FREE
+                : family < 5 ? CSG_GRID
+                : family < 6 ? CSG_TILTED
+                             : CSG_EXPORT;
     /* 5..100 leaves, small trees more often than large ones (cost grows with size). */
     t->leaf_count = 5 + (int)((CSG_MAX_LEAVES - 5 + 1) * pow(uniform(&rng), 3.0));
     random_leaves(t, &rng);
@@ -483,7 +599,7 @@ static void print_node(FILE *f, const csg_tree_spec *t, int node, int depth)
     fputs("}\n", f);
 }
 
-static const char *const family_names[] = {"free", "grid", "tilted"};
+static const char *const family_names[CSG_FAMILIES] = {"free", "grid", "tilted", "export"};
 
 void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
 {
@@ -823,6 +939,49 @@ static bool check_provenance(const tree_facts *f, const mcsg_mesh *out,
 
 /* The output mesh on its own: valid (closed, oriented, manifold by index where it is
  * manifold by coordinates), touching only where allowed, not inverted, inside the box. */
+/* The result's own check (stats->output_check) against the independent ones: it must
+ * tell what mcsg_mesh_check (welded), the index test and the crossing test find. */
+static bool output_check_agrees(const mcsg_mesh *out, const mcsg_eval_stats *stats,
+                                const mcsg_check_report *report, size_t defects,
+                                csg_result *r)
+{
+    const mcsg_output_check *c = &stats->output_check;
+    if (report->nonmanifold_edges != c->welded_nonmanifold_edges + c->touching_edges ||
+        report->boundary_edges != c->open_edges ||
+        report->inconsistent_edges != c->misoriented_edges ||
+        report->degenerate_triangles != c->degenerate_triangles ||
+        (c->index_nonmanifold_edges > 0 && defects == 0))
+        return fail(r, "the result's check disagrees with mcsg_mesh_check: %zu+%zu "
+                    "non-manifold, %zu open, %zu misoriented edges, %zu degenerate "
+                    "triangles, %zu index edges reported; found %zu non-manifold, %zu "
+                    "boundary, %zu inconsistent, %zu degenerate, %zu index defects",
+                    c->welded_nonmanifold_edges, c->touching_edges, c->open_edges,
+                    c->misoriented_edges, c->degenerate_triangles, c->index_nonmanifold_edges,
+                    report->nonmanifold_edges, report->boundary_edges,
+                    report->inconsistent_edges, report->degenerate_triangles, defects);
+    if (csg_self_check && out->triangle_count > 0) {
+        size_t pairs = 0;
+        mcsg_error err;
+        if (mcsg_mesh_self_intersections(out, NULL, &pairs, NULL, &err) != MCSG_OK)
+            return fail(r, "mcsg_mesh_self_intersections: %s", err.message);
+        r->self_intersecting = pairs > 0;
+        if (!c->crossings_checked || c->crossing_pairs != pairs)
+            return fail(r, "the result's check reports %zu crossing pairs, the test finds %zu",
+                        c->crossing_pairs, pairs);
+    }
+    return true;
+}
+
+/* Whether rounding to doubles changed the result's combinatorics (vertices joined,
+ * triangles dropped or split): only then can it break a guarantee, and a broken
+ * guarantee that the result's check reports is accepted (snap rounding is to remove
+ * those); without rounding's doing, it is a bug. */
+static bool rounding_acted(const mcsg_eval_stats *stats)
+{
+    return stats->rounding_joined_vertices > 0 || stats->rounding_dropped_triangles > 0 ||
+           stats->rounding_split_triangles > 0 || stats->rounding_flat_triangles > 0;
+}
+
 static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
                        bool allow_touching, const box *scene, double scale, csg_result *r)
 {
@@ -835,6 +994,15 @@ static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
     if (mcsg_mesh_check(out, NULL, &report, &err) != MCSG_OK)
         return fail(r, "mcsg_mesh_check: %s", err.message);
     defects = test_index_manifold_defects(out);
+    if (!output_check_agrees(out, stats, &report, defects, r))
+        return false;
+    if (mcsg_output_check_failed(&stats->output_check) &&
+        stats->output_check.crossing_pairs == 0 && !rounding_acted(stats))
+        return fail(r, "the result breaks a guarantee although rounding changed nothing");
+    if (mcsg_output_check_failed(&stats->output_check) && !report.inverted) {
+        r->rounding_reported = true;
+        return true;
+    }
     /* Parts touching at a point or along an edge get their own vertex copies, so the
      * output must be manifold by index too. */
     if (defects > 0)
@@ -883,13 +1051,6 @@ static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
             return fail(r, "output reaches out of the leaves' box along axis %d: [%.17g, "
                         "%.17g] vs [%.17g, %.17g]", k, outbox.lo[k], outbox.hi[k],
                         scene->lo[k], scene->hi[k]);
-    if (csg_self_check && out->triangle_count > 0) {
-        size_t pairs = 0;
-        mcsg_status st = mcsg_mesh_self_intersections(out, NULL, &pairs, NULL, &err);
-        if (st != MCSG_OK)
-            return fail(r, "mcsg_mesh_self_intersections: %s", err.message);
-        r->self_intersecting = pairs > 0;
-    }
     return true;
 }
 
@@ -1019,7 +1180,11 @@ bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed
         if (scene.lo[k] <= scene.hi[k])
             scale = fmax(scale, fmax(fabs(scene.lo[k]), fabs(scene.hi[k])));
 
-    st = mcsg_eval(tree, NULL, &out, with_provenance ? &prov : NULL, &stats, &err);
+    {
+        mcsg_options opts = {0};
+        opts.check_output_crossings = csg_self_check;
+        st = mcsg_eval(tree, &opts, &out, with_provenance ? &prov : NULL, &stats, &err);
+    }
     if (st != MCSG_OK) {
         ok = fail(r, "mcsg_eval: %s: %s", mcsg_status_string(st), err.message);
     } else {

@@ -24,8 +24,13 @@ typedef enum csg_shape { CSG_CUBE, CSG_SPHERE, CSG_CYLINDER, CSG_MODEL } csg_sha
  * another's placement; grid: axis-aligned boxes, cylinders and spheres with small
  * integer coordinates (coplanar faces, shared edges and vertices everywhere); tilted:
  * grid leaves under exact integer similarity transforms, so that planes in general
- * directions are shared exactly. */
-typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED } csg_family;
+ * directions are shared exactly; export: trees as OpenSCAD's .csg export writes them,
+ * every size and matrix entry with six significant digits (Menger-like grids of boxes,
+ * cubes turned by multiples of 15 and 45 degrees, plates drilled by cylinders), turned
+ * and moved far from the origin: faces meant to be coplanar are 1e-5 apart or tilted by
+ * 1e-16, features below the spacing of doubles. */
+typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED, CSG_EXPORT } csg_family;
+#define CSG_FAMILIES 4
 
 typedef struct csg_leaf_spec {
     csg_shape shape;
@@ -62,6 +67,9 @@ typedef struct csg_result {
     bool touching;              /* accepted edge-non-manifold output (shared edges) */
     bool rounding_artifacts;    /* closed and oriented, but flat triangles left by rounding */
     bool self_intersecting;     /* with csg_self_check: the rounded output intersects itself */
+    bool rounding_reported;     /* the result's check reported a guarantee broken by
+                                   rounding (accepted: what snap rounding will fix), and
+                                   agreed with the independent checks */
 } csg_result;
 
 /* When set, every output is also tested for self-intersections (counted, not failed:

@@ -55,7 +55,8 @@ int main(int argc, char **argv)
         csg_free_models();
         return 0;
     }
-    long trees = 0, failures = 0, leaves = 0, self_intersecting[3] = {0}, families[3] = {0};
+    long trees = 0, failures = 0, leaves = 0, reported = 0;
+    long self_intersecting[CSG_FAMILIES] = {0}, families[CSG_FAMILIES] = {0};
     if (!csg_load_models())
         fprintf(stderr, "fuzz_csg: models of tests/data/models missing (set MCSG_TEST_DATA to tests/data): "
                 "free trees use primitives only\n");
@@ -73,6 +74,7 @@ int main(int argc, char **argv)
         leaves += t.leaf_count;
         if (csg_run_case(&t, NULL, with_provenance, &r)) {
             self_intersecting[t.family] += r.self_intersecting;
+            reported += r.rounding_reported;
             continue;
         }
         failures++;
@@ -80,10 +82,12 @@ int main(int argc, char **argv)
         save_case(dir, &t, with_provenance);
         fflush(stdout);
     }
-    printf("fuzz_csg: %ld trees (%ld free, %ld grid, %ld tilted; %ld leaves) in %.0f s, %ld "
-           "failed; outputs that intersect themselves: %ld free, %ld grid, %ld tilted\n", trees,
-           families[0], families[1], families[2], leaves, csg_now() - start, failures,
-           self_intersecting[0], self_intersecting[1], self_intersecting[2]);
+    printf("fuzz_csg: %ld trees (%ld free, %ld grid, %ld tilted, %ld export; %ld leaves) in "
+           "%.0f s, %ld failed; outputs that intersect themselves: %ld free, %ld grid, %ld "
+           "tilted, %ld export; %ld reported broken by rounding\n", trees, families[0],
+           families[1], families[2], families[3], leaves, csg_now() - start, failures,
+           self_intersecting[0], self_intersecting[1], self_intersecting[2],
+           self_intersecting[3], reported);
     csg_free_models();
     return failures ? 1 : 0;
 }

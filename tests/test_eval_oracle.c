@@ -30,8 +30,8 @@ static double test_scale(void)
 }
 
 typedef struct totals {
-    int trees, failed, families[3], touching, rounded, self_intersecting, empty, max_leaves;
-    int self_by_family[3];
+    int trees, failed, families[CSG_FAMILIES], touching, rounded, self_intersecting, reported;
+    int empty, max_leaves, self_by_family[CSG_FAMILIES];
     size_t points, checked, inside, triangles, dropped;
     double eval_seconds, oracle_seconds;
 } totals;
@@ -43,6 +43,7 @@ static void add_result(totals *s, const csg_result *r)
     s->touching += r->touching;
     s->rounded += r->rounding_artifacts;
     s->self_intersecting += r->self_intersecting;
+    s->reported += r->rounding_reported;
     s->empty += r->triangles == 0;
     s->eval_seconds += r->eval_seconds;
     s->oracle_seconds += r->oracle_seconds;
@@ -52,15 +53,16 @@ static void print_totals(const char *what, const totals *s, double seconds, bool
 {
     printf("%s: %d trees", what, s->trees);
     if (generated)
-        printf(" (%d free, %d grid, %d tilted; up to %d leaves)", s->families[0],
-               s->families[1], s->families[2], s->max_leaves);
+        printf(" (%d free, %d grid, %d tilted, %d export; up to %d leaves)", s->families[0],
+               s->families[1], s->families[2], s->families[3], s->max_leaves);
     printf(", %d failed: %zu points, %zu checked (%zu inside); %d empty results, %d with "
            "edges where solids touch, %d with triangles flattened by rounding, %d "
            "intersecting themselves", s->failed, s->points, s->checked, s->inside, s->empty,
            s->touching, s->rounded, s->self_intersecting);
     if (generated)
-        printf(" (free %d, grid %d, tilted %d)", s->self_by_family[0], s->self_by_family[1],
-               s->self_by_family[2]);
+        printf(" (free %d, grid %d, tilted %d, export %d)", s->self_by_family[0],
+               s->self_by_family[1], s->self_by_family[2], s->self_by_family[3]);
+    printf(", %d reported broken by rounding", s->reported);
     printf("; %zu output triangles, %zu dropped by rounding; %.1f s (%.1f s in mcsg_eval, "
            "%.1f s in the oracle)\n", s->triangles, s->dropped, seconds, s->eval_seconds,
            s->oracle_seconds);
