@@ -25,7 +25,9 @@
  * MCSG_TEST_SCALE (default 1, 0.5 under the sanitizers) multiplies the number of
  * scenarios; MCSG_TEST_SEED sets the random seed. The tables at the end count the cases and the filter's decisions.
  */
+#include "base/parallel.h"
 #include "exact/big.h"
+#include "exact/exact_cache.h"
 #include "exact/kernel.h"
 #include "exact_reference.h"
 #include "exact_scenarios.h"
@@ -765,20 +767,54 @@ static bool class_selected(int cls)
     return !only || strstr(class_names[cls], only);
 }
 
-static void run_scenario(const scenario *s)
+static void run_queries(const scenario *s)
 {
-    int idx[MAXPT], n;
-    double t = seconds();
-    if (!class_selected(s->cls))
-        return;
-    build(s);
-    check_claims(s);
-    n = usable_points(s, idx);
+    int idx[MAXPT], n = usable_points(s, idx);
     build_lines(s, idx, n);
     queries_orient3d(s, idx, n);
     queries_pairs(s, idx, n);
     queries_orient2d(s, idx, n);
     queries_linedir(s);
+}
+
+/* Points kept by the threads' exact caches (exact/exact_cache.h) over the scenarios run
+ * inside a loop: the cached path was taken, not only allowed. */
+static long cached_points_seen;
+
+static mcsg_status run_queries_task(void *user, size_t index, mcsg_error *err)
+{
+    (void)index;
+    (void)err;
+    run_queries(user);
+    cached_points_seen += (long)mci_exact_cache_count();
+    return MCSG_OK;
+}
+
+/* Every other scenario runs its queries inside a one-thread loop, where the exact stage
+ * keeps points in the thread's cache and answers repeated queries from it: the same
+ * checks against the reference then hold for the cached path. */
+static void run_queries_in_loop(const scenario *s)
+{
+    mcsg_options opts = {0};
+    mci_ctx ctx;
+    mcsg_error err;
+    opts.threads = 1;
+    mci_ctx_init(&ctx, &opts);
+    CHECK(mci_parallel_for(&ctx, 1, run_queries_task, (void *)s, &err) == MCSG_OK);
+}
+
+static void run_scenario(const scenario *s)
+{
+    static long runs;
+    double t = seconds();
+    if (!class_selected(s->cls))
+        return;
+    build(s);
+    check_claims(s);
+    if (runs++ % 2)
+        run_queries_in_loop(s);
+    else
+        run_queries(s);
     class_scenarios[s->cls]++;
     class_seconds[s->cls] += seconds() - t;
 }
@@ -1135,6 +1171,8 @@ int main(void)
     print_predicate_table();
     /* The box filter's check was not vacuous: it decided some cases and left others. */
     CHECK(box_filter_decided > 0 && box_filter_decided < box_filter_cases);
+    printf("points kept by the exact cache: %ld\n", cached_points_seen);
+    CHECK(cached_points_seen > 0);
     ws_clear();
     return test_summary();
 }

@@ -27,6 +27,7 @@
 enum { CLAIM_BATCH = 16, SINGLE_CLAIMS = 256 };
 
 typedef struct loop {
+    mcsg_allocator alloc; /* for the threads' scratch (mci_thread_scratch) */
     mci_task_fn fn;
     void *user;
     const uint32_t *order; /* NULL: tasks in index order */
@@ -58,9 +59,60 @@ static void run_position(loop *l, size_t i)
     pthread_mutex_unlock(&l->lock);
 }
 
+/* ---------------------------------------------------------------------------------- */
+/* Thread scratch                                                                      */
+
+/* The scratch of the loop a thread runs tasks of; the outermost loop's when nested. */
+typedef struct scratch_scope {
+    const mcsg_allocator *alloc;
+    void *memory;
+    size_t size;
+} scratch_scope;
+
+static _Thread_local scratch_scope *current_scope;
+
+/* Enters s unless the thread is inside a loop already: false then (s is not used). */
+static bool scratch_enter(scratch_scope *s, const mcsg_allocator *alloc)
+{
+    if (current_scope)
+        return false;
+    s->alloc = alloc;
+    s->memory = NULL;
+    s->size = 0;
+    current_scope = s;
+    return true;
+}
+
+static void scratch_leave(scratch_scope *s, bool entered)
+{
+    if (!entered)
+        return;
+    if (s->memory)
+        s->alloc->free_fn(s->alloc->user, s->memory);
+    current_scope = NULL;
+}
+
+void *mci_thread_scratch(size_t size, bool *fresh)
+{
+    scratch_scope *s = current_scope;
+    *fresh = false;
+    if (!s || size == 0)
+        return NULL;
+    if (!s->memory) {
+        if (s->size != 0) /* an earlier allocation failed: do not retry on every call */
+            return NULL;
+        s->size = size;
+        s->memory = s->alloc->malloc_fn(s->alloc->user, size);
+        *fresh = s->memory != NULL;
+    }
+    return s->size == size ? s->memory : NULL;
+}
+
 static void *worker(void *arg)
 {
     loop *l = arg;
+    scratch_scope scope;
+    bool entered = scratch_enter(&scope, &l->alloc);
     for (;;) {
         size_t batch = atomic_load(&l->next) < SINGLE_CLAIMS ? 1 : CLAIM_BATCH;
         size_t first, end;
@@ -73,6 +125,7 @@ static void *worker(void *arg)
         for (size_t i = first; i < end; i++)
             run_position(l, i);
     }
+    scratch_leave(&scope, entered);
     return NULL;
 }
 
@@ -308,6 +361,18 @@ mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
     return mci_parallel_for(ctx, (n + chunk - 1) / chunk, range_task, &r, err);
 }
 
+static mcsg_status run_serially(const mci_ctx *ctx, size_t count, const uint32_t *order,
+                                mci_task_fn fn, void *user, mcsg_error *err)
+{
+    scratch_scope scope;
+    bool entered = scratch_enter(&scope, &ctx->alloc);
+    mcsg_status st = MCSG_OK;
+    for (size_t i = 0; i < count && st == MCSG_OK; i++)
+        st = fn(user, order ? order[i] : i, err);
+    scratch_leave(&scope, entered);
+    return st;
+}
+
 mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint32_t *order,
                                    mci_task_fn fn, void *user, mcsg_error *err)
 {
@@ -315,15 +380,10 @@ mcsg_status mci_parallel_for_order(const mci_ctx *ctx, size_t count, const uint3
     int wanted = mci_thread_count(ctx), started = 0;
     mci_pool *pool = ctx->pool;
     loop l;
-    if (wanted <= 1 || count <= 1 || (pool && atomic_exchange(&pool->in_use, true))) {
-        for (size_t i = 0; i < count; i++) {
-            mcsg_status st = fn(user, order ? order[i] : i, err);
-            if (st != MCSG_OK)
-                return st;
-        }
-        return MCSG_OK;
-    }
+    if (wanted <= 1 || count <= 1 || (pool && atomic_exchange(&pool->in_use, true)))
+        return run_serially(ctx, count, order, fn, user, err);
     memset(&l, 0, sizeof l);
+    l.alloc = ctx->alloc;
     l.fn = fn;
     l.user = user;
     l.order = order;

@@ -48,6 +48,14 @@ mcsg_status mci_parallel_for_heaviest_first(const mci_ctx *ctx, size_t count, mc
 typedef mcsg_status (*mci_range_fn)(void *user, size_t begin, size_t end, mcsg_error *err);
 mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
                                     mci_range_fn fn, void *user, mcsg_error *err);
+/* Memory that the calling thread keeps while it runs one loop's tasks (serial loops
+ * included): `size` uninitialised bytes from the loop's allocator, allocated at the
+ * thread's first call in the loop (*fresh is then true) and freed when it leaves the
+ * loop. NULL outside loops, when the allocation fails, or when size differs from the
+ * first call's in this loop. For caches that only save work (exact points: exact/
+ * exact_cache.c): a thread keeps its scratch through nested loops. */
+void *mci_thread_scratch(size_t size, bool *fresh);
+
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);
 

@@ -137,6 +137,41 @@ int mci_big_sign(const mci_big *a)
     return (a->size > 0) - (a->size < 0);
 }
 
+void mci_big_shift_left(mci_big *r, const mci_big *a, unsigned bits)
+{
+    int n = abs_size(a), words = (int)(bits / GMP_NUMB_BITS), negative = a->size < 0;
+    unsigned rest = bits % GMP_NUMB_BITS;
+    mp_limb_t out[MCI_BIG_LIMBS + 1];
+    if (n == 0) {
+        r->size = 0;
+        return;
+    }
+    memset(out, 0, (size_t)words * sizeof(mp_limb_t));
+    if (rest) {
+        out[words + n] = mpn_lshift(out + words, a->limb, n, rest);
+    } else {
+        memcpy(out + words, a->limb, (size_t)n * sizeof(mp_limb_t));
+        out[words + n] = 0;
+    }
+    big_assign(r, out, words + n + 1, negative);
+}
+
+int mci_big_export(const mci_big *a, mp_limb_t *out, int capacity)
+{
+    int n = abs_size(a);
+    if (n > capacity)
+        return INT_MIN;
+    memcpy(out, a->limb, (size_t)n * sizeof(mp_limb_t));
+    return a->size;
+}
+
+void mci_big_import(mci_big *r, const mp_limb_t *limbs, int size)
+{
+    int n = size < 0 ? -size : size;
+    memcpy(r->limb, limbs, (size_t)n * sizeof(mp_limb_t));
+    r->size = size;
+}
+
 /* Compare magnitudes: -1, 0 or +1. */
 static int compare_abs(const mci_big *a, const mci_big *b)
 {

@@ -44,6 +44,13 @@ void mci_big_add(mci_big *r, const mci_big *a, const mci_big *b);
 void mci_big_sub(mci_big *r, const mci_big *a, const mci_big *b);
 void mci_big_mul(mci_big *r, const mci_big *a, const mci_big *b);
 int mci_big_sign(const mci_big *a);
+/* *r = a * 2^bits, for a result within the capacity (r may alias a). */
+void mci_big_shift_left(mci_big *r, const mci_big *a, unsigned bits);
+/* a's limbs into out[0..capacity): its signed limb count, or INT_MIN when it needs more
+ * than `capacity` limbs (out is then unspecified). */
+int mci_big_export(const mci_big *a, mp_limb_t *out, int capacity);
+/* *r = the number that mci_big_export wrote as limbs[0..|size|) with size's sign. */
+void mci_big_import(mci_big *r, const mp_limb_t *limbs, int size);
 /* num / den * 2^exp2 rounded to the nearest double (ties to even), subnormal results
  * included; 0 if num = 0 or den = 0. Requires exp2 >= -1074 (the lsb exponent of a
  * double: the unit of mci_big_from_double's integers) and a result that does not

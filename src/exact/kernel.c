@@ -22,6 +22,7 @@
  */
 #include "exact/kernel.h"
 #include "exact/big.h"
+#include "exact/exact_cache.h"
 
 #include <float.h>
 #include <limits.h>
@@ -744,13 +745,122 @@ int mci_compare_coord_filtered(const mci_point *a, const mci_point *b, int axis)
     return fv_sign(fv_sub(fv_mul(xa[axis], b->w), fv_mul(b->y[axis], a->w)));
 }
 
+/* ---------------------------------------------------------------------------------- */
+/* Exact points from the thread's cache (exact/exact_cache.h)                          */
+
+static const double cache_origin[3] = {0, 0, 0};
+
+/* Entry e made to hold p, computing p's coordinates from the origin when it does not
+ * yet; false when a number does not fit an entry. */
+static bool fill_entry(mci_exact_point *e, const mci_point *p)
+{
+    const mci_point *points[1] = {p};
+    big_point e_big;
+    if (mci_exact_cache_holds(e, p))
+        return true;
+    e->e0 = scale_of(points, 1, NULL, 0).e0;
+    big_point_at(&e_big, p, cache_origin, e->e0, 7u); /* every coordinate */
+    for (int k = 0; k < 4; k++) {
+        const mci_big *n = k < 3 ? &e_big.x[k] : &e_big.w;
+        if ((e->size[k] = mci_big_export(n, e->limb[k], MCI_EXACT_LIMBS)) == INT_MIN) {
+            mci_exact_cache_clear(e);
+            return false;
+        }
+    }
+    mci_exact_cache_claim(e, p);
+    return true;
+}
+
+/* Entries holding points[0..n) (n <= 3), in distinct slots; false when the thread has
+ * no cache, two points share a slot, or a number is too large for an entry. */
+static bool cached_points(const mci_point *const *points, int n, mci_exact_point **out)
+{
+    for (int i = 0; i < n; i++) {
+        if (!(out[i] = mci_exact_cache_slot(points[i])))
+            return false;
+        for (int j = 0; j < i; j++)
+            if (out[j] == out[i])
+                return false;
+    }
+    for (int i = 0; i < n; i++)
+        if (!fill_entry(out[i], points[i]))
+            return false;
+    return true;
+}
+
+/* Number k of e (x[0..2], or w for k = 3) times 2^shift. */
+static void entry_number(mci_big *r, const mci_exact_point *e, int k, unsigned shift)
+{
+    mci_big_import(r, e->limb[k], e->size[k]);
+    if (shift)
+        mci_big_shift_left(r, r, shift);
+}
+
+static int entry_w_sign(const mci_exact_point *e)
+{
+    return (e->size[3] > 0) - (e->size[3] < 0);
+}
+
+/* sign(xa / wa 2^ea - xb / wb 2^eb) = sign(xa wb 2^(ea-m) - xb wa 2^(eb-m)) times the
+ * signs of wa and wb, m the smaller exponent. */
+static int cached_compare_coord(const mci_exact_point *a, const mci_exact_point *b, int axis)
+{
+    int m = a->e0 < b->e0 ? a->e0 : b->e0;
+    mci_big l, r, w;
+    entry_number(&l, a, axis, (unsigned)(a->e0 - m));
+    entry_number(&w, b, 3, 0);
+    mci_big_mul(&l, &l, &w);
+    entry_number(&r, b, axis, (unsigned)(b->e0 - m));
+    entry_number(&w, a, 3, 0);
+    mci_big_mul(&r, &r, &w);
+    mci_big_sub(&l, &l, &r);
+    return mci_big_sign(&l) * entry_w_sign(a) * entry_w_sign(b);
+}
+
+/* orient2d of the rows (x_i 2^e, x_j 2^e, w): the common factor 2^m of the first two
+ * columns (m the smallest exponent) leaves integer rows of the same sign, which is
+ * then the sign of the projected points' orientation times the signs of the w. */
+static int cached_orient2d(mci_exact_point *const e[3], int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3, m = e[0]->e0, sign = 1;
+    mci_big entries[3][3], det;
+    const mci_big *rows[3][3];
+    for (int k = 1; k < 3; k++)
+        m = e[k]->e0 < m ? e[k]->e0 : m;
+    for (int k = 0; k < 3; k++) {
+        unsigned shift = (unsigned)(e[k]->e0 - m);
+        entry_number(&entries[k][0], e[k], i, shift);
+        entry_number(&entries[k][1], e[k], j, shift);
+        entry_number(&entries[k][2], e[k], 3, 0);
+        for (int c = 0; c < 3; c++)
+            rows[k][c] = &entries[k][c];
+        sign *= entry_w_sign(e[k]);
+    }
+    big_det3(&det, rows);
+    return mci_big_sign(&det) * sign;
+}
+
+/* Whether the thread's cache holds all of points[0..n) already (nothing computed). */
+static bool all_cached(const mci_point *const *points, int n)
+{
+    for (int i = 0; i < n; i++) {
+        const mci_exact_point *e = mci_exact_cache_slot(points[i]);
+        if (!e || !mci_exact_cache_holds(e, points[i]))
+            return false;
+    }
+    return true;
+}
+
 int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
 {
     const mci_point *points[2] = {a, b};
+    mci_exact_point *e[2];
     input_scale s = scale_of(points, 2, NULL, 0);
     int da = x_degree(a) + w_degree(b), db = x_degree(b) + w_degree(a);
     if (fits_i128(s, da > db ? da : db))
         return i128_compare_coord(a, b, axis, s.e0);
+    if (cached_points(points, 2, e))
+        return cached_compare_coord(e[0], e[1], axis);
     return big_compare_coord(a, b, axis, s.e0);
 }
 
@@ -845,9 +955,12 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
                                  int axis)
 {
     const mci_point *points[3] = {p, q, r};
+    mci_exact_point *e[3];
     input_scale s = scale_of(points, 3, NULL, 0);
     if (fits_i128(s, x_degree(p) + x_degree(q) + x_degree(r)))
         return i128_orient2d(points, axis, s.e0);
+    if (cached_points(points, 3, e))
+        return cached_orient2d(e, axis);
     return big_orient2d(points, axis, s.e0);
 }
 
@@ -929,7 +1042,14 @@ static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const m
         if (fits_i128(sc, x_degree(p) + x_degree(q) + x_degree(r)))
             return i128_orient2d(points, axis, sc.e0);
     }
-    s = mci_orient2d_projected_dd(p, q, r, axis);
+    /* Points that needed the exact stage before are in the thread's cache: the exact
+     * stage on them costs less than the double-double one, which left them undecided
+     * once already (near-collinear points closer than the spacing of doubles). */
+    {
+        const mci_point *points[3] = {p, q, r};
+        if (!all_cached(points, 3))
+            s = mci_orient2d_projected_dd(p, q, r, axis);
+    }
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 
