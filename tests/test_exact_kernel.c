@@ -307,6 +307,33 @@ static bool point_bounds_ok(int i, bool print)
     return ok;
 }
 
+/* The double-word values the exact cache keeps (mci_point_dd_values) hold the exact
+ * coordinates: |x - (hi + lo)| <= e. */
+static long approx_points, approx_tight;
+
+static void check_point_approx(const scenario *s, int i)
+{
+    double approx[3][3];
+    mpq_t d, e;
+    if (!mci_point_dd_values(&ws.kpt[i], approx))
+        return;
+    approx_points++;
+    mpq_inits(d, e, NULL);
+    for (int k = 0; k < 3; k++) {
+        mpq_set_d(d, approx[k][0]);
+        mpq_set_d(e, approx[k][1]);
+        mpq_add(d, d, e);
+        mpq_sub(d, ws.rx[i].c[k], d);
+        mpq_abs(d, d);
+        mpq_set_d(e, approx[k][2]);
+        CHECK_MSG(mpq_cmp(d, e) <= 0, "%s: point %d coordinate %d: approximation %.17g + %.17g "
+                  "off by more than %.3g", class_names[s->cls], i, k, approx[k][0], approx[k][1],
+                  approx[k][2]);
+        approx_tight += approx[k][2] <= fabs(approx[k][0]) * 0x1p-100;
+    }
+    mpq_clears(d, e, NULL);
+}
+
 static void check_point_bounds(const scenario *s, int i)
 {
     query q = {PR_BOUNDS, {i, 0, 0}, {0, 0}, {0, 0}, 0, 0};
@@ -445,6 +472,7 @@ static void build_point(const scenario *s, int i)
         check_point_bounds(s, i);
     check_point_box(s, i);
     check_point_round(s, i);
+    check_point_approx(s, i);
 }
 
 static void build(const scenario *s)
@@ -1171,7 +1199,9 @@ int main(void)
     print_predicate_table();
     /* The box filter's check was not vacuous: it decided some cases and left others. */
     CHECK(box_filter_decided > 0 && box_filter_decided < box_filter_cases);
-    printf("points kept by the exact cache: %ld\n", cached_points_seen);
+    printf("points kept by the exact cache: %ld; approximations checked %ld, coordinates "
+           "within 2^-100: %ld\n", cached_points_seen, approx_points, approx_tight);
+    CHECK(approx_points > 0 && approx_tight > 0);
     CHECK(cached_points_seen > 0);
     ws_clear();
     return test_summary();

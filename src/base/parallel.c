@@ -62,17 +62,10 @@ static void run_position(loop *l, size_t i)
 /* ---------------------------------------------------------------------------------- */
 /* Thread scratch                                                                      */
 
-/* The scratch of the loop a thread runs tasks of; the outermost loop's when nested. */
-typedef struct scratch_scope {
-    const mcsg_allocator *alloc;
-    void *memory;
-    size_t size;
-} scratch_scope;
+/* The scope a thread's scratch belongs to: the outermost loop or scope it is in. */
+static _Thread_local mci_scratch_scope *current_scope;
 
-static _Thread_local scratch_scope *current_scope;
-
-/* Enters s unless the thread is inside a loop already: false then (s is not used). */
-static bool scratch_enter(scratch_scope *s, const mcsg_allocator *alloc)
+bool mci_scratch_enter(mci_scratch_scope *s, const mcsg_allocator *alloc)
 {
     if (current_scope)
         return false;
@@ -83,7 +76,7 @@ static bool scratch_enter(scratch_scope *s, const mcsg_allocator *alloc)
     return true;
 }
 
-static void scratch_leave(scratch_scope *s, bool entered)
+void mci_scratch_leave(mci_scratch_scope *s, bool entered)
 {
     if (!entered)
         return;
@@ -94,7 +87,7 @@ static void scratch_leave(scratch_scope *s, bool entered)
 
 void *mci_thread_scratch(size_t size, bool *fresh)
 {
-    scratch_scope *s = current_scope;
+    mci_scratch_scope *s = current_scope;
     *fresh = false;
     if (!s || size == 0)
         return NULL;
@@ -111,8 +104,8 @@ void *mci_thread_scratch(size_t size, bool *fresh)
 static void *worker(void *arg)
 {
     loop *l = arg;
-    scratch_scope scope;
-    bool entered = scratch_enter(&scope, &l->alloc);
+    mci_scratch_scope scope;
+    bool entered = mci_scratch_enter(&scope, &l->alloc);
     for (;;) {
         size_t batch = atomic_load(&l->next) < SINGLE_CLAIMS ? 1 : CLAIM_BATCH;
         size_t first, end;
@@ -125,7 +118,7 @@ static void *worker(void *arg)
         for (size_t i = first; i < end; i++)
             run_position(l, i);
     }
-    scratch_leave(&scope, entered);
+    mci_scratch_leave(&scope, entered);
     return NULL;
 }
 
@@ -209,12 +202,16 @@ static void *pool_worker(void *arg)
 {
     mci_pool *p = arg;
     unsigned seen = 0;
+    mci_scratch_scope scope;
+    bool entered = mci_scratch_enter(&scope, &p->alloc); /* the worker's whole life */
     for (;;) {
         loop *l;
         sleep_until(p, &p->posted, generation_moved, seen);
         seen = atomic_load(&p->generation);
-        if (atomic_load(&p->shutdown))
+        if (atomic_load(&p->shutdown)) {
+            mci_scratch_leave(&scope, entered);
             return NULL;
+        }
         atomic_fetch_add(&p->active, 1);
         if ((l = atomic_load(&p->job)) != NULL)
             worker(l);
@@ -364,12 +361,12 @@ mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
 static mcsg_status run_serially(const mci_ctx *ctx, size_t count, const uint32_t *order,
                                 mci_task_fn fn, void *user, mcsg_error *err)
 {
-    scratch_scope scope;
-    bool entered = scratch_enter(&scope, &ctx->alloc);
+    mci_scratch_scope scope;
+    bool entered = mci_scratch_enter(&scope, &ctx->alloc);
     mcsg_status st = MCSG_OK;
     for (size_t i = 0; i < count && st == MCSG_OK; i++)
         st = fn(user, order ? order[i] : i, err);
-    scratch_leave(&scope, entered);
+    mci_scratch_leave(&scope, entered);
     return st;
 }
 

@@ -49,12 +49,25 @@ typedef mcsg_status (*mci_range_fn)(void *user, size_t begin, size_t end, mcsg_e
 mcsg_status mci_parallel_for_ranges(const mci_ctx *ctx, size_t n, size_t chunk,
                                     mci_range_fn fn, void *user, mcsg_error *err);
 /* Memory that the calling thread keeps while it runs one loop's tasks (serial loops
- * included): `size` uninitialised bytes from the loop's allocator, allocated at the
- * thread's first call in the loop (*fresh is then true) and freed when it leaves the
- * loop. NULL outside loops, when the allocation fails, or when size differs from the
- * first call's in this loop. For caches that only save work (exact points: exact/
- * exact_cache.c): a thread keeps its scratch through nested loops. */
+ * included), or longer within a scope (below): `size` uninitialised bytes from the
+ * scope's allocator, allocated at the thread's first call in it (*fresh is then true)
+ * and freed when the thread leaves it. NULL outside loops and scopes, when the
+ * allocation fails, or when size differs from the first call's. For caches that only
+ * save work (exact points: exact/exact_cache.c), which must therefore stay valid
+ * however long the scope lasts. */
 void *mci_thread_scratch(size_t size, bool *fresh);
+
+/* A scope of the calling thread's scratch over several loops (a whole evaluation): the
+ * loops it runs then share it, and a pool's workers keep theirs while the pool lives.
+ * mci_scratch_enter returns false, and the scope is not used, when the thread is in a
+ * scope already; pass its result to mci_scratch_leave. */
+typedef struct mci_scratch_scope {
+    const mcsg_allocator *alloc;
+    void *memory;
+    size_t size;
+} mci_scratch_scope;
+bool mci_scratch_enter(mci_scratch_scope *s, const mcsg_allocator *alloc);
+void mci_scratch_leave(mci_scratch_scope *s, bool entered);
 
 /* ctx->threads, or the number of online processors when it is 0 (at most 64). */
 int mci_thread_count(const mci_ctx *ctx);

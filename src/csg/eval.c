@@ -743,6 +743,8 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     eval_state e;
     double t0 = mci_seconds_now();
     mcsg_status st;
+    mci_scratch_scope scratch;
+    bool scratch_entered;
     memset(&e, 0, sizeof e);
     mci_ctx_init(&e.ctx, opts);
     if (out)
@@ -752,7 +754,11 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     if (!tree || !out)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_eval: NULL %s", tree ? "out" : "tree");
     mci_pool_start(&e.ctx);
+    /* One scratch scope for every loop: points computed exactly in one step are reused by
+     * the next (exact/exact_cache.c) */
+    scratch_entered = mci_scratch_enter(&scratch, &e.ctx.alloc);
     st = run(&e, tree, out, provenance, err);
+    mci_scratch_leave(&scratch, scratch_entered);
     mci_classifier_free(&e.ctx, &e.cl);
     mci_kept_free(&e.ctx, &e.kept);
     free_trimmed(&e);

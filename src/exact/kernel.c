@@ -26,6 +26,7 @@
 
 #include <float.h>
 #include <limits.h>
+#include <stdlib.h>
 #include <math.h>
 #include <string.h>
 
@@ -328,6 +329,7 @@ static void tighten_wide_box(mci_point *p)
         if (!((p->exact_axes >> k) & 1))
             p->c[k] = rounded[k];
     p->r = r;
+    p->ill_conditioned = 1;
 }
 
 /* The cached box of a constructed point (see mci_point): centre and radius from the
@@ -346,6 +348,7 @@ static void set_box(mci_point *p, const double exact[3], unsigned exact_axes)
         p->r = mci_max(p->r, isfinite(c) && isfinite(r) ? r : INFINITY);
     }
     p->exact_axes = (uint8_t)exact_axes;
+    p->ill_conditioned = 0;
     for (int k = 0; k < 3; k++)
         if ((exact_axes >> k) & 1)
             p->c[k] = exact[k];
@@ -750,40 +753,110 @@ int mci_compare_coord_filtered(const mci_point *a, const mci_point *b, int axis)
 
 static const double cache_origin[3] = {0, 0, 0};
 
-/* Entry e made to hold p, computing p's coordinates from the origin when it does not
- * yet; false when a number does not fit an entry. */
-static bool fill_entry(mci_exact_point *e, const mci_point *p)
+/* Quotient limbs kept for a double-word value: 192 bits, where a value has 106. */
+#define APPROX_LIMBS 3
+
+/* e's coordinate k as a double-word value into out; false when scaling could leave the
+ * normal range. With |x| shifted left by `words` limbs so that the quotient has at least
+ * APPROX_LIMBS limbs, |x| / |w| 2^e0 = (q + f) 2^(e0 - 64 words), 0 <= f < 1; the top
+ * APPROX_LIMBS limbs of q are kept and the rest, with f, is below one unit of them. */
+static bool coordinate_approx(const mci_exact_point *e, int k, double out[3])
+{
+    int nx = abs(e->size[k]), nw = abs(e->size[3]);
+    int words = nw + APPROX_LIMBS > nx ? nw + APPROX_LIMBS - nx : 0, nn = nx + words;
+    int qn = nn - nw + 1, base, sign = (e->size[k] < 0) == (e->size[3] < 0) ? 1 : -1;
+    mp_limb_t num[2 * MCI_EXACT_LIMBS + APPROX_LIMBS], q[2 * MCI_EXACT_LIMBS + APPROX_LIMBS];
+    mp_limb_t rem[MCI_EXACT_LIMBS];
+    uint32_t chunk[2 * APPROX_LIMBS];
+    if (nx == 0) {
+        out[0] = out[1] = out[2] = 0;
+        return true;
+    }
+    memset(num, 0, (size_t)words * sizeof num[0]);
+    memcpy(num + words, e->limb[k], (size_t)nx * sizeof num[0]);
+    mpn_tdiv_qr(q, rem, 0, num, nn, e->limb[3], nw);
+    while (qn > APPROX_LIMBS && q[qn - 1] == 0)
+        qn--;
+    base = qn - APPROX_LIMBS;
+    for (int i = 0; i < APPROX_LIMBS; i++) {
+        chunk[2 * i] = (uint32_t)q[base + i];
+        chunk[2 * i + 1] = (uint32_t)(q[base + i] >> 32);
+    }
+    return mci_dd_from_chunks(chunk, 2 * APPROX_LIMBS, e->e0 + 64 * (base - words), sign,
+                              out);
+}
+
+/* p's exact coordinates into e (nothing else of e set); false when a number does not
+ * fit an entry. */
+static bool compute_entry(mci_exact_point *e, const mci_point *p)
 {
     const mci_point *points[1] = {p};
     big_point e_big;
-    if (mci_exact_cache_holds(e, p))
-        return true;
     e->e0 = scale_of(points, 1, NULL, 0).e0;
     big_point_at(&e_big, p, cache_origin, e->e0, 7u); /* every coordinate */
     for (int k = 0; k < 4; k++) {
         const mci_big *n = k < 3 ? &e_big.x[k] : &e_big.w;
-        if ((e->size[k] = mci_big_export(n, e->limb[k], MCI_EXACT_LIMBS)) == INT_MIN) {
-            mci_exact_cache_clear(e);
+        if ((e->size[k] = mci_big_export(n, e->limb[k], MCI_EXACT_LIMBS)) == INT_MIN)
             return false;
-        }
+    }
+    e->has_approx = e->size[3] != 0;
+    for (int k = 0; k < 3 && e->has_approx; k++)
+        e->has_approx = coordinate_approx(e, k, e->approx[k]);
+    return true;
+}
+
+/* Entry e (p's, from mci_exact_cache_find) made to hold p; false when a number does not
+ * fit an entry. */
+static bool fill_entry(mci_exact_point *e, const mci_point *p)
+{
+    if (!compute_entry(e, p)) {
+        mci_exact_cache_clear(p); /* e held another point, now overwritten */
+        return false;
     }
     mci_exact_cache_claim(e, p);
     return true;
 }
 
-/* Entries holding points[0..n) (n <= 3), in distinct slots; false when the thread has
- * no cache, two points share a slot, or a number is too large for an entry. */
-static bool cached_points(const mci_point *const *points, int n, mci_exact_point **out)
+bool mci_point_dd_values(const mci_point *p, double approx[3][3])
 {
+    mci_exact_point e;
+    if (!compute_entry(&e, p) || !e.has_approx)
+        return false;
+    memcpy(approx, e.approx, sizeof e.approx);
+    return true;
+}
+
+/* When cached_points computes the points its cache does not hold yet. */
+typedef enum fill_rule {
+    FILL_ALWAYS,
+    /* Only where a point is held already or ill-conditioned (mci_point): such points
+     * come in crowds (crossings of nearly coplanar faces), meet the same predicates
+     * again and again, and cost the double-double stage far more each time, from their
+     * definitions, than they cost once exactly. Elsewhere that stage decides most cases
+     * at a fraction of an exact point's cost. */
+    FILL_NEAR_TROUBLE,
+} fill_rule;
+
+/* Entries holding points[0..n) (n <= 3), in distinct slots, computing those not held as
+ * `rule` allows; false when the thread has no cache, two points share a slot, or a point
+ * is not held (and not computed, or too large for an entry). */
+static bool cached_points(const mci_point *const *points, int n, fill_rule rule,
+                          mci_exact_point **out)
+{
+    bool held[3], trouble = false, all_held = true;
     for (int i = 0; i < n; i++) {
-        if (!(out[i] = mci_exact_cache_slot(points[i])))
+        if (!(out[i] = mci_exact_cache_find(points[i], &held[i])))
             return false;
         for (int j = 0; j < i; j++)
             if (out[j] == out[i])
                 return false;
+        trouble |= held[i] || points[i]->ill_conditioned;
+        all_held &= held[i];
     }
+    if (!all_held && rule == FILL_NEAR_TROUBLE && !trouble)
+        return false;
     for (int i = 0; i < n; i++)
-        if (!fill_entry(out[i], points[i]))
+        if (!held[i] && !fill_entry(out[i], points[i]))
             return false;
     return true;
 }
@@ -807,6 +880,11 @@ static int cached_compare_coord(const mci_exact_point *a, const mci_exact_point 
 {
     int m = a->e0 < b->e0 ? a->e0 : b->e0;
     mci_big l, r, w;
+    if (a->has_approx && b->has_approx) {
+        int s = mci_compare_dd_values(a->approx[axis], b->approx[axis]);
+        if (s != MCI_UNCERTAIN)
+            return s;
+    }
     entry_number(&l, a, axis, (unsigned)(a->e0 - m));
     entry_number(&w, b, 3, 0);
     mci_big_mul(&l, &l, &w);
@@ -825,6 +903,11 @@ static int cached_orient2d(mci_exact_point *const e[3], int axis)
     int i = (axis + 1) % 3, j = (axis + 2) % 3, m = e[0]->e0, sign = 1;
     mci_big entries[3][3], det;
     const mci_big *rows[3][3];
+    if (e[0]->has_approx && e[1]->has_approx && e[2]->has_approx) {
+        int s = mci_orient2d_dd_values(e[0]->approx[0], e[1]->approx[0], e[2]->approx[0], axis);
+        if (s != MCI_UNCERTAIN)
+            return s;
+    }
     for (int k = 1; k < 3; k++)
         m = e[k]->e0 < m ? e[k]->e0 : m;
     for (int k = 0; k < 3; k++) {
@@ -840,17 +923,6 @@ static int cached_orient2d(mci_exact_point *const e[3], int axis)
     return mci_big_sign(&det) * sign;
 }
 
-/* Whether the thread's cache holds all of points[0..n) already (nothing computed). */
-static bool all_cached(const mci_point *const *points, int n)
-{
-    for (int i = 0; i < n; i++) {
-        const mci_exact_point *e = mci_exact_cache_slot(points[i]);
-        if (!e || !mci_exact_cache_holds(e, points[i]))
-            return false;
-    }
-    return true;
-}
-
 int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
 {
     const mci_point *points[2] = {a, b};
@@ -859,7 +931,7 @@ int mci_compare_coord_exact(const mci_point *a, const mci_point *b, int axis)
     int da = x_degree(a) + w_degree(b), db = x_degree(b) + w_degree(a);
     if (fits_i128(s, da > db ? da : db))
         return i128_compare_coord(a, b, axis, s.e0);
-    if (cached_points(points, 2, e))
+    if (cached_points(points, 2, FILL_ALWAYS, e))
         return cached_compare_coord(e[0], e[1], axis);
     return big_compare_coord(a, b, axis, s.e0);
 }
@@ -959,7 +1031,7 @@ int mci_orient2d_projected_exact(const mci_point *p, const mci_point *q, const m
     input_scale s = scale_of(points, 3, NULL, 0);
     if (fits_i128(s, x_degree(p) + x_degree(q) + x_degree(r)))
         return i128_orient2d(points, axis, s.e0);
-    if (cached_points(points, 3, e))
+    if (cached_points(points, 3, FILL_ALWAYS, e))
         return cached_orient2d(e, axis);
     return big_orient2d(points, axis, s.e0);
 }
@@ -1042,14 +1114,17 @@ static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const m
         if (fits_i128(sc, x_degree(p) + x_degree(q) + x_degree(r)))
             return i128_orient2d(points, axis, sc.e0);
     }
-    /* Points that needed the exact stage before are in the thread's cache: the exact
-     * stage on them costs less than the double-double one, which left them undecided
-     * once already (near-collinear points closer than the spacing of doubles). */
+    /* Points that needed the exact stage before are in the thread's cache, with their
+     * coordinates to 106 bits: that decides before the double-double stage on their
+     * definitions, which left them undecided once already (nearly collinear points
+     * closer together than the spacing of doubles). */
     {
         const mci_point *points[3] = {p, q, r};
-        if (!all_cached(points, 3))
-            s = mci_orient2d_projected_dd(p, q, r, axis);
+        mci_exact_point *e[3];
+        if (cached_points(points, 3, FILL_NEAR_TROUBLE, e))
+            return cached_orient2d(e, axis);
     }
+    s = mci_orient2d_projected_dd(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : mci_orient2d_projected_exact(p, q, r, axis);
 }
 

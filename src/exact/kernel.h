@@ -121,9 +121,13 @@ typedef enum mci_point_kind {
 
 typedef struct mci_point {
     mci_point_kind kind;
-    /* These two sit in kind's padding (points are stored and copied by the million). */
+    /* These three sit in kind's padding (points are stored and copied by the million). */
     uint8_t exact_axes; /* bit k: coordinate k is exactly c[k] (see the box below) */
     int8_t w_sign; /* exact sign of the stored w (+1), or 0 if W is exactly 0 (no point) */
+    /* W tiny against its error bound (nearly parallel planes): the box was tightened
+     * exactly (kernel.c, tighten_wide_box), and predicates on the point tend to need the
+     * exact stage. */
+    uint8_t ill_conditioned;
     /* Defining input vertices. explicit: v[0]. LPI: line v[0], v[1]; plane v[2..4].
      * TPI: planes v[0..2], v[3..5], v[6..8]. base = v[0] in every case. */
     const double *v[9];
@@ -333,6 +337,19 @@ int mci_orient3d_vertices_dd(const double *a, const double *b, const double *c,
  * into out[k] when it can prove the result; returns the bits it could not decide. */
 unsigned mci_point_round_dd(const mci_point *p, unsigned pending, const double guess[3],
                             double out[3]);
+/* Double-word values {hi, lo, e} (the value lies within e of hi + lo) of exact
+ * coordinates, for the points exact/exact_cache.c keeps. mci_dd_from_chunks: the value
+ * of sign (T + g) 2^exponent, T the integer of the 32-bit chunks c[0..n) (c[0] the least
+ * significant), 0 <= g < 1; false when scaling could leave the normal range. The two
+ * predicates give the sign of orient2d of three points in the plane normal to `axis`
+ * (each point nine doubles, coordinate k's value from index 3k) and of a - b, or
+ * MCI_UNCERTAIN. */
+bool mci_dd_from_chunks(const uint32_t *chunk, int n, int exponent, int sign, double out[3]);
+int mci_orient2d_dd_values(const double *p, const double *q, const double *r, int axis);
+int mci_compare_dd_values(const double a[3], const double b[3]);
+/* p's coordinates as such values, from its exact ones (what exact/exact_cache.c keeps);
+ * false when they are not kept (a number too large, or scaling out of range). */
+bool mci_point_dd_values(const mci_point *p, double approx[3][3]);
 /* Sign of component `axis` of n1 x n2 (the direction of a plane-plane line). */
 int mci_line_direction_sign_filtered(const mci_plane *p1, const mci_plane *p2, int axis);
 int mci_line_direction_sign_exact(const mci_plane *p1, const mci_plane *p2, int axis);

@@ -303,3 +303,45 @@ unsigned mci_point_round_dd(const mci_point *p, unsigned pending, const double g
             pending &= ~(1u << k);
     return pending;
 }
+
+/* ---------------------------------------------------------------------------------- */
+/* Double-word values of exact coordinates (kept by exact/exact_cache.c)               */
+
+bool mci_dd_from_chunks(const uint32_t *chunk, int n, int exponent, int sign, double out[3])
+{
+    dd sum = {0, 0, 0};
+    /* The top chunk's bits and the unit of the error must stay normal doubles after
+     * scaling: 2^(exponent + 32 n) below 2^1000, 2^exponent above 2^-900. */
+    if (n <= 0 || exponent + 32 * n > 1000 || exponent < -900)
+        return false;
+    double unit = 1; /* 2^(32 i): exact while 32 n stays below the exponent range */
+    if (n > 30)
+        return false;
+    for (int i = 0; i < n; i++, unit *= 0x1p32) {
+        dd term = {(double)chunk[i] * unit, 0, 0}; /* exact: 32 bits */
+        sum = dd_add(term, sum);
+    }
+    sum.e += 1; /* the fraction g below one unit */
+    out[0] = sign * ldexp(sum.hi, exponent);
+    out[1] = sign * ldexp(sum.lo, exponent);
+    out[2] = ldexp(sum.e * DD_BOUND_SAFETY, exponent);
+    return true;
+}
+
+static dd dd_value(const double v[3])
+{
+    return (dd){v[0], v[1], v[2]};
+}
+
+int mci_orient2d_dd_values(const double *p, const double *q, const double *r, int axis)
+{
+    int i = 3 * ((axis + 1) % 3), j = 3 * ((axis + 2) % 3);
+    dd qx = dd_sub(dd_value(q + i), dd_value(p + i)), qy = dd_sub(dd_value(q + j), dd_value(p + j));
+    dd rx = dd_sub(dd_value(r + i), dd_value(p + i)), ry = dd_sub(dd_value(r + j), dd_value(p + j));
+    return dd_sign(dd_sub(dd_mul(qx, ry), dd_mul(qy, rx)));
+}
+
+int mci_compare_dd_values(const double a[3], const double b[3])
+{
+    return dd_sign(dd_sub(dd_value(a), dd_value(b)));
+}
