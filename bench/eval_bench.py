@@ -184,10 +184,59 @@ def menger_sponge(level, digits=None):
     return '\n'.join(out) + '\n'
 
 
+def fan_plate_polygon(n, length=9000.0, width=100.0):
+    """The outline of a CAD-like plate: its near edge on x = 0 with a vertex at its middle
+    (the apex), its far end at x = -length an arc of n segments bulging by width / 4."""
+    poly = [(0.0, -width / 2), (0.0, 0.0), (0.0, width / 2)]
+    for i in range(n + 1):
+        t = math.pi / 2 - math.pi * i / n
+        poly.append((-(length + width / 4 * math.cos(t)), width / 2 * math.sin(t)))
+    return poly
+
+
+def fan_plate(poly, z0, height):
+    """The plate extruded from z0, its flat faces fan-triangulated from the apex as CAD
+    exporters triangulate a polygon: slivers as long as the plate and 0.08 wide."""
+    m = len(poly)  # counter-clockwise seen from +z, the apex at index 1
+    v = [(x, y, z0) for x, y in poly] + [(x, y, z0 + height) for x, y in poly]
+    f = []
+    for k in range(2, m):
+        a, b = k, (k + 1) % m
+        f.append((1, b, a))
+        f.append((1 + m, a + m, b + m))
+    for i in range(m):
+        j = (i + 1) % m
+        f.append((i, j, j + m))
+        f.append((i, j + m, i + m))
+    return v, f
+
+
+def polygon_area(poly):
+    return abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in
+                   zip(poly, poly[1:] + poly[:1]))) / 2
+
+
+def cad_fans(layout, n=3900):
+    """Two fan-triangulated plates (31K faces in all), 'crossing' at right angles (the
+    second turned about z and raised by half the thickness) or 'stacked' (the second on
+    the first, mirrored: their touching fans share the apex)."""
+    poly = fan_plate_polygon(n)
+    a = fan_plate(poly, 0.0, 10.0)
+    if layout == 'crossing':
+        b = ([(-y - 4500.0, x + 4500.0, z + 5.0) for x, y, z in a[0]], a[1])
+    else:
+        mirrored = [(x, 0.0 - y) for x, y in poly][::-1]
+        b = fan_plate(mirrored[-3:] + mirrored[:-3], 10.0, 10.0)
+    return [a, b], ['union', 0, 1]
+
+
 def analytic_references():
     ref = {}
     for n in (2, 3, 4):  # half a Menger sponge of side 100; one shell
         ref['menger_%d_exact' % n] = (0.5 * 100.0 ** 3 * (20 / 27) ** n, 1)
+    plate = polygon_area(fan_plate_polygon(3900)) * 10.0
+    ref['cad_fans_crossing'] = (2 * plate - 100.0 * 100.0 * 5.0, 1)
+    ref['cad_fans_stacked'] = (2 * plate, 1)
     for n in (32, 64):
         ref['box_grid_%d' % n] = (0.875 * n * n, 1)  # plate - holes (n^2 / 4) + bars (n^2 / 8)
         hole = 0.5 * 24 * 0.3 ** 2 * math.sin(2 * math.pi / 24)
@@ -226,6 +275,9 @@ def scene_builders(ms, models):
                     'OpenSCAD example024 export, level %d' % n))
         out.append(('menger_%d_exact' % n, lambda n=n: menger_sponge(n),
                     'the same, exact numbers'))
+    for layout in ('crossing', 'stacked'):
+        out.append(('cad_fans_%s' % layout, lambda l=layout: cad_fans(l),
+                    'CAD fans, 31K faces, %s' % layout))
     for faces in ('25k', '50k'):
         out.append(('bunny%s_minus_shifted' % faces,
                     lambda f=faces: model_minus_shifted(ms, models, 'bunny%s.obj' % f),

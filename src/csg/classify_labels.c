@@ -8,6 +8,7 @@
 #include "csg/classify_leaf.h"
 #include "csg/local_test.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -57,25 +58,40 @@ static void seed_by_local_tests(mci_leaf_work *w, uint32_t r)
         local_labels_at(w, lab, w->sep_slots[i], true);
 }
 
-/* First seed: the region's labels by rays from its vertices (untouched faces' vertices
- * first: they lie on no other surface). A ray from a vertex on the other leaf's surface
- * decides nothing; the next vertex is tried. */
-static void seed_region(mci_leaf_work *w, uint32_t r)
+/* Whether every label region r needs is known. */
+static bool region_labelled(const mci_leaf_work *w, uint32_t r)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (size_t c = 0; c < w->ncand; c++)
+        if (w->needed[c] && lab[c] == MCI_LABEL_UNKNOWN)
+            return false;
+    return true;
+}
+
+/* Rays from region vertices for the labels still unknown, vertices in a fixed order
+ * (untouched faces' vertices first: they lie on no other surface), from the first'th
+ * to before the end'th; true once every label needed is known. A ray from a vertex on
+ * the other leaf's surface decides nothing; the next vertex is tried. */
+static bool labels_from_vertices(mci_leaf_work *w, uint32_t r, size_t first, size_t end)
 {
     uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    size_t at = 0;
     for (int pass = 0; pass < 2; pass++)
         for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1]; k++) {
             uint32_t p = w->reg_pieces[k];
             bool untouched = mci_scene_arr_of_face(w->s, w->pface[p]) == NULL;
             if (untouched != (pass == 0))
                 continue;
-            for (int i = 0; i < 3; i++) {
+            for (int i = 0; i < 3; i++, at++) {
                 mci_point v;
-                mci_label label;
-                bool all = true;
+                if (at < first)
+                    continue;
+                if (at >= end || w->out_of_memory)
+                    return false;
                 mci_leaf_piece_point(w, p, i, &v);
                 for (size_t c = 0; c < w->ncand; c++) {
                     uint32_t m = w->cand[c];
+                    mci_label label;
                     if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
                         continue;
                     if (point_outside_box(&v, w->cl->box[m])) {
@@ -85,16 +101,32 @@ static void seed_region(mci_leaf_work *w, uint32_t r)
                     w->stats->rays++;
                     if (!mci_ray_label_octree(w->ctx, &v, &w->s->octree, m, &w->ray, &label)) {
                         w->out_of_memory = true;
-                        return;
+                        return false;
                     }
                     lab[c] = (uint8_t)label;
-                    all = all && label != MCI_LABEL_UNKNOWN;
                 }
-                if (all)
-                    return;
+                if (region_labelled(w, r))
+                    return true;
             }
         }
+    return false;
+}
+
+/* Vertices tried by rays before the local tests at the region's separators: a region
+ * whose vertices all lie on another leaf's surface (a face's part inside a wall-bounded
+ * solid, cut by its walls) would otherwise cast a fruitless ray from every vertex, each
+ * crossing the whole octree, where one local test at a separator decides. */
+#define SEED_RAY_VERTICES 12
+
+/* First seed: the region's labels by rays from a few vertices, then by local tests at
+ * its separators, then by rays from the rest of its vertices. */
+static void seed_region(mci_leaf_work *w, uint32_t r)
+{
+    if (labels_from_vertices(w, r, 0, SEED_RAY_VERTICES) || w->out_of_memory)
+        return;
     seed_by_local_tests(w, r);
+    if (!region_labelled(w, r))
+        labels_from_vertices(w, r, SEED_RAY_VERTICES, SIZE_MAX);
 }
 
 /* Labels of the region of piece k / 3 with respect to the leaves holding its edge slot
