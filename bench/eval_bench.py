@@ -218,15 +218,17 @@ def polygon_area(poly):
 
 def cad_fans(layout, n=3900):
     """Two fan-triangulated plates (31K faces in all), 'crossing' at right angles (the
-    second turned about z and raised by half the thickness) or 'stacked' (the second on
-    the first, mirrored: their touching fans share the apex)."""
+    second turned about z and raised by half the thickness), 'stacked' (the second on
+    the first, mirrored: their touching fans share the apex) or 'gap' (stacked 1e-7
+    apart: no face meets the other plate, but their float boxes overlap)."""
     poly = fan_plate_polygon(n)
     a = fan_plate(poly, 0.0, 10.0)
     if layout == 'crossing':
         b = ([(-y - 4500.0, x + 4500.0, z + 5.0) for x, y, z in a[0]], a[1])
     else:
         mirrored = [(x, 0.0 - y) for x, y in poly][::-1]
-        b = fan_plate(mirrored[-3:] + mirrored[:-3], 10.0, 10.0)
+        b = fan_plate(mirrored[-3:] + mirrored[:-3], 10.0 + (1e-7 if layout == 'gap' else 0),
+                      10.0)
     return [a, b], ['union', 0, 1]
 
 
@@ -237,6 +239,7 @@ def analytic_references():
     plate = polygon_area(fan_plate_polygon(3900)) * 10.0
     ref['cad_fans_crossing'] = (2 * plate - 100.0 * 100.0 * 5.0, 1)
     ref['cad_fans_stacked'] = (2 * plate, 1)
+    ref['cad_fans_gap'] = (2 * plate, 2)
     for n in (32, 64):
         ref['box_grid_%d' % n] = (0.875 * n * n, 1)  # plate - holes (n^2 / 4) + bars (n^2 / 8)
         hole = 0.5 * 24 * 0.3 ** 2 * math.sin(2 * math.pi / 24)
@@ -275,7 +278,7 @@ def scene_builders(ms, models):
                     'OpenSCAD example024 export, level %d' % n))
         out.append(('menger_%d_exact' % n, lambda n=n: menger_sponge(n),
                     'the same, exact numbers'))
-    for layout in ('crossing', 'stacked'):
+    for layout in ('crossing', 'stacked', 'gap'):
         out.append(('cad_fans_%s' % layout, lambda l=layout: cad_fans(l),
                     'CAD fans, 31K faces, %s' % layout))
     for faces in ('25k', '50k'):
