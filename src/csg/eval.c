@@ -754,8 +754,9 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     if (!tree || !out)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_eval: NULL %s", tree ? "out" : "tree");
     mci_pool_start(&e.ctx);
-    /* One scratch scope for every loop: points computed exactly in one step are reused by
-     * the next (exact/exact_cache.c) */
+    /* One scratch scope for all the loops this thread runs: the exact cache
+     * (exact/exact_cache.c) is allocated once per evaluation, not per loop, and the
+     * points a step leaves in it may serve the next */
     scratch_entered = mci_scratch_enter(&scratch, &e.ctx.alloc);
     st = run(&e, tree, out, provenance, err);
     mci_scratch_leave(&scratch, scratch_entered);
