@@ -127,50 +127,13 @@ static bool trim_hits(const mci_ctx *ctx, mci_hit_list *h)
     return defs != NULL;
 }
 
-static bool same_coordinates(const double *a, const double *b)
-{
-    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
-}
-
-/* Whether the vectors x - v and y - v, collinear and nonzero, point the same way. */
-static bool same_direction(const double *v, const double *x, const double *y)
-{
-    for (int k = 0; k < 3; k++)
-        if (x[k] != v[k])
-            return (x[k] > v[k]) == (y[k] > v[k]);
-    return false;
-}
-
 /* Whether coplanar faces f and g (planes p and q), their insides apart, touch at one
- * common corner only: exactly one corner in common, and no edge of one leaving it along
- * an edge of the other (two convex sets sharing only boundary points meet in a point or
- * a segment, and a segment from the common corner runs along an edge of each). Such a
- * contact adds nothing to either face's arrangement; CAD fans meeting at one apex have
- * millions of them. */
+ * common corner only (exact/tri_tri.h): the contact adds nothing to either arrangement. */
 static bool touch_at_common_corner_only(const mci_plane *p, const mci_plane *q)
 {
     const double *a[3] = {p->a, p->b, p->c}, *b[3] = {q->a, q->b, q->c};
-    int shared = 0, i0 = 0, j0 = 0, sign, axis;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            if (same_coordinates(a[i], b[j])) {
-                shared++;
-                i0 = i;
-                j0 = j;
-            }
-    if (shared != 1 || (axis = mci_plane_projection_axis(p, &sign)) < 0)
-        return false;
-    for (int s = 1; s < 3; s++)
-        for (int t = 1; t < 3; t++) {
-            const double *v = a[i0], *x = a[(i0 + s) % 3], *y = b[(j0 + t) % 3];
-            mci_point pv, px, py;
-            mci_point_explicit(&pv, v);
-            mci_point_explicit(&px, x);
-            mci_point_explicit(&py, y);
-            if (mci_orient2d_projected(&pv, &px, &py, axis) == 0 && same_direction(v, x, y))
-                return false;
-        }
-    return true;
+    int sign, axis = mci_plane_projection_axis(p, &sign);
+    return axis >= 0 && mci_coplanar_touch_at_corner_only(a, b, axis);
 }
 
 /* Every other coplanar pair is kept, touching or not: faces that only share an edge

@@ -15,6 +15,7 @@
 #include "base/sort.h"
 #include "exact/kernel.h"
 #include "exact/predicates.h"
+#include "exact/tri_tri.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -765,13 +766,6 @@ static int side_of_plane(const face_plane *p, const double *v)
     return s > bound ? 1 : s < -bound ? -1 : 0;
 }
 
-/* orient2d of a, b, c projected along `axis` (exact). */
-static int orient_along(const double *a, const double *b, const double *c, int axis)
-{
-    int i = (axis + 1) % 3, j = (axis + 2) % 3;
-    return mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
-}
-
 /* Whether vertex x lies on the plane p of corners a[], exactly: the filter first for
  * those off it, a coordinate shared by all four (CAD parts cut along axis planes), else
  * the exact orientation. */
@@ -785,56 +779,33 @@ static bool on_face_plane(const face_plane *p, const double *const a[3], const d
     return mci_orient3d_vertices(a[0], a[1], a[2], x) == 0;
 }
 
-/* Whether faces f (plane p) and g are coplanar and touch at one common corner only, their
- * sectors there apart: exactly one common corner v, g's other corners on f's plane, and,
- * with both sectors turned counter-clockwise in a projection along the normal's largest
- * component, both of g's edges at v strictly beyond the line of one of f's edges at v.
- * (An edge of g along an edge of f, a contact along a segment, fails the strict tests.) Two fans meeting at one apex
- * on a shared plane, as two parts unioned along a cut, have millions of such pairs and
- * no arrangement needs them (intersect_pairs.c drops the same contacts after the test). */
+/* Whether faces f (plane p) and g are coplanar, exactly, and touch at one common corner
+ * only (mci_coplanar_touch_at_corner_only, in a projection along the normal's largest
+ * component). Two fans meeting at one apex on a shared plane, as two parts unioned along
+ * a cut, have millions of such pairs; intersect_pairs.c would drop their contacts after
+ * the pair test anyway. */
 static bool coplanar_touch_at_corner_only(const mci_octree *t, const face_plane *p, uint32_t f,
                                           uint32_t g)
 {
-    const double *a[3], *b[3];
-    int shared = 0, i0 = 0, j0 = 0, axis = 0;
+    const double *a[3], *b[3], *off[3];
+    int axis = 0, n_off = 0;
     for (int k = 0; k < 3; k++) {
         a[k] = mci_octree_face_vertex(t, f, k);
         b[k] = mci_octree_face_vertex(t, g, k);
     }
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            if (a[i][0] == b[j][0] && a[i][1] == b[j][1] && a[i][2] == b[j][2]) {
-                shared++;
-                i0 = i;
-                j0 = j;
-            }
-    if (shared != 1 || !on_face_plane(p, a, b[(j0 + 1) % 3]) ||
-        !on_face_plane(p, a, b[(j0 + 2) % 3]))
+    for (int k = 0; k < 3; k++) { /* g's corners that are not f's */
+        bool shared = false;
+        for (int i = 0; i < 3; i++)
+            shared |= b[k][0] == a[i][0] && b[k][1] == a[i][1] && b[k][2] == a[i][2];
+        if (!shared)
+            off[n_off++] = b[k];
+    }
+    if (n_off != 2 || !on_face_plane(p, a, off[0]) || !on_face_plane(p, a, off[1]))
         return false;
     for (int k = 1; k < 3; k++)
         if (fabs(p->n[k]) > fabs(p->n[axis]))
             axis = k;
-    {
-        const double *v = a[i0], *a1 = a[(i0 + 1) % 3], *a2 = a[(i0 + 2) % 3];
-        const double *b1 = b[(j0 + 1) % 3], *b2 = b[(j0 + 2) % 3], *swap;
-        int turn_a = orient_along(v, a1, a2, axis), turn_b = orient_along(v, b1, b2, axis);
-        if (turn_a == 0 || turn_b == 0)
-            return false;
-        if (turn_a < 0) {
-            swap = a1;
-            a1 = a2;
-            a2 = swap;
-        }
-        if (turn_b < 0) {
-            swap = b1;
-            b1 = b2;
-            b2 = swap;
-        }
-        /* f's sector lies left of v->a1 and right of v->a2 (it spans less than a half
-         * turn): g's, strictly beyond one of those lines, meets it at v only */
-        return (orient_along(v, a1, b1, axis) < 0 && orient_along(v, a1, b2, axis) < 0) ||
-               (orient_along(v, a2, b1, axis) > 0 && orient_along(v, a2, b2, axis) > 0);
-    }
+    return mci_coplanar_touch_at_corner_only(a, b, axis);
 }
 
 /* Whether face g lies strictly on one side of face f's plane p. */

@@ -10,6 +10,7 @@
  * line of either triangle has the whole other triangle on its closed outer side.
  */
 #include "exact/tri_tri.h"
+#include "exact/predicates.h"
 
 #include <stdint.h>
 #include <string.h>
@@ -323,4 +324,47 @@ void mci_triangle_intersection_defined(const mci_plane *t1, const mci_plane *t2,
                                        mci_tt_result *out)
 {
     intersect(t1, t2, out, true);
+}
+
+/* orient2d of a, b, c projected along `axis`. */
+static int orient_along(const double *a, const double *b, const double *c, int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    return mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
+}
+
+bool mci_coplanar_touch_at_corner_only(const double *const a[3], const double *const b[3],
+                                       int axis)
+{
+    int shared = 0, i0 = 0, j0 = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (a[i][0] == b[j][0] && a[i][1] == b[j][1] && a[i][2] == b[j][2]) {
+                shared++;
+                i0 = i;
+                j0 = j;
+            }
+    if (shared != 1)
+        return false;
+    {
+        const double *v = a[i0], *a1 = a[(i0 + 1) % 3], *a2 = a[(i0 + 2) % 3];
+        const double *b1 = b[(j0 + 1) % 3], *b2 = b[(j0 + 2) % 3], *swap;
+        int turn_a = orient_along(v, a1, a2, axis), turn_b = orient_along(v, b1, b2, axis);
+        if (turn_a == 0 || turn_b == 0)
+            return false;
+        if (turn_a < 0) {
+            swap = a1;
+            a1 = a2;
+            a2 = swap;
+        }
+        if (turn_b < 0) {
+            swap = b1;
+            b1 = b2;
+            b2 = swap;
+        }
+        /* a's sector lies left of v->a1 and right of v->a2 (it spans less than a half
+         * turn): b's, strictly beyond one of those lines, meets it at v only */
+        return (orient_along(v, a1, b1, axis) < 0 && orient_along(v, a1, b2, axis) < 0) ||
+               (orient_along(v, a2, b1, axis) > 0 && orient_along(v, a2, b2, axis) > 0);
+    }
 }

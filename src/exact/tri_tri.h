@@ -44,4 +44,14 @@ void mci_triangle_intersection(const mci_plane *t1, const mci_plane *t2, mci_tt_
 void mci_triangle_intersection_defined(const mci_plane *t1, const mci_plane *t2,
                                        mci_tt_result *out);
 
+/* For coplanar triangles a and b (the caller knows they are): whether they meet at one
+ * common corner only, exactly. Exactly one corner v has the same coordinates in both, and,
+ * in the projection along `axis` (any axis the plane's normal has a nonzero component
+ * on), both of b's edges at v lie strictly beyond the line of one of a's edges at v. A
+ * contact along a segment (an edge of b along an edge of a) fails the strict tests, as
+ * do degenerate projections. Such a contact adds nothing to either face's arrangement,
+ * and two CAD fans meeting at one apex have millions of them. */
+bool mci_coplanar_touch_at_corner_only(const double *const a[3], const double *const b[3],
+                                       int axis);
+
 #endif
