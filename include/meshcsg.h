@@ -536,8 +536,11 @@ typedef struct mcsg_eval_stats {
  * vertices rounded to double (only at the end). An empty result gives a mesh with no
  * triangles.
  * Input contract: every non-empty leaf the root reaches must pass mcsg_mesh_check
- * (mcsg_check_report_is_valid, and not inverted): closed, consistently oriented outward,
- * edge-manifold, finite, without zero-area or repeated triangles. This is checked first;
+ * (mcsg_check_report_is_valid, and a non-zero volume when it has one component): closed,
+ * consistently oriented, edge-manifold, finite, without zero-area or repeated triangles.
+ * A leaf is the set where its winding number is positive: it may have several shells,
+ * facing out or in, that neither cross nor touch (an inward shell inside an outward one is
+ * a cavity, one on its own is empty; see docs/robustness.md). This is checked first;
  * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
  * (its label: file or primitive, and position in the CSG text) and an example of the
  * problem. Leaves must also not intersect themselves; that is checked up front only with

@@ -479,6 +479,23 @@ static void random_operations(csg_tree_spec *t, uint64_t *rng)
     t->root = pending[0];
 }
 
+/* Inner shells for the primitives of a free tree (not its models), drawn from a stream of
+ * their own so that the tree is otherwise the free tree of the same seed. */
+static void add_shells(csg_tree_spec *t)
+{
+    uint64_t rng = csg_mix_seed(t->seed ^ 0x5be11);
+    for (int i = 0; i < t->leaf_count; i++) {
+        csg_leaf_spec *l = &t->leaves[i];
+        if (l->shape == CSG_MODEL || test_random_int(&rng, 0, 2) == 0)
+            continue;
+        l->inner = test_random_int(&rng, 0, 2);
+        l->inner_scale[0] = uniform_in(&rng, 0.3, 0.8);
+        l->inner_scale[1] = l->inner_scale[0] * uniform_in(&rng, 0.3, 0.8);
+        for (int k = 0; k < 3; k++)
+            l->inward[k] = test_random_int(&rng, 0, 2) == 0;
+    }
+}
+
 void csg_random_tree(csg_tree_spec *t, uint64_t seed)
 {
     uint64_t rng = seed;
@@ -493,6 +510,10 @@ void csg_random_tree(csg_tree_spec *t, uint64_t seed)
     t->leaf_count = 5 + (int)((CSG_MAX_LEAVES - 5 + 1) * pow(uniform(&rng), 3.0));
     random_leaves(t, &rng);
     random_operations(t, &rng);
+    if (t->family == CSG_FREE && csg_mix_seed(seed) % 3 == 0) {
+        t->family = CSG_SHELLS;
+        add_shells(t);
+    }
 }
 
 /* reach[i]: node i is in the tree. */
@@ -533,7 +554,13 @@ static bool has_copies(const csg_tree_spec *t)
     return false;
 }
 
-static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
+/* Solids of the tree may touch: exact copies, or placements on a grid. */
+static bool touching_allowed(const csg_tree_spec *t)
+{
+    return (t->family != CSG_FREE && t->family != CSG_SHELLS) || has_copies(t);
+}
+
+static mcsg_status make_primitive_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
 {
     mcsg_resolution res = {l->fn, 0, 0};
     switch (l->shape) {
@@ -549,6 +576,57 @@ static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_e
     return mcsg_mesh_copy(&models[l->model].mesh, NULL, out, err);
 }
 
+/* Shell k of the leaf (0: the primitive, else its copy k - 1 scaled about the box
+ * centre c) written at vertex `base` and triangle `tri` of out. */
+static void write_shell(const csg_leaf_spec *l, const mcsg_mesh *m, const double c[3], int k,
+                        mcsg_mesh *out)
+{
+    double s = k == 0 ? 1 : l->inner_scale[k - 1];
+    size_t base = (size_t)k * m->vertex_count, tri = (size_t)k * m->triangle_count;
+    for (size_t v = 0; v < 3 * m->vertex_count; v++)
+        out->vertices[3 * base + v] = k == 0 ? m->vertices[v] : c[v % 3] + s * (m->vertices[v] - c[v % 3]);
+    for (size_t t = 0; t < m->triangle_count; t++)
+        for (int i = 0; i < 3; i++)
+            out->triangles[3 * (tri + t) + (size_t)i] =
+                (uint32_t)base + m->triangles[3 * t + (size_t)(l->inward[k] ? (3 - i) % 3 : i)];
+}
+
+/* The primitive and its inner copies in one mesh. */
+static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
+{
+    mcsg_mesh m;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
+    mcsg_status st = make_primitive_mesh(l, &m, err);
+    int shells = 1 + l->inner;
+    if (st != MCSG_OK || (l->inner == 0 && !l->inward[0])) {
+        *out = m;
+        return st;
+    }
+    for (size_t v = 0; v < 3 * m.vertex_count; v++) {
+        lo[v % 3] = fmin(lo[v % 3], m.vertices[v]);
+        hi[v % 3] = fmax(hi[v % 3], m.vertices[v]);
+    }
+    for (int k = 0; k < 3; k++)
+        c[k] = (lo[k] + hi[k]) / 2;
+    out->vertex_count = (size_t)shells * m.vertex_count;
+    out->triangle_count = (size_t)shells * m.triangle_count;
+    out->vertices = malloc(3 * out->vertex_count * sizeof *out->vertices);
+    out->triangles = malloc(3 * out->triangle_count * sizeof *out->triangles);
+    if (!out->vertices || !out->triangles) { /* mcsg_mesh_free frees with free() */
+        mcsg_mesh_free(out, NULL);
+        mcsg_mesh_free(&m, NULL);
+        if (err) {
+            err->status = MCSG_ERR_NOMEM;
+            snprintf(err->message, sizeof err->message, "out of memory");
+        }
+        return MCSG_ERR_NOMEM;
+    }
+    for (int k = 0; k < shells; k++)
+        write_shell(l, &m, c, k, out);
+    mcsg_mesh_free(&m, NULL);
+    return st;
+}
+
 /* ---------------------------------------------------------------------------------- */
 /* Printing a case as a CSG file                                                       */
 
@@ -558,12 +636,37 @@ static void print_indent(FILE *f, int depth)
         fputs("  ", f);
 }
 
+/* A leaf with shells as a polyhedron (OpenSCAD lists faces clockwise from outside). */
+static void print_polyhedron(FILE *f, const csg_leaf_spec *l)
+{
+    mcsg_mesh m;
+    mcsg_error err;
+    if (make_leaf_mesh(l, &m, &err) != MCSG_OK) {
+        fprintf(f, "// %s\n", err.message);
+        return;
+    }
+    fputs("polyhedron(points = [", f);
+    for (size_t v = 0; v < m.vertex_count; v++)
+        fprintf(f, "%s[%.17g, %.17g, %.17g]", v ? ", " : "", m.vertices[3 * v],
+                m.vertices[3 * v + 1], m.vertices[3 * v + 2]);
+    fputs("], faces = [", f);
+    for (size_t t = 0; t < m.triangle_count; t++)
+        fprintf(f, "%s[%u, %u, %u]", t ? ", " : "", m.triangles[3 * t], m.triangles[3 * t + 2],
+                m.triangles[3 * t + 1]);
+    fputs("]);\n", f);
+    mcsg_mesh_free(&m, NULL);
+}
+
 static void print_leaf(FILE *f, const csg_leaf_spec *l)
 {
     const double *m = l->m;
     fprintf(f, "multmatrix([[%.17g, %.17g, %.17g, %.17g], [%.17g, %.17g, %.17g, %.17g], "
                "[%.17g, %.17g, %.17g, %.17g], [0, 0, 0, 1]]) ",
             m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]);
+    if (l->inner > 0 || l->inward[0]) {
+        print_polyhedron(f, l);
+        return;
+    }
     switch (l->shape) {
     case CSG_CUBE:
         fprintf(f, "cube([%.17g, %.17g, %.17g], center = %s);\n", l->size[0], l->size[1],
@@ -599,13 +702,13 @@ static void print_node(FILE *f, const csg_tree_spec *t, int node, int depth)
     fputs("}\n", f);
 }
 
-static const char *const family_names[CSG_FAMILIES] = {"free", "grid", "tilted", "export"};
+const char *const csg_family_names[CSG_FAMILIES] = {"free", "grid", "tilted", "export", "shells"};
 
 void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
 {
     fprintf(f, "// fuzz-csg: seed 0x%016" PRIx64 " family %s touching %s provenance %s; "
-            "%d leaves\n", t->seed, family_names[t->family],
-            t->family != CSG_FREE || has_copies(t) ? "yes" : "no", with_provenance ? "yes" : "no",
+            "%d leaves\n", t->seed, csg_family_names[t->family],
+            touching_allowed(t) ? "yes" : "no", with_provenance ? "yes" : "no",
             csg_reachable_leaves(t));
     print_node(f, t, t->root, 0);
 }
@@ -1248,7 +1351,7 @@ bool csg_run_case(const csg_tree_spec *t, const csg_tree_spec *claim, bool with_
     memset(r, 0, sizeof *r);
     if (build_tree(t, &tree, r) == MCSG_OK && (!claim || build_tree(claim, &claim_tree, r) == MCSG_OK))
         ok = csg_check_tree(tree, claim_tree, t->seed, with_provenance,
-                            t->family != CSG_FREE || has_copies(t), r);
+                            touching_allowed(t), r);
     mcsg_tree_free(tree);
     mcsg_tree_free(claim_tree);
     return ok;

@@ -28,9 +28,14 @@ typedef enum csg_shape { CSG_CUBE, CSG_SPHERE, CSG_CYLINDER, CSG_MODEL } csg_sha
  * every size and matrix entry with six significant digits (Menger-like grids of boxes,
  * cubes turned by multiples of 15 and 45 degrees, plates drilled by cylinders), turned
  * and moved far from the origin: faces meant to be coplanar are 1e-5 apart or tilted by
- * 1e-16, features below the spacing of doubles. */
-typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED, CSG_EXPORT } csg_family;
-#define CSG_FAMILIES 4
+ * 1e-16, features below the spacing of doubles; shells: free trees whose primitives
+ * carry smaller copies of themselves inside (one or two, each facing out or in), and may
+ * face inward themselves: leaves whose solid is where their winding number is positive,
+ * with nested shells, cavities, and shells that are empty on their own. */
+typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED, CSG_EXPORT, CSG_SHELLS } csg_family;
+#define CSG_FAMILIES 5
+/* The families' names, as the case files' first line and the reports write them. */
+extern const char *const csg_family_names[CSG_FAMILIES];
 
 typedef struct csg_leaf_spec {
     csg_shape shape;
@@ -39,6 +44,12 @@ typedef struct csg_leaf_spec {
     int center;       /* cube, cylinder */
     int fn;           /* sphere, cylinder */
     int model;        /* index into the models */
+    /* Shells family: inner copies of the primitive (0..2), each scaled by inner_scale[k]
+     * about the centre of the primitive's box; inward[0] turns the primitive itself
+     * inside out, inward[1 + k] the copy k. */
+    int inner;
+    double inner_scale[2];
+    bool inward[3];
     double m[12];     /* row-major 3x4 placement */
 } csg_leaf_spec;
 

@@ -82,12 +82,14 @@ int main(int argc, char **argv)
         save_case(dir, &t, with_provenance);
         fflush(stdout);
     }
-    printf("fuzz_csg: %ld trees (%ld free, %ld grid, %ld tilted, %ld export; %ld leaves) in "
-           "%.0f s, %ld failed; outputs that intersect themselves: %ld free, %ld grid, %ld "
-           "tilted, %ld export; %ld reported broken by rounding\n", trees, families[0],
-           families[1], families[2], families[3], leaves, csg_now() - start, failures,
-           self_intersecting[0], self_intersecting[1], self_intersecting[2],
-           self_intersecting[3], reported);
+    printf("fuzz_csg: %ld trees (", trees);
+    for (int k = 0; k < CSG_FAMILIES; k++)
+        printf("%s%ld %s", k ? ", " : "", families[k], csg_family_names[k]);
+    printf("; %ld leaves) in %.0f s, %ld failed; outputs that intersect themselves: ", leaves,
+           csg_now() - start, failures);
+    for (int k = 0; k < CSG_FAMILIES; k++)
+        printf("%s%ld %s", k ? ", " : "", self_intersecting[k], csg_family_names[k]);
+    printf("; %ld reported broken by rounding\n", reported);
     csg_free_models();
     return failures ? 1 : 0;
 }

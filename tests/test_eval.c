@@ -409,6 +409,95 @@ TEST(cad_fan_plates)
 
 /* Exact volumes of curved solids are unknown, but they must add up: vol(A u B) +
  * vol(A n B) = vol(A) + vol(B) and vol(A - B) = vol(A) - vol(A n B), to rounding. */
+/* A polyhedron of axis-aligned boxes, one shell each: box k spans lo[k] .. hi[k] on every
+ * axis and faces inward when inward[k]. OpenSCAD lists faces clockwise seen from
+ * outside. */
+static char *box_shells(const double *lo, const double *hi, const bool *inward, int n)
+{
+    static const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                    {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    size_t cap = 512 + (size_t)n * 512, len = 0;
+    char *text = malloc(cap);
+    len += (size_t)snprintf(text + len, cap - len, "polyhedron(points=[");
+    for (int k = 0; k < n; k++)
+        for (int c = 0; c < 8; c++)
+            len += (size_t)snprintf(text + len, cap - len, "%s[%g,%g,%g]", k + c ? "," : "",
+                                    c & 4 ? hi[k] : lo[k], c & 2 ? hi[k] : lo[k],
+                                    c & 1 ? hi[k] : lo[k]);
+    len += (size_t)snprintf(text + len, cap - len, "], faces=[");
+    for (int k = 0; k < n; k++)
+        for (int f = 0; f < 6; f++) {
+            int c[4];
+            for (int i = 0; i < 4; i++)
+                c[i] = 8 * k + quads[f][inward[k] ? 3 - i : i];
+            len += (size_t)snprintf(text + len, cap - len, "%s[%d,%d,%d,%d]", k + f ? "," : "",
+                                    c[0], c[1], c[2], c[3]);
+        }
+    snprintf(text + len, cap - len, "]);");
+    return text;
+}
+
+/* "op() { A B }" in a buffer of its own. */
+static char *tree_of(const char *op, const char *a, const char *b)
+{
+    size_t n = strlen(op) + strlen(a) + strlen(b) + 16;
+    char *text = malloc(n);
+    snprintf(text, n, "%s() { %s %s }", op, a, b);
+    return text;
+}
+
+static void expect_tree_volume(const char *op, const char *a, const char *b, double volume,
+                               size_t components)
+{
+    char *text = tree_of(op, a, b);
+    if (volume == 0)
+        expect_empty(text);
+    else
+        expect_solid(text, volume, components);
+    free(text);
+}
+
+/* A leaf is where its winding number is positive: a box inside a box adds nothing, an
+ * inward box inside one is a cavity, an inward box alone is empty; other leaves crossing
+ * the shells, or lying on them, are classified by the numbers on each side. */
+TEST(leaves_with_several_shells)
+{
+    const double lo[] = {0, 2, 4}, hi[] = {10, 8, 6};
+    const bool out_out[] = {false, false}, out_in[] = {false, true}, in_out[] = {true, false};
+    const bool out_in_out[] = {false, true, false}, in[] = {true};
+    const char *slab = "translate([5,-1,-1]) cube([20,5,20]);";
+    char *nested = box_shells(lo, hi, out_out, 2), *cavity = box_shells(lo, hi, out_in, 2);
+    char *hollow = box_shells(lo, hi, in_out, 2), *triple = box_shells(lo, hi, out_in_out, 3);
+    char *inverted = box_shells(lo, hi, in, 1);
+    expect_tree_volume("union", nested, "", 1000, 1);
+    expect_tree_volume("union", inverted, "", 0, 0);
+    expect_tree_volume("union", hollow, "", 0, 0);
+    expect_tree_volume("difference", nested, slab, 800, 1);
+    expect_tree_volume("intersection", nested, slab, 200, 1);
+    expect_tree_volume("union", nested, slab, 2800, 1);
+    expect_tree_volume("difference", slab, nested, 1800, 1);
+    expect_tree_volume("difference", cavity, slab, 620, 1); /* the slab opens the cavity */
+    expect_tree_volume("intersection", cavity, slab, 164, 1);
+    expect_tree_volume("union", cavity, slab, 2620, 2);
+    expect_tree_volume("difference", slab, cavity, 1836, 2);
+    expect_tree_volume("union", inverted, slab, 2000, 1);
+    expect_tree_volume("difference", slab, hollow, 2000, 1);
+    expect_tree_volume("difference", triple, slab, 628, 2);
+    expect_tree_volume("intersection", triple, slab, 164, 1);
+    /* Coincident shells of two such leaves. */
+    expect_tree_volume("union", nested, cavity, 1000, 1);
+    expect_tree_volume("intersection", nested, cavity, 784, 2);
+    expect_tree_volume("difference", nested, cavity, 216, 1);
+    expect_tree_volume("difference", cavity, nested, 0, 0);
+    expect_tree_volume("union", triple, cavity, 792, 3);
+    expect_tree_volume("union", inverted, cavity, 784, 2);
+    free(nested);
+    free(cavity);
+    free(hollow);
+    free(triple);
+    free(inverted);
+}
+
 TEST(curved_volumes_add_up)
 {
     static const char *a = "sphere(1, $fn=24);";
@@ -950,7 +1039,8 @@ TEST(input_contract_is_checked)
         t[3 * i + 1] = contract_cube_t[3 * i + 2];
         t[3 * i + 2] = contract_cube_t[3 * i + 1];
     }
-    expect_contract_error(&m, "inside out");
+    /* Inside out is valid: the leaf's solid is empty, the union the big cube alone. */
+    CHECK_OK(eval_with_leaf(&m, &err), &err);
     memcpy(t, contract_cube_t, sizeof contract_cube_t);
     v[3 * 6] = NAN;
     expect_contract_error(&m, "NaN or infinite coordinates, e.g. vertex 6");
@@ -1001,5 +1091,6 @@ int main(void)
     RUN(intersect_reports_progress_and_can_cancel);
     RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
+    RUN(leaves_with_several_shells);
     return test_summary();
 }

@@ -52,16 +52,18 @@ static void add_result(totals *s, const csg_result *r)
 static void print_totals(const char *what, const totals *s, double seconds, bool generated)
 {
     printf("%s: %d trees", what, s->trees);
+    for (int k = 0; generated && k < CSG_FAMILIES; k++)
+        printf("%s%d %s", k ? ", " : " (", s->families[k], csg_family_names[k]);
     if (generated)
-        printf(" (%d free, %d grid, %d tilted, %d export; up to %d leaves)", s->families[0],
-               s->families[1], s->families[2], s->families[3], s->max_leaves);
+        printf("; up to %d leaves)", s->max_leaves);
     printf(", %d failed: %zu points, %zu checked (%zu inside); %d empty results, %d with "
            "edges where solids touch, %d with triangles flattened by rounding, %d "
            "intersecting themselves", s->failed, s->points, s->checked, s->inside, s->empty,
            s->touching, s->rounded, s->self_intersecting);
+    for (int k = 0; generated && k < CSG_FAMILIES; k++)
+        printf("%s%s %d", k ? ", " : " (", csg_family_names[k], s->self_by_family[k]);
     if (generated)
-        printf(" (free %d, grid %d, tilted %d, export %d)", s->self_by_family[0],
-               s->self_by_family[1], s->self_by_family[2], s->self_by_family[3]);
+        printf(")");
     printf(", %d reported broken by rounding", s->reported);
     printf("; %zu output triangles, %zu dropped by rounding; %.1f s (%.1f s in mcsg_eval, "
            "%.1f s in the oracle)\n", s->triangles, s->dropped, seconds, s->eval_seconds,

@@ -12,6 +12,54 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Which candidates are winding leaves, and room for their numbers if any is. */
+static mcsg_status winding_candidates(mci_leaf_work *w)
+{
+    const uint8_t *winding = w->cl->tree->leaf_winding;
+    bool any = false;
+    if (!(w->cand_winding = mci_malloc_array(w->ctx, w->ncand + 1, 1)))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t c = 0; c < w->ncand; c++)
+        any |= (w->cand_winding[c] = winding[w->cand[c]]) != 0;
+    if (!any)
+        return MCSG_OK;
+    if (!(w->wind = mci_malloc_array(w->ctx, w->nreg * w->ncand + 1, sizeof *w->wind)))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t i = 0; i < w->nreg * w->ncand; i++)
+        w->wind[i] = MCI_WIND_UNKNOWN;
+    return MCSG_OK;
+}
+
+/* Region r's label and winding number with respect to winding candidate c, from the
+ * ray-given number at a point of the region off that leaf's surface. */
+static void set_winding(mci_leaf_work *w, uint32_t r, size_t c, int32_t number)
+{
+    w->wind[(size_t)r * w->ncand + c] = number;
+    w->labels[(size_t)r * w->ncand + c] = (uint8_t)mci_label_of_windings(number, number);
+}
+
+bool mci_leaf_label_by_ray(mci_leaf_work *w, uint32_t r, size_t c, const mci_point *v)
+{
+    uint32_t m = w->cand[c];
+    w->stats->rays++;
+    if (w->cand_winding[c]) {
+        int number;
+        bool decided;
+        if (!mci_ray_winding_octree(w->ctx, v, &w->s->octree, m, &w->ray, &number, &decided))
+            return false;
+        if (decided)
+            set_winding(w, r, c, number);
+        return true;
+    }
+    {
+        mci_label label;
+        if (!mci_ray_label_octree(w->ctx, v, &w->s->octree, m, &w->ray, &label))
+            return false;
+        w->labels[(size_t)r * w->ncand + c] = (uint8_t)label;
+    }
+    return true;
+}
+
 /* The candidates: the other leaves whose boxes meet this leaf's, in increasing index. */
 static mcsg_status find_candidates(mci_leaf_work *w)
 {
@@ -34,7 +82,7 @@ static mcsg_status find_candidates(mci_leaf_work *w)
     if (!w->labels)
         return mci_fail_nomem(w->err, "classifying faces");
     memset(w->labels, MCI_LABEL_UNKNOWN, w->nreg * w->ncand);
-    return MCSG_OK;
+    return winding_candidates(w);
 }
 
 static bool point_outside_box(const mci_point *p, const double box[6])
@@ -47,15 +95,15 @@ static bool point_outside_box(const mci_point *p, const double box[6])
     return false;
 }
 
-static void local_labels_at(mci_leaf_work *w, uint8_t *to, size_t k, bool only_unknown);
+static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_unknown,
+                            uint32_t from);
 
 /* Labels a seed region's rays left open (every vertex tried lies on that leaf's
  * surface): decided at a separator of the region on that leaf, if any. */
 static void seed_by_local_tests(mci_leaf_work *w, uint32_t r)
 {
-    uint8_t *lab = w->labels + (size_t)r * w->ncand;
     for (uint32_t i = w->sep_start[r]; i < w->sep_start[r + 1]; i++)
-        local_labels_at(w, lab, w->sep_slots[i], true);
+        local_labels_at(w, r, w->sep_slots[i], true, MCI_NONE);
 }
 
 /* Whether every label region r needs is known. */
@@ -90,26 +138,70 @@ static bool labels_from_vertices(mci_leaf_work *w, uint32_t r, size_t first, siz
                     return false;
                 mci_leaf_piece_point(w, p, i, &v);
                 for (size_t c = 0; c < w->ncand; c++) {
-                    uint32_t m = w->cand[c];
-                    mci_label label;
                     if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
                         continue;
-                    if (point_outside_box(&v, w->cl->box[m])) {
+                    if (point_outside_box(&v, w->cl->box[w->cand[c]])) {
+                        if (w->cand_winding[c])
+                            set_winding(w, r, c, 0);
                         lab[c] = MCI_LABEL_OUT;
                         continue;
                     }
-                    w->stats->rays++;
-                    if (!mci_ray_label_octree(w->ctx, &v, &w->s->octree, m, &w->ray, &label)) {
+                    if (!mci_leaf_label_by_ray(w, r, c, &v)) {
                         w->out_of_memory = true;
                         return false;
                     }
-                    lab[c] = (uint8_t)label;
                 }
                 if (region_labelled(w, r))
                     return true;
             }
         }
     return false;
+}
+
+/* Region r's labels with respect to candidate c from a ray from q, a point strictly
+ * inside one of its pieces, in the plane `at` of the piece's face: for a winding leaf, its
+ * numbers on both sides when the piece lies in its surface too. False when out of
+ * memory. */
+static bool label_from_inside(mci_leaf_work *w, uint32_t r, size_t c, const mci_point *q,
+                              const mci_plane *at)
+{
+    int behind, in_front;
+    bool decided;
+    if (!w->cand_winding[c])
+        return mci_leaf_label_by_ray(w, r, c, q);
+    w->stats->rays++;
+    if (!mci_ray_windings_on_plane(w->ctx, q, &w->s->octree, w->cand[c], at, &w->ray, &behind,
+                                   &in_front, &decided))
+        return false;
+    if (decided) {
+        w->wind[(size_t)r * w->ncand + c] = in_front;
+        w->labels[(size_t)r * w->ncand + c] = (uint8_t)mci_label_of_windings(behind, in_front);
+    }
+    return true;
+}
+
+bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only)
+{
+    uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    bool learnt = false;
+    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && !learnt; k++) {
+        mci_point probe;
+        mci_plane at;
+        double ends[2][3];
+        if (!mci_leaf_piece_inside(w, w->reg_pieces[k], ends, &probe, &at))
+            continue;
+        for (size_t c = 0; c < w->ncand; c++) {
+            if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c] ||
+                (winding_only && !w->cand_winding[c]))
+                continue;
+            if (!label_from_inside(w, r, c, &probe, &at)) {
+                w->out_of_memory = true;
+                return false;
+            }
+            learnt = learnt || lab[c] != MCI_LABEL_UNKNOWN;
+        }
+    }
+    return learnt;
 }
 
 /* Vertices tried by rays before the local tests at the region's separators: a region
@@ -127,25 +219,64 @@ static void seed_region(mci_leaf_work *w, uint32_t r)
     seed_by_local_tests(w, r);
     if (!region_labelled(w, r))
         labels_from_vertices(w, r, SEED_RAY_VERTICES, SIZE_MAX);
+    /* A winding leaf is not decided by a local test alone (it tells a side, not the
+     * number), and every vertex lies on its surface where the region does. */
+    if (w->wind && !region_labelled(w, r) && !w->out_of_memory)
+        mci_leaf_labels_from_inside(w, r, true);
 }
 
-/* Labels of the region of piece k / 3 with respect to the leaves holding its edge slot
- * k, by local tests (only those still unknown if only_unknown). */
-static void local_labels_at(mci_leaf_work *w, uint8_t *to, size_t k, bool only_unknown)
+/* The three points of slot k's piece: the slot's ends x, y and the far vertex. */
+static void slot_points(const mci_leaf_work *w, size_t k, mci_point *x, mci_point *y,
+                        mci_point *far)
+{
+    size_t p = k / 3;
+    mci_leaf_piece_point(w, p, (int)(k % 3), x);
+    mci_leaf_piece_point(w, p, (int)(k % 3 + 1) % 3, y);
+    mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, far);
+}
+
+/* Region r's winding number and label for winding candidate c, whose face h holds the
+ * separator between r (slot k, local label `here`) and region `from` across it. */
+static void winding_across(mci_leaf_work *w, uint32_t from, uint32_t r, size_t k, size_t c,
+                           uint32_t h, mci_label here)
 {
     const mci_scene *s = w->s;
-    size_t p = k / 3;
+    size_t k1 = w->mate[k];
+    mci_point x, y, far;
+    mci_label there;
+    int32_t front;
+    slot_points(w, k1, &x, &y, &far);
+    w->stats->local_tests++;
+    there = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x, &y, &far, h);
+    w->labels[(size_t)r * w->ncand + c] =
+        (uint8_t)mci_wind_across(w->wind[(size_t)from * w->ncand + c], there, here, &front);
+    w->wind[(size_t)r * w->ncand + c] = front;
+}
+
+/* Labels of region r, whose piece has edge slot k, with respect to the leaves holding
+ * that slot, by local tests (only those still unknown if only_unknown). A winding leaf's
+ * number is carried over from region `from` across the slot (mate of k), and left alone
+ * when from is MCI_NONE. */
+static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_unknown,
+                            uint32_t from)
+{
+    const mci_scene *s = w->s;
+    uint8_t *to = w->labels + (size_t)r * w->ncand;
     uint64_t key = mci_edge_key(mci_leaf_slot_from(w, k), mci_leaf_slot_to(w, k));
     mci_point x, y, far;
-    mci_leaf_piece_point(w, p, (int)(k % 3), &x);
-    mci_leaf_piece_point(w, p, (int)(k % 3 + 1) % 3, &y);
-    mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, &far);
+    slot_points(w, k, &x, &y, &far);
     for (size_t e = mci_leaf_find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++) {
         uint32_t h = w->sep[e].ref, c = w->slot_of_leaf[s->octree.face_leaf[h]];
-        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
+        mci_label here;
+        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN) ||
+            (w->cand_winding[c] && from == MCI_NONE))
             continue;
         w->stats->local_tests++;
-        to[c] = (uint8_t)mci_local_label(s, mci_scene_arr_of_face(s, w->pface[p]), &x, &y, &far, h);
+        here = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h);
+        if (w->cand_winding[c])
+            winding_across(w, from, r, k, c, h, here);
+        else
+            to[c] = (uint8_t)here;
     }
 }
 
@@ -153,9 +284,11 @@ static void local_labels_at(mci_leaf_work *w, uint8_t *to, size_t k, bool only_u
  * but for the leaves whose surface holds the separator (paper Prop. 2). */
 static void inherit_labels(mci_leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
 {
-    uint8_t *to = w->labels + (size_t)r2 * w->ncand;
-    memcpy(to, w->labels + (size_t)r1 * w->ncand, w->ncand);
-    local_labels_at(w, to, k, false);
+    memcpy(w->labels + (size_t)r2 * w->ncand, w->labels + (size_t)r1 * w->ncand, w->ncand);
+    if (w->wind)
+        memcpy(w->wind + (size_t)r2 * w->ncand, w->wind + (size_t)r1 * w->ncand,
+               w->ncand * sizeof *w->wind);
+    local_labels_at(w, r2, k, false, r1);
 }
 
 /* Whether separator slot k lies on the surface of leaf m. */
@@ -207,10 +340,16 @@ static void fill_unknown_labels(mci_leaf_work *w)
                         continue; /* a wall */
                     r2 = w->region[w->mate[k] / 3];
                     there = w->labels[(size_t)r2 * w->ncand + c];
-                    if (there != MCI_LABEL_UNKNOWN && !separator_on_leaf(w, k, w->cand[c])) {
+                    if (there == MCI_LABEL_UNKNOWN)
+                        continue;
+                    if (!separator_on_leaf(w, k, w->cand[c])) {
                         lab[c] = there;
-                        changed = true;
+                        if (w->cand_winding[c])
+                            w->wind[(size_t)r * w->ncand + c] = w->wind[(size_t)r2 * w->ncand + c];
+                    } else if (w->cand_winding[c]) {
+                        local_labels_at(w, r, k, true, r2);
                     }
+                    changed |= lab[c] != MCI_LABEL_UNKNOWN;
                 }
             }
         }

@@ -3,6 +3,7 @@
  * rest of the pipeline sees csg/classify.h. mci_classify_leaf (classify.c) runs:
  *   mci_leaf_regions  (classify_regions.c) pieces, separators, walls, edge pairing,
  *                     regions
+ *   mci_leaf_shell_fronts (classify_winding.c) a winding leaf's own number per shell
  *   mci_leaf_trim     (classify_labels.c)  the candidates and the trimmed CSGlist
  *   mci_leaf_label    (classify_labels.c)  labels of every region: seeds by rays,
  *                     inheritance across separators by the local test, copies
@@ -39,6 +40,14 @@ typedef struct mci_leaf_work {
     size_t ncand;
     uint32_t *slot_of_leaf; /* leaf -> index in cand, or MCI_NONE */
     uint8_t *labels;  /* nreg x ncand */
+    /* Winding leaves (mci_ptree.leaf_winding, classify_winding.c). cand_winding: per
+     * candidate, 1 for a winding leaf; wind (NULL when no candidate is one): nreg x
+     * ncand, that leaf's winding number in front of the region, MCI_WIND_UNKNOWN if not
+     * known yet; face_front (NULL unless this leaf is one): per face of the leaf, its
+     * winding number in front of the face's shell. */
+    uint8_t *cand_winding;
+    int32_t *wind;
+    int32_t *face_front;
     uint8_t *needed;  /* per candidate: in a subtree of the trimmed CSGlist */
     mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
     size_t nlist;
@@ -85,6 +94,41 @@ static inline size_t mci_leaf_find_separator(const mci_leaf_work *w, uint64_t ke
 {
     return mci_find_key(w->sep, w->nsep, key);
 }
+
+/* Region r's label with respect to candidate c by a ray from v (and its winding number
+ * for a winding leaf); the label stays UNKNOWN when v lies on that leaf's surface. False
+ * when out of memory. */
+bool mci_leaf_label_by_ray(mci_leaf_work *w, uint32_t r, size_t c, const mci_point *v);
+
+/* The region's labels still unknown (only those of winding leaves if winding_only), by
+ * rays from a point strictly inside one of its pieces: where every vertex of a region lies
+ * on a leaf's surface, the inside of a piece still tells (or, for a winding leaf, tells
+ * the numbers on both sides of a piece lying in that surface). False when nothing was
+ * learnt (w->out_of_memory set when out of memory). */
+bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only);
+
+/* Winding numbers (classify_winding.c). */
+#define MCI_WIND_UNKNOWN INT32_MIN
+
+/* face_front for a winding leaf (nothing otherwise). */
+mcsg_status mci_leaf_shell_fronts(mci_leaf_work *w);
+/* The label of a region with the winding numbers behind and in front of it. */
+mci_label mci_label_of_windings(int32_t behind, int32_t in_front);
+/* A winding leaf's number in front of a region (*to_front) and the region's label, from
+ * the number in front of the region across a separator on that leaf's surface and the
+ * local labels of both regions there (UNKNOWN when something is unknown). */
+mci_label mci_wind_across(int32_t from_front, mci_label from_local, mci_label to_local,
+                          int32_t *to_front);
+/* A point strictly inside the triangle a, b, c (input vertices): where a line through its
+ * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
+ * vertices; `ends` holds the line's two ends, which the point refers to). False when the
+ * doubles do not give a line crossing the plane or a point strictly inside (slivers). */
+bool mci_point_inside_triangle(const double *a, const double *b, const double *c,
+                               double ends[2][3], mci_point *out);
+/* The same for piece p (its corners may be implicit points), in the plane of its face
+ * (*plane, which the point refers to as well). */
+bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, double ends[2][3], mci_point *out,
+                           mci_plane *plane);
 
 mcsg_status mci_leaf_regions(mci_leaf_work *w);
 mcsg_status mci_leaf_trim(mci_leaf_work *w);

@@ -151,82 +151,6 @@ static void region_labels(mci_leaf_work *w, size_t r, uint32_t as)
         w->leaf_labels[w->leaf] = mci_label_reverse(w->leaf_labels[w->leaf]);
 }
 
-/* A point strictly inside the triangle a, b, c (input vertices): where a line through its
- * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
- * vertices; `ends` holds the line's two ends, which the point refers to). False when the
- * doubles do not give a line crossing the plane or a point strictly inside (slivers). */
-static bool point_inside_triangle(const double *a, const double *b, const double *c,
-                                  double ends[2][3], mci_point *out)
-{
-    double e1[3], e2[3], n[3], size = 0, norm = 0;
-    mci_plane plane;
-    mci_point corner[3];
-    int axis, sign, turns[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = b[k] - a[k];
-        e2[k] = c[k] - a[k];
-        size = fmax(size, fmax(fabs(e1[k]), fabs(e2[k])));
-    }
-    for (int k = 0; k < 3; k++) {
-        n[k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
-        norm = fmax(norm, fabs(n[k]));
-    }
-    if (!(norm > 0) || !(size > 0) || !isfinite(norm))
-        return false;
-    for (int k = 0; k < 3; k++) {
-        double centre = (a[k] + b[k] + c[k]) / 3, step = n[k] / norm * size;
-        ends[0][k] = centre + step;
-        ends[1][k] = centre - step;
-    }
-    mci_plane_init(&plane, a, b, c);
-    if (mci_orient3d_vertices(a, b, c, ends[0]) * mci_orient3d_vertices(a, b, c, ends[1]) >= 0 ||
-        !mci_point_lpi(out, ends[0], ends[1], &plane) ||
-        (axis = mci_plane_projection_axis(&plane, &sign)) < 0)
-        return false;
-    mci_point_explicit(&corner[0], a);
-    mci_point_explicit(&corner[1], b);
-    mci_point_explicit(&corner[2], c);
-    for (int i = 0; i < 3; i++)
-        turns[i] = mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], out, axis);
-    return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
-}
-
-/* The region's labels still unknown when its labels do not decide it: rays from a point
- * strictly inside one of its pieces with input corners. The seeds cast rays from region
- * vertices only; when every vertex lies on a leaf's surface and no side of the region is
- * on it (faces touching that leaf only at their corners), the inside of a piece still
- * tells. False when nothing was learnt. */
-static bool labels_from_inside(mci_leaf_work *w, uint32_t r)
-{
-    uint8_t *lab = w->labels + (size_t)r * w->ncand;
-    bool learnt = false;
-    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && !learnt; k++) {
-        mci_point v[3], probe;
-        double ends[2][3];
-        uint32_t p = w->reg_pieces[k];
-        for (int i = 0; i < 3; i++)
-            mci_leaf_piece_point(w, p, i, &v[i]);
-        if (v[0].kind != MCI_POINT_EXPLICIT || v[1].kind != MCI_POINT_EXPLICIT ||
-            v[2].kind != MCI_POINT_EXPLICIT ||
-            !point_inside_triangle(v[0].v[0], v[1].v[0], v[2].v[0], ends, &probe))
-            continue;
-        for (size_t c = 0; c < w->ncand; c++) {
-            mci_label label;
-            if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c])
-                continue;
-            w->stats->rays++;
-            if (!mci_ray_label_octree(w->ctx, &probe, &w->s->octree, w->cand[c], &w->ray,
-                                      &label)) {
-                w->out_of_memory = true;
-                return false;
-            }
-            lab[c] = (uint8_t)label;
-            learnt = learnt || label != MCI_LABEL_UNKNOWN;
-        }
-    }
-    return learnt;
-}
-
 /* Whether region r is kept, for this leaf or its copy k (-1: its labels do not tell). */
 /* The blist on region r's own labels (mci_blist_accepts without spreading them over the
  * leaves first: a leaf that hundreds of others cross has as many candidates, and a walk
@@ -264,15 +188,23 @@ static int region_accepts(mci_leaf_work *w, uint32_t r, size_t k)
                                       w->scratch);
 }
 
+/* Whether region r lies where this leaf's winding number is the same on both sides
+ * (not 0 in front and 1 behind): then it bounds nothing of the leaf's solid. */
+static bool off_own_boundary(const mci_leaf_work *w, uint32_t r)
+{
+    return w->face_front &&
+           w->face_front[w->pface[w->reg_pieces[w->reg_start[r]]] - w->face_base] != 0;
+}
+
 /* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
 static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
 {
     bool self = k == w->ncopies, rejected = self ? w->rejected : w->copy_nlist[k] == SIZE_MAX;
     for (uint32_t r = 0; r < w->nreg; r++) {
         int accepts = 0;
-        if (!rejected) {
+        if (!rejected && !off_own_boundary(w, r)) {
             accepts = region_accepts(w, r, k);
-            if (accepts < 0 && labels_from_inside(w, r))
+            if (accepts < 0 && mci_leaf_labels_from_inside(w, r, false))
                 accepts = region_accepts(w, r, k);
             if (w->out_of_memory)
                 return mci_fail_nomem(w->err, "classifying faces");

@@ -155,10 +155,11 @@ mcsg_status mci_ptree_build(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree
     out->leaf_node = mci_malloc_array(ctx, n, sizeof *out->leaf_node);
     out->leaf_mesh = mci_malloc_array(ctx, n, sizeof *out->leaf_mesh);
     out->leaf_source = mci_malloc_array(ctx, n, sizeof *out->leaf_source);
+    out->leaf_winding = mci_calloc_array(ctx, n, 1);
     b.stack = mci_malloc_array(ctx, n, sizeof *b.stack);
     b.done = mci_malloc_array(ctx, n, sizeof *b.done);
     if (!out->nodes || !out->child || !out->leaf_node || !out->leaf_mesh ||
-        !out->leaf_source || !b.stack || !b.done) {
+        !out->leaf_source || !out->leaf_winding || !b.stack || !b.done) {
         mci_free(ctx, b.stack);
         mci_free(ctx, b.done);
         mci_ptree_free(ctx, out);
@@ -177,6 +178,7 @@ void mci_ptree_free(const mci_ctx *ctx, mci_ptree *t)
     mci_free(ctx, t->leaf_node);
     mci_free(ctx, t->leaf_mesh);
     mci_free(ctx, t->leaf_source);
+    mci_free(ctx, t->leaf_winding);
     memset(t, 0, sizeof *t);
 }
 

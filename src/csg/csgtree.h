@@ -58,6 +58,9 @@ typedef struct mci_ptree {
     uint32_t *leaf_node;          /* per primitive: its node */
     const mcsg_mesh **leaf_mesh;  /* per primitive */
     mcsg_node_id *leaf_source;    /* per primitive: the mcsg_tree leaf */
+    /* Per primitive: 1 when its solid must be found by winding numbers (several shells,
+     * or inside out), set by mci_check_leaves; 0 for one outward shell. */
+    uint8_t *leaf_winding;
     size_t leaf_count;
 } mci_ptree;
 

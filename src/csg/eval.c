@@ -587,7 +587,8 @@ static mcsg_status find_copies(eval_state *e, mcsg_error *err)
     for (size_t i = 1, run = 0; i < n; i++) {
         if (!same_key(&order[i], &order[i - 1]))
             run = i;
-        for (size_t j = run; j < i; j++)
+        /* Copies share their stand-in's labels, which assume one outward shell. */
+        for (size_t j = run; j < i && !e->tree.leaf_winding[order[i].leaf]; j++)
             if (same_mesh(order[i].mesh, order[j].mesh)) {
                 alias[order[i].leaf] = alias[order[j].leaf];
                 copies++;

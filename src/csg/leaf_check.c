@@ -1,7 +1,11 @@
 /*
  * The evaluator's input contract, checked before any geometry: every primitive must be
- * a closed, consistently oriented, edge-manifold mesh with finite coordinates, no
- * zero-area triangles (they have no plane) and facing outward. A leaf that breaks it is
+ * a closed, consistently oriented, edge-manifold mesh with finite coordinates and no
+ * zero-area triangles (they have no plane). It may have several shells, nested or apart,
+ * and shells may face inward: the primitive's solid is where its winding number is
+ * positive, so an inward shell inside another is a cavity and one on its own is empty.
+ * Such primitives are marked for classification by winding numbers
+ * (mci_ptree.leaf_winding). A leaf that breaks the contract is
  * named in a one-line message (its label says which file or primitive it came from, and
  * where in the CSG text) with the first offending edge, triangle or vertex, so that the
  * user can find it; nothing is evaluated. Self-intersecting leaves are looked for up
@@ -18,7 +22,7 @@
 
 typedef struct leaf_check_job {
     const mcsg_tree *tree;
-    const mci_ptree *ptree;
+    mci_ptree *ptree;
     const mci_ctx *ctx;
 } leaf_check_job;
 
@@ -60,18 +64,15 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
     } else if (r->duplicate_triangles) {
         snprintf(out, size, "%zu triangles repeat the three vertices of another, e.g. "
                  "triangle %u", r->duplicate_triangles, r->example_duplicate_triangle);
-    } else if (r->volume_sign == 0) {
+    } else if (r->volume_sign == 0 && r->components == 1) {
         snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
                  "other, e.g. all in one plane)");
-    } else if (r->inverted) {
-        snprintf(out, size, "the mesh is inside out (every triangle faces inward; "
-                 "`meshcsg check -o FIXED` flips it)");
     }
 }
 
 static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 {
-    const leaf_check_job *job = user;
+    leaf_check_job *job = user;
     const mcsg_mesh *m = job->ptree->leaf_mesh[k];
     mcsg_node_id node = job->ptree->leaf_source[k];
     const char *label = mcsg_tree_node_label(job->tree, node);
@@ -81,8 +82,10 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     if (st != MCSG_OK)
         return st;
     describe_problem(m, &report, problem, sizeof problem);
-    if (problem[0] == '\0')
+    if (problem[0] == '\0') {
+        job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0;
         return MCSG_OK;
+    }
     return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
                     label[0] ? ", " : "", label, problem);
 }
@@ -90,7 +93,7 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
                                           const mci_ptree *ptree, mcsg_error *err);
 
-mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mci_ptree *ptree,
+mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
 {
     leaf_check_job job = {tree, ptree, ctx};

@@ -4,12 +4,13 @@
 
 #include "csg/csgtree.h"
 
-/* MCSG_OK when every primitive of ptree is a closed, consistently oriented, outward,
- * edge-manifold mesh with finite coordinates and no zero-area or repeated triangles (and,
- * with ctx->check_self_intersections, does not intersect itself); otherwise
- * MCSG_ERR_INVALID_MESH naming the first such leaf (lowest primitive number) and its
- * first problem. */
-mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, const mci_ptree *ptree,
+/* MCSG_OK when every primitive of ptree is a closed, consistently oriented,
+ * edge-manifold mesh with finite coordinates and no zero-area or repeated triangles, and
+ * encloses some volume if it has one shell (and, with ctx->check_self_intersections, does
+ * not intersect itself); otherwise MCSG_ERR_INVALID_MESH naming the first such leaf
+ * (lowest primitive number) and its first problem. Sets ptree->leaf_winding for the
+ * primitives with several shells or a negative volume. */
+mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err);
 
 /* Called when evaluation failed with MCSG_ERR_INTERNAL: if a primitive intersects

@@ -1,6 +1,7 @@
 /*
  * Exact ray shooting (paper §5.2 first seeds, §5.5): where a point is with respect to a
- * closed mesh, by the parity of the crossings of a ray along +x, symbolically perturbed
+ * closed mesh, by the signed crossings of a ray along +x (the winding number; the paper
+ * counts their parity, which is the same for one outward shell), symbolically perturbed
  * so that rays through edges and vertices are decided consistently (no re-shooting, no
  * nudge). Through the octree, only the leaf's faces in the cells the ray passes through
  * are tested.
@@ -49,14 +50,15 @@ static bool point_on_triangle(const mci_point *p, const mci_plane *plane)
     return mci_orient3d(p, plane) == 0 && mci_point_in_triangle(p, plane, &which) != MCI_OUTSIDE;
 }
 
+static void add_crossing_ahead(const mci_point *p, const double *a, const double *b,
+                               const double *c, const mci_plane *plane, int *winding);
+
 /* One triangle's part in the ray test from p (bounds lo..hi): adds its crossing ahead
  * of p to *winding; false when p lies on the triangle (no ray decides then). */
 static bool ray_crossing(const mci_point *p, const double lo[3], const double hi[3],
                          const double *a, const double *b, const double *c, int *winding)
 {
-    mci_point pa, pb, pc;
     mci_plane plane;
-    int nx, side;
     bool misses_ray, misses_point;
     box_tests(a, b, c, lo, hi, &misses_ray, &misses_point);
     if (misses_ray)
@@ -64,19 +66,27 @@ static bool ray_crossing(const mci_point *p, const double lo[3], const double hi
     mci_plane_init(&plane, a, b, c);
     if (!misses_point && point_on_triangle(p, &plane))
         return false;
+    add_crossing_ahead(p, a, b, c, &plane, winding);
+    return true;
+}
+
+/* The crossing of the perturbed ray from p with triangle a, b, c (plane `plane`), which
+ * does not hold p, added to *winding. */
+static void add_crossing_ahead(const mci_point *p, const double *a, const double *b,
+                               const double *c, const mci_plane *plane, int *winding)
+{
+    mci_point pa, pb, pc;
+    int nx, side;
     mci_point_explicit(&pa, a);
     mci_point_explicit(&pb, b);
     mci_point_explicit(&pc, c);
     nx = mci_orient2d_projected(&pa, &pb, &pc, 0); /* sign of the normal's x */
     if (nx == 0 || perturbed_orient_yz(&pa, &pb, p) != nx ||
         perturbed_orient_yz(&pb, &pc, p) != nx || perturbed_orient_yz(&pc, &pa, p) != nx)
-        return true;
-    side = mci_orient3d(p, &plane);
-    if (side == 0)
-        return false; /* unreachable: p would be on the triangle */
+        return;
+    side = mci_orient3d(p, plane); /* not 0: p is not on the triangle */
     if (side == -nx)
         *winding += nx; /* crossed ahead of p; leaving the solid when nx > 0 */
-    return true;
 }
 
 mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m)
@@ -163,22 +173,99 @@ static bool collect_ray_faces(const mci_ctx *ctx, const mci_octree *o, uint32_t 
     return true;
 }
 
-bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
-                          uint32_t m, mci_ray_scratch *s, mci_label *label)
+bool mci_ray_winding_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                            uint32_t m, mci_ray_scratch *s, int *winding, bool *decided)
 {
     double lo[3], hi[3];
-    int winding = 0;
     mci_point_bounds(p, lo, hi);
+    *winding = 0;
+    *decided = false;
     if (!collect_ray_faces(ctx, o, m, lo, hi, s))
         return false;
-    *label = MCI_LABEL_UNKNOWN;
     for (size_t i = 0; i < s->face_count; i++) {
         uint32_t f = s->faces[i];
         if (!ray_crossing(p, lo, hi, mci_octree_face_vertex(o, f, 0),
                           mci_octree_face_vertex(o, f, 1), mci_octree_face_vertex(o, f, 2),
-                          &winding))
+                          winding))
             return true;
     }
-    *label = winding > 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
+    *decided = true;
+    return true;
+}
+
+/* The sign of the normal's component `axis` of the plane through a, b, c. */
+static int normal_sign(const double *a, const double *b, const double *c, int axis)
+{
+    mci_point pa, pb, pc;
+    mci_point_explicit(&pa, a);
+    mci_point_explicit(&pb, b);
+    mci_point_explicit(&pc, c);
+    return mci_orient2d_projected(&pa, &pb, &pc, axis);
+}
+
+/* Face a, b, c holds p, which lies in plane `at`: +1 or -1 when the face lies in that
+ * plane facing the same or the other way, 0 when it does not lie in it. */
+static int coincident_orientation(const double *a, const double *b, const double *c,
+                                  const mci_plane *at)
+{
+    int axis, sign;
+    if (mci_orient3d_vertex(a, at) != 0 || mci_orient3d_vertex(b, at) != 0 ||
+        mci_orient3d_vertex(c, at) != 0 || (axis = mci_plane_projection_axis(at, &sign)) < 0)
+        return 0;
+    return normal_sign(a, b, c, axis) * sign;
+}
+
+/* The two windings from the ray's: it starts at p + (0, e, e^2), on side sigma of `at`
+ * (0 when the plane is across the ray, which then leaves it towards nx), and crosses the
+ * faces holding p right away when it heads towards the plane (their net orientation
+ * `coincident`, against at's normal). Behind those faces the number is `coincident`
+ * more than in front. */
+static void windings_beside(const mci_plane *at, int beyond, int coincident, int *behind,
+                            int *in_front)
+{
+    int n[3], sigma, side, value;
+    for (int k = 0; k < 3; k++)
+        n[k] = normal_sign(at->a, at->b, at->c, k);
+    sigma = n[1] != 0 ? n[1] : n[2];
+    side = sigma != 0 ? sigma : n[0];
+    value = beyond + (sigma * n[0] < 0 ? n[0] * coincident : 0);
+    *in_front = side > 0 ? value : value - coincident;
+    *behind = *in_front + coincident;
+}
+
+bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                               uint32_t m, const mci_plane *at, mci_ray_scratch *s,
+                               int *behind, int *in_front, bool *decided)
+{
+    double lo[3], hi[3];
+    int beyond = 0, coincident = 0;
+    mci_point_bounds(p, lo, hi);
+    *decided = false;
+    if (!collect_ray_faces(ctx, o, m, lo, hi, s))
+        return false;
+    for (size_t i = 0; i < s->face_count; i++) {
+        const double *a = mci_octree_face_vertex(o, s->faces[i], 0),
+                     *b = mci_octree_face_vertex(o, s->faces[i], 1),
+                     *c = mci_octree_face_vertex(o, s->faces[i], 2);
+        if (!ray_crossing(p, lo, hi, a, b, c, &beyond)) { /* the face holds p */
+            int orientation = coincident_orientation(a, b, c, at);
+            if (orientation == 0)
+                return true; /* a face across the plane meets it at p */
+            coincident += orientation;
+        }
+    }
+    windings_beside(at, beyond, coincident, behind, in_front);
+    *decided = true;
+    return true;
+}
+
+bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                          uint32_t m, mci_ray_scratch *s, mci_label *label)
+{
+    int winding;
+    bool decided;
+    if (!mci_ray_winding_octree(ctx, p, o, m, s, &winding, &decided))
+        return false;
+    *label = !decided ? MCI_LABEL_UNKNOWN : winding > 0 ? MCI_LABEL_IN : MCI_LABEL_OUT;
     return true;
 }

@@ -21,6 +21,22 @@ typedef struct mci_ray_scratch {
 
 void mci_ray_scratch_free(const mci_ctx *ctx, mci_ray_scratch *s);
 
+/* The winding number of leaf m of octree o at p: the crossings of the perturbed ray
+ * along +x, +1 where it leaves through a face (the face's normal has a positive x) and
+ * -1 where it enters. *decided is false when p lies on a face of m (no ray decides then).
+ * Returns false when out of memory. */
+bool mci_ray_winding_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                            uint32_t m, mci_ray_scratch *s, int *winding, bool *decided);
+
+/* Leaf m's winding numbers just behind and just in front of the plane `at` (as its
+ * normal points) at p, a point of that plane where no face of m crosses the plane: the
+ * faces holding p all lie in it (coincident faces, counted with their orientation: one
+ * facing like `at` adds one behind). *decided is false when a face across the plane
+ * holds p. Returns false when out of memory. */
+bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
+                               uint32_t m, const mci_plane *at, mci_ray_scratch *s,
+                               int *behind, int *in_front, bool *decided);
+
 /* mci_ray_label for the leaf m of octree o, testing only m's faces in the cells the ray
  * passes through (paper §5.2). Returns false when out of memory (*label unset). */
 bool mci_ray_label_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
