@@ -119,10 +119,11 @@ typedef struct mcsg_options {
                                  steps they spin (yielding) up to 2 ms, then sleep */
     mcsg_progress_fn progress; /* NULL: no progress reports */
     void *progress_user;       /* passed to progress */
-    int check_self_intersections; /* mcsg_eval: nonzero tests every leaf for
-                                     self-intersections before evaluating (exact, costs
-                                     about as much as an evaluation) and names the first
-                                     such leaf with MCSG_ERR_INVALID_MESH */
+    int check_self_intersections; /* mcsg_eval: nonzero tests every shell of every leaf
+                                     for self-intersections before evaluating (exact,
+                                     costs about as much as an evaluation; shells of one
+                                     leaf may cross each other) and names the first such
+                                     leaf with MCSG_ERR_INVALID_MESH */
     int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
                                    triangles that cross each other (exact, costs about as
                                    much as an evaluation; see mcsg_output_check) */
@@ -539,8 +540,9 @@ typedef struct mcsg_eval_stats {
  * (mcsg_check_report_is_valid, and a non-zero volume when it has one component): closed,
  * consistently oriented, edge-manifold, finite, without zero-area or repeated triangles.
  * A leaf is the set where its winding number is positive: it may have several shells,
- * facing out or in, that neither cross nor touch (an inward shell inside an outward one is
- * a cavity, one on its own is empty; see docs/robustness.md). This is checked first;
+ * facing out or in, nested or overlapping but not touching (overlapping outward shells are
+ * their union, an inward shell inside an outward one is a cavity, one on its own is
+ * empty; see docs/robustness.md). This is checked first;
  * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
  * (its label: file or primitive, and position in the CSG text) and an example of the
  * problem. Leaves must also not intersect themselves; that is checked up front only with

@@ -493,6 +493,10 @@ static void add_shells(csg_tree_spec *t)
         l->inner_scale[1] = l->inner_scale[0] * uniform_in(&rng, 0.3, 0.8);
         for (int k = 0; k < 3; k++)
             l->inward[k] = test_random_int(&rng, 0, 2) == 0;
+        for (int k = 0; k < 2; k++)
+            if (test_random_int(&rng, 0, 1)) /* crossing the primitive, or the other copy */
+                for (int axis = 0; axis < 3; axis++)
+                    l->inner_shift[k][axis] = uniform_in(&rng, -0.6, 0.6);
     }
 }
 
@@ -577,14 +581,18 @@ static mcsg_status make_primitive_mesh(const csg_leaf_spec *l, mcsg_mesh *out, m
 }
 
 /* Shell k of the leaf (0: the primitive, else its copy k - 1 scaled about the box
- * centre c) written at vertex `base` and triangle `tri` of out. */
-static void write_shell(const csg_leaf_spec *l, const mcsg_mesh *m, const double c[3], int k,
-                        mcsg_mesh *out)
+ * centre c and moved by its shift times the box size) written at vertex `base` and
+ * triangle `tri` of out. */
+static void write_shell(const csg_leaf_spec *l, const mcsg_mesh *m, const double c[3],
+                        const double size[3], int k, mcsg_mesh *out)
 {
     double s = k == 0 ? 1 : l->inner_scale[k - 1];
+    const double *shift = k == 0 ? NULL : l->inner_shift[k - 1];
     size_t base = (size_t)k * m->vertex_count, tri = (size_t)k * m->triangle_count;
     for (size_t v = 0; v < 3 * m->vertex_count; v++)
-        out->vertices[3 * base + v] = k == 0 ? m->vertices[v] : c[v % 3] + s * (m->vertices[v] - c[v % 3]);
+        out->vertices[3 * base + v] =
+            k == 0 ? m->vertices[v]
+                   : c[v % 3] + s * (m->vertices[v] - c[v % 3]) + shift[v % 3] * size[v % 3];
     for (size_t t = 0; t < m->triangle_count; t++)
         for (int i = 0; i < 3; i++)
             out->triangles[3 * (tri + t) + (size_t)i] =
@@ -595,7 +603,8 @@ static void write_shell(const csg_leaf_spec *l, const mcsg_mesh *m, const double
 static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
 {
     mcsg_mesh m;
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, c[3];
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double c[3], size[3];
     mcsg_status st = make_primitive_mesh(l, &m, err);
     int shells = 1 + l->inner;
     if (st != MCSG_OK || (l->inner == 0 && !l->inward[0])) {
@@ -606,8 +615,10 @@ static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_e
         lo[v % 3] = fmin(lo[v % 3], m.vertices[v]);
         hi[v % 3] = fmax(hi[v % 3], m.vertices[v]);
     }
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         c[k] = (lo[k] + hi[k]) / 2;
+        size[k] = hi[k] - lo[k];
+    }
     out->vertex_count = (size_t)shells * m.vertex_count;
     out->triangle_count = (size_t)shells * m.triangle_count;
     out->vertices = malloc(3 * out->vertex_count * sizeof *out->vertices);
@@ -622,7 +633,7 @@ static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_e
         return MCSG_ERR_NOMEM;
     }
     for (int k = 0; k < shells; k++)
-        write_shell(l, &m, c, k, out);
+        write_shell(l, &m, c, size, k, out);
     mcsg_mesh_free(&m, NULL);
     return st;
 }

@@ -29,9 +29,10 @@ typedef enum csg_shape { CSG_CUBE, CSG_SPHERE, CSG_CYLINDER, CSG_MODEL } csg_sha
  * cubes turned by multiples of 15 and 45 degrees, plates drilled by cylinders), turned
  * and moved far from the origin: faces meant to be coplanar are 1e-5 apart or tilted by
  * 1e-16, features below the spacing of doubles; shells: free trees whose primitives
- * carry smaller copies of themselves inside (one or two, each facing out or in), and may
- * face inward themselves: leaves whose solid is where their winding number is positive,
- * with nested shells, cavities, and shells that are empty on their own. */
+ * carry smaller copies of themselves (one or two, inside or crossing them, each facing
+ * out or in), and may face inward themselves: leaves whose solid is where their winding
+ * number is positive, with nested and overlapping shells, cavities, and shells that are
+ * empty on their own. */
 typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED, CSG_EXPORT, CSG_SHELLS } csg_family;
 #define CSG_FAMILIES 5
 /* The families' names, as the case files' first line and the reports write them. */
@@ -44,11 +45,12 @@ typedef struct csg_leaf_spec {
     int center;       /* cube, cylinder */
     int fn;           /* sphere, cylinder */
     int model;        /* index into the models */
-    /* Shells family: inner copies of the primitive (0..2), each scaled by inner_scale[k]
-     * about the centre of the primitive's box; inward[0] turns the primitive itself
-     * inside out, inward[1 + k] the copy k. */
+    /* Shells family: copies of the primitive (0..2), each scaled by inner_scale[k] about
+     * the centre of the primitive's box and moved by inner_shift[k] times the box's size
+     * (0: nested inside; else crossing it); inward[0] turns the primitive itself inside
+     * out, inward[1 + k] the copy k. */
     int inner;
-    double inner_scale[2];
+    double inner_scale[2], inner_shift[2][3];
     bool inward[3];
     double m[12];     /* row-major 3x4 placement */
 } csg_leaf_spec;

@@ -491,6 +491,23 @@ TEST(leaves_with_several_shells)
     expect_tree_volume("difference", cavity, nested, 0, 0);
     expect_tree_volume("union", triple, cavity, 792, 3);
     expect_tree_volume("union", inverted, cavity, 784, 2);
+    /* Shells crossing each other: [0,10], [5,15] and [2,12] cubes in one leaf. */
+    {
+        const double olo[] = {0, 5, 2}, ohi[] = {10, 15, 12};
+        const bool in_second[] = {false, true, false};
+        char *two = box_shells(olo, ohi, out_out, 2), *three = box_shells(olo, ohi, out_out, 3);
+        char *minus = box_shells(olo, ohi, in_second, 2);
+        expect_tree_volume("union", two, "", 1875, 1);
+        expect_tree_volume("union", three, "", 3000 - 980 + 125, 1);
+        expect_tree_volume("union", minus, "", 875, 1); /* the inward cube cuts the other */
+        expect_tree_volume("difference", two, slab, 1675, 1);
+        expect_tree_volume("difference", "cube(12);", two, 1728 - 1218, 1);
+        expect_tree_volume("intersection", two, three, 1875, 1);
+        expect_tree_volume("difference", three, two, 2145 - 1875, 1);
+        free(two);
+        free(three);
+        free(minus);
+    }
     free(nested);
     free(cavity);
     free(hollow);

@@ -174,7 +174,7 @@ static void free_work(mci_leaf_work *w)
     void *all[] = {w->pv, w->pface, w->plocal, w->mate, w->is_sep, w->sep, w->walls, w->region,
                    w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
                    w->slot_of_leaf, w->labels, w->needed, w->list, w->scratch,
-                   w->leaf_labels, w->blist_slot, w->cand_winding, w->wind, w->face_front};
+                   w->leaf_labels, w->blist_slot, w->cand_winding, w->wind, w->coin, w->own_front};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
     for (size_t k = 0; w->copy_list && k < w->ncopies; k++)
@@ -206,8 +206,6 @@ mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint
     st = mci_leaf_regions(&w);
     if (st == MCSG_OK)
         st = mci_leaf_trim(&w);
-    if (st == MCSG_OK && !w.rejected)
-        st = mci_leaf_shell_fronts(&w);
     if (st == MCSG_OK && (!w.rejected || w.ncopies > 0)) {
         st = mci_leaf_label(&w);
         if (st == MCSG_OK)

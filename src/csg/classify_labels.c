@@ -21,21 +21,35 @@ static mcsg_status winding_candidates(mci_leaf_work *w)
         return mci_fail_nomem(w->err, "classifying faces");
     for (size_t c = 0; c < w->ncand; c++)
         any |= (w->cand_winding[c] = winding[w->cand[c]]) != 0;
+    if (winding[w->leaf]) {
+        if (!(w->own_front = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *w->own_front)))
+            return mci_fail_nomem(w->err, "classifying faces");
+        for (size_t r = 0; r < w->nreg; r++)
+            w->own_front[r] = MCI_WIND_UNKNOWN;
+    }
     if (!any)
         return MCSG_OK;
-    if (!(w->wind = mci_malloc_array(w->ctx, w->nreg * w->ncand + 1, sizeof *w->wind)))
+    w->wind = mci_malloc_array(w->ctx, w->nreg * w->ncand + 1, sizeof *w->wind);
+    w->coin = mci_calloc_array(w->ctx, w->nreg * w->ncand + 1, sizeof *w->coin);
+    if (!w->wind || !w->coin)
         return mci_fail_nomem(w->err, "classifying faces");
     for (size_t i = 0; i < w->nreg * w->ncand; i++)
         w->wind[i] = MCI_WIND_UNKNOWN;
     return MCSG_OK;
 }
 
-/* Region r's label and winding number with respect to winding candidate c, from the
- * ray-given number at a point of the region off that leaf's surface. */
+/* Region r's label and winding numbers with respect to winding candidate c. */
+static void set_windings(mci_leaf_work *w, uint32_t r, size_t c, int32_t behind, int32_t in_front)
+{
+    w->wind[(size_t)r * w->ncand + c] = in_front;
+    w->coin[(size_t)r * w->ncand + c] = behind - in_front;
+    w->labels[(size_t)r * w->ncand + c] = (uint8_t)mci_label_of_windings(behind, in_front);
+}
+
+/* The same from the ray-given number at a point of the region off that leaf's surface. */
 static void set_winding(mci_leaf_work *w, uint32_t r, size_t c, int32_t number)
 {
-    w->wind[(size_t)r * w->ncand + c] = number;
-    w->labels[(size_t)r * w->ncand + c] = (uint8_t)mci_label_of_windings(number, number);
+    set_windings(w, r, c, number, number);
 }
 
 bool mci_leaf_label_by_ray(mci_leaf_work *w, uint32_t r, size_t c, const mci_point *v)
@@ -173,10 +187,8 @@ static bool label_from_inside(mci_leaf_work *w, uint32_t r, size_t c, const mci_
     if (!mci_ray_windings_on_plane(w->ctx, q, &w->s->octree, w->cand[c], at, &w->ray, &behind,
                                    &in_front, &decided))
         return false;
-    if (decided) {
-        w->wind[(size_t)r * w->ncand + c] = in_front;
-        w->labels[(size_t)r * w->ncand + c] = (uint8_t)mci_label_of_windings(behind, in_front);
-    }
+    if (decided)
+        set_windings(w, r, c, behind, in_front);
     return true;
 }
 
@@ -235,28 +247,66 @@ static void slot_points(const mci_leaf_work *w, size_t k, mci_point *x, mci_poin
     mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, far);
 }
 
-/* Region r's winding number and label for winding candidate c, whose face h holds the
- * separator between r (slot k, local label `here`) and region `from` across it. */
-static void winding_across(mci_leaf_work *w, uint32_t from, uint32_t r, size_t k, size_t c,
-                           uint32_t h, mci_label here)
+/* The winding numbers across separator slot k of region r from region `from` (across
+ * the slot's mate), for the leaf whose faces hold it in sep[begin .. end): one step per
+ * shell (faces of one group at the separator are one sheet of it). */
+static mci_wind_sum wind_steps(mci_leaf_work *w, size_t k, size_t begin, size_t end)
 {
     const mci_scene *s = w->s;
-    size_t k1 = w->mate[k];
-    mci_point x, y, far;
-    mci_label there;
-    int32_t front;
-    slot_points(w, k1, &x, &y, &far);
-    w->stats->local_tests++;
-    there = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x, &y, &far, h);
-    w->labels[(size_t)r * w->ncand + c] =
-        (uint8_t)mci_wind_across(w->wind[(size_t)from * w->ncand + c], there, here, &front);
-    w->wind[(size_t)r * w->ncand + c] = front;
+    mci_wind_sum sum = {0, 0, false};
+    uint32_t seen[8];
+    size_t nseen = 0, k1 = w->mate[k];
+    mci_point x, y, far, x1, y1, far1;
+    slot_points(w, k, &x, &y, &far);
+    slot_points(w, k1, &x1, &y1, &far1);
+    for (size_t e = begin; e < end; e++) {
+        uint32_t h = w->sep[e].ref, g = mci_scene_face_group(s, h);
+        mci_label to, from;
+        bool repeated = false;
+        for (size_t i = 0; i < nseen; i++)
+            repeated |= seen[i] == g;
+        if (repeated)
+            continue;
+        if (nseen == sizeof seen / sizeof seen[0]) {
+            sum.unknown = true; /* more shells through one curve than looked at */
+            break;
+        }
+        seen[nseen++] = g;
+        w->stats->local_tests += 2;
+        to = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h);
+        from = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x1, &y1, &far1, h);
+        mci_wind_sheet(&sum, from, to);
+    }
+    return sum;
+}
+
+/* Region r's number and label for winding candidate c from region `from`'s. */
+static void winding_across(mci_leaf_work *w, uint32_t from, uint32_t r, size_t c, mci_wind_sum sum)
+{
+    size_t at = (size_t)from * w->ncand + c;
+    int32_t before = w->wind[at];
+    if (before == MCI_WIND_UNKNOWN || sum.unknown) {
+        w->wind[(size_t)r * w->ncand + c] = MCI_WIND_UNKNOWN;
+        w->labels[(size_t)r * w->ncand + c] = MCI_LABEL_UNKNOWN;
+        return;
+    }
+    set_windings(w, r, c, before + sum.front + w->coin[at] + sum.coincident, before + sum.front);
+}
+
+/* This leaf's own number in front of region r from region `from`'s, across shells of it
+ * that cross the region's face. */
+static void own_across(mci_leaf_work *w, uint32_t from, uint32_t r, mci_wind_sum sum)
+{
+    int32_t before = w->own_front[from];
+    w->own_front[r] = before == MCI_WIND_UNKNOWN || sum.unknown ? MCI_WIND_UNKNOWN
+                                                               : before + sum.front;
 }
 
 /* Labels of region r, whose piece has edge slot k, with respect to the leaves holding
  * that slot, by local tests (only those still unknown if only_unknown). A winding leaf's
- * number is carried over from region `from` across the slot (mate of k), and left alone
- * when from is MCI_NONE. */
+ * number (and this leaf's own, where another of its shells holds the slot) is carried
+ * over from region `from` across the slot (mate of k), and left alone when from is
+ * MCI_NONE. Entries of one leaf are consecutive (sorted by face). */
 static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_unknown,
                             uint32_t from)
 {
@@ -264,19 +314,31 @@ static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_un
     uint8_t *to = w->labels + (size_t)r * w->ncand;
     uint64_t key = mci_edge_key(mci_leaf_slot_from(w, k), mci_leaf_slot_to(w, k));
     mci_point x, y, far;
+    size_t e = mci_leaf_find_separator(w, key), end;
     slot_points(w, k, &x, &y, &far);
-    for (size_t e = mci_leaf_find_separator(w, key); e < w->nsep && w->sep[e].key == key; e++) {
-        uint32_t h = w->sep[e].ref, c = w->slot_of_leaf[s->octree.face_leaf[h]];
-        mci_label here;
-        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN) ||
-            (w->cand_winding[c] && from == MCI_NONE))
+    for (; e < w->nsep && w->sep[e].key == key; e = end) {
+        uint32_t leaf = s->octree.face_leaf[w->sep[e].ref], c = w->slot_of_leaf[leaf];
+        for (end = e + 1; end < w->nsep && w->sep[end].key == key &&
+                          s->octree.face_leaf[w->sep[end].ref] == leaf;)
+            end++;
+        if (leaf == w->leaf) {
+            if (w->own_front && from != MCI_NONE && (!only_unknown ||
+                                                     w->own_front[r] == MCI_WIND_UNKNOWN))
+                own_across(w, from, r, wind_steps(w, k, e, end));
             continue;
-        w->stats->local_tests++;
-        here = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h);
-        if (w->cand_winding[c])
-            winding_across(w, from, r, k, c, h, here);
-        else
-            to[c] = (uint8_t)here;
+        }
+        if (c == MCI_NONE || !w->needed[c] || (only_unknown && to[c] != MCI_LABEL_UNKNOWN))
+            continue;
+        if (w->cand_winding[c]) {
+            if (from != MCI_NONE)
+                winding_across(w, from, r, c, wind_steps(w, k, e, end));
+            continue;
+        }
+        for (size_t i = e; i < end && !(only_unknown && to[c] != MCI_LABEL_UNKNOWN); i++) {
+            w->stats->local_tests++;
+            to[c] = (uint8_t)mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x,
+                                             &y, &far, w->sep[i].ref);
+        }
     }
 }
 
@@ -285,10 +347,17 @@ static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_un
 static void inherit_labels(mci_leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
 {
     memcpy(w->labels + (size_t)r2 * w->ncand, w->labels + (size_t)r1 * w->ncand, w->ncand);
-    if (w->wind)
+    if (w->wind) {
         memcpy(w->wind + (size_t)r2 * w->ncand, w->wind + (size_t)r1 * w->ncand,
                w->ncand * sizeof *w->wind);
+        memcpy(w->coin + (size_t)r2 * w->ncand, w->coin + (size_t)r1 * w->ncand,
+               w->ncand * sizeof *w->coin);
+    }
+    if (w->own_front)
+        w->own_front[r2] = w->own_front[r1];
     local_labels_at(w, r2, k, false, r1);
+    if (w->own_front && w->own_front[r2] == MCI_WIND_UNKNOWN && !w->out_of_memory)
+        mci_leaf_own_seed(w, r2);
 }
 
 /* Whether separator slot k lies on the surface of leaf m. */
@@ -299,6 +368,32 @@ static bool separator_on_leaf(const mci_leaf_work *w, size_t k, uint32_t m)
         if (w->s->octree.face_leaf[w->sep[e].ref] == m)
             return true;
     return false;
+}
+
+/* This leaf's own numbers still unknown (a region whose pieces give no point to cast a
+ * ray from, and the regions reached from it): taken from a neighbour across a
+ * separator, changed by the shells of this leaf holding it, until nothing changes. */
+static void fill_unknown_own(mci_leaf_work *w)
+{
+    bool changed = true;
+    while (changed) {
+        changed = false;
+        for (uint32_t r = 0; r < w->nreg; r++)
+            for (uint32_t i = w->sep_start[r];
+                 w->own_front[r] == MCI_WIND_UNKNOWN && i < w->sep_start[r + 1]; i++) {
+                uint32_t k = w->sep_slots[i], r2;
+                if (w->mate[k] == MCI_NONE)
+                    continue; /* a wall */
+                r2 = w->region[w->mate[k] / 3];
+                if (w->own_front[r2] == MCI_WIND_UNKNOWN)
+                    continue;
+                if (separator_on_leaf(w, k, w->leaf))
+                    local_labels_at(w, r, k, true, r2);
+                else
+                    w->own_front[r] = w->own_front[r2];
+                changed |= w->own_front[r] != MCI_WIND_UNKNOWN;
+            }
+    }
 }
 
 /* memchr first: a leaf that hundreds of others cross (the ring of a ring of spheres) has
@@ -344,8 +439,10 @@ static void fill_unknown_labels(mci_leaf_work *w)
                         continue;
                     if (!separator_on_leaf(w, k, w->cand[c])) {
                         lab[c] = there;
-                        if (w->cand_winding[c])
+                        if (w->cand_winding[c]) {
                             w->wind[(size_t)r * w->ncand + c] = w->wind[(size_t)r2 * w->ncand + c];
+                            w->coin[(size_t)r * w->ncand + c] = w->coin[(size_t)r2 * w->ncand + c];
+                        }
                     } else if (w->cand_winding[c]) {
                         local_labels_at(w, r, k, true, r2);
                     }
@@ -371,6 +468,8 @@ static mcsg_status label_regions(mci_leaf_work *w)
         if (seen[start])
             continue;
         seed_region(w, start);
+        if (w->own_front && !w->out_of_memory)
+            mci_leaf_own_seed(w, start);
         seen[start] = 1;
         queue[tail++] = start;
         while (head < tail) {
@@ -390,6 +489,8 @@ static mcsg_status label_regions(mci_leaf_work *w)
     if (w->out_of_memory)
         return mci_fail_nomem(w->err, "classifying faces");
     fill_unknown_labels(w);
+    if (w->own_front)
+        fill_unknown_own(w);
     return MCSG_OK;
 }
 

@@ -3,7 +3,6 @@
  * rest of the pipeline sees csg/classify.h. mci_classify_leaf (classify.c) runs:
  *   mci_leaf_regions  (classify_regions.c) pieces, separators, walls, edge pairing,
  *                     regions
- *   mci_leaf_shell_fronts (classify_winding.c) a winding leaf's own number per shell
  *   mci_leaf_trim     (classify_labels.c)  the candidates and the trimmed CSGlist
  *   mci_leaf_label    (classify_labels.c)  labels of every region: seeds by rays,
  *                     inheritance across separators by the local test, copies
@@ -43,11 +42,12 @@ typedef struct mci_leaf_work {
     /* Winding leaves (mci_ptree.leaf_winding, classify_winding.c). cand_winding: per
      * candidate, 1 for a winding leaf; wind (NULL when no candidate is one): nreg x
      * ncand, that leaf's winding number in front of the region, MCI_WIND_UNKNOWN if not
-     * known yet; face_front (NULL unless this leaf is one): per face of the leaf, its
-     * winding number in front of the face's shell. */
+     * known yet, and coin (the same size) how much more it is behind the region (not 0
+     * where the region lies in that leaf's surface); own_front (NULL unless this leaf is
+     * one): per region, this leaf's winding number in front of it, or MCI_WIND_UNKNOWN. */
     uint8_t *cand_winding;
-    int32_t *wind;
-    int32_t *face_front;
+    int32_t *wind, *coin;
+    int32_t *own_front;
     uint8_t *needed;  /* per candidate: in a subtree of the trimmed CSGlist */
     mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
     size_t nlist;
@@ -110,15 +110,22 @@ bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only
 /* Winding numbers (classify_winding.c). */
 #define MCI_WIND_UNKNOWN INT32_MIN
 
-/* face_front for a winding leaf (nothing otherwise). */
-mcsg_status mci_leaf_shell_fronts(mci_leaf_work *w);
+/* own_front[r] by a ray from a point inside one of region r's pieces; false when no
+ * piece gives a point whose ray decides (w->out_of_memory set when out of memory). */
+bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r);
 /* The label of a region with the winding numbers behind and in front of it. */
 mci_label mci_label_of_windings(int32_t behind, int32_t in_front);
-/* A winding leaf's number in front of a region (*to_front) and the region's label, from
- * the number in front of the region across a separator on that leaf's surface and the
- * local labels of both regions there (UNKNOWN when something is unknown). */
-mci_label mci_wind_across(int32_t from_front, mci_label from_local, mci_label to_local,
-                          int32_t *to_front);
+/* A winding leaf's numbers across a separator on its surface, summed over the shells
+ * that hold it: how much the number in front of the region grows from the region before
+ * (`front`), and how much the excess behind it over in front does (`coincident`: a
+ * region lying in a shell has one more, or one less, behind). */
+typedef struct mci_wind_sum {
+    int32_t front, coincident;
+    bool unknown;
+} mci_wind_sum;
+/* Adds one shell holding the separator, with the local labels of the region before and
+ * of the region after with respect to it. */
+void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local);
 /* A point strictly inside the triangle a, b, c (input vertices): where a line through its
  * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
  * vertices; `ends` holds the line's two ends, which the point refers to). False when the

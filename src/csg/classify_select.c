@@ -192,8 +192,7 @@ static int region_accepts(mci_leaf_work *w, uint32_t r, size_t k)
  * (not 0 in front and 1 behind): then it bounds nothing of the leaf's solid. */
 static bool off_own_boundary(const mci_leaf_work *w, uint32_t r)
 {
-    return w->face_front &&
-           w->face_front[w->pface[w->reg_pieces[w->reg_start[r]]] - w->face_base] != 0;
+    return w->own_front && w->own_front[r] != 0;
 }
 
 /* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */
@@ -202,6 +201,9 @@ static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
     bool self = k == w->ncopies, rejected = self ? w->rejected : w->copy_nlist[k] == SIZE_MAX;
     for (uint32_t r = 0; r < w->nreg; r++) {
         int accepts = 0;
+        if (w->own_front && w->own_front[r] == MCI_WIND_UNKNOWN)
+            return mci_fail(w->err, MCSG_ERR_INTERNAL, "leaf %u: the winding number of a "
+                            "region could not be decided", w->leaf);
         if (!rejected && !off_own_boundary(w, r)) {
             accepts = region_accepts(w, r, k);
             if (accepts < 0 && mci_leaf_labels_from_inside(w, r, false))

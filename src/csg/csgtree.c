@@ -156,10 +156,13 @@ mcsg_status mci_ptree_build(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree
     out->leaf_mesh = mci_malloc_array(ctx, n, sizeof *out->leaf_mesh);
     out->leaf_source = mci_malloc_array(ctx, n, sizeof *out->leaf_source);
     out->leaf_winding = mci_calloc_array(ctx, n, 1);
+    out->leaf_shell = mci_calloc_array(ctx, n, sizeof *out->leaf_shell);
+    out->leaf_shells = mci_calloc_array(ctx, n, sizeof *out->leaf_shells);
     b.stack = mci_malloc_array(ctx, n, sizeof *b.stack);
     b.done = mci_malloc_array(ctx, n, sizeof *b.done);
     if (!out->nodes || !out->child || !out->leaf_node || !out->leaf_mesh ||
-        !out->leaf_source || !out->leaf_winding || !b.stack || !b.done) {
+        !out->leaf_source || !out->leaf_winding || !out->leaf_shell || !out->leaf_shells ||
+        !b.stack || !b.done) {
         mci_free(ctx, b.stack);
         mci_free(ctx, b.done);
         mci_ptree_free(ctx, out);
@@ -179,6 +182,10 @@ void mci_ptree_free(const mci_ctx *ctx, mci_ptree *t)
     mci_free(ctx, t->leaf_mesh);
     mci_free(ctx, t->leaf_source);
     mci_free(ctx, t->leaf_winding);
+    for (size_t l = 0; t->leaf_shell && l < t->leaf_count; l++)
+        mci_free(ctx, t->leaf_shell[l]);
+    mci_free(ctx, t->leaf_shell);
+    mci_free(ctx, t->leaf_shells);
     memset(t, 0, sizeof *t);
 }
 

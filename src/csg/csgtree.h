@@ -61,6 +61,10 @@ typedef struct mci_ptree {
     /* Per primitive: 1 when its solid must be found by winding numbers (several shells,
      * or inside out), set by mci_check_leaves; 0 for one outward shell. */
     uint8_t *leaf_winding;
+    /* Per primitive of several shells (NULL for the others): each triangle's shell,
+     * 0 .. leaf_shells[l] - 1 (set by mci_check_leaves, owned). */
+    uint32_t **leaf_shell;
+    uint32_t *leaf_shells;
     size_t leaf_count;
 } mci_ptree;
 

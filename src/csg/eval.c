@@ -90,6 +90,8 @@ typedef struct eval_state {
     mci_trimmed_list *trimmed; /* per primitive, from the whole-face decision */
     mcsg_eval_stats stats;
     bool no_whole_faces; /* split and classify every touched face (the fallback in run) */
+    uint32_t *face_group; /* per global face (see mci_octree_params), NULL when no
+                             primitive has several shells */
 } eval_state;
 
 static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
@@ -626,15 +628,43 @@ static mcsg_status copies_meet_coplanar_faces(eval_state *e, bool *meet, mcsg_er
     return MCSG_OK;
 }
 
+/* Face groups when a primitive has several shells: each shell its own group, so that
+ * shells of one leaf that cross are intersected like different leaves. Faces dropped
+ * whole are then not looked for: that decision takes a face's leaf to be clean. */
+static mcsg_status group_shells(eval_state *e, mcsg_error *err)
+{
+    const mci_ptree *t = &e->tree;
+    size_t faces = 0, next = t->leaf_count;
+    bool any = false;
+    for (size_t l = 0; l < t->leaf_count; l++) {
+        faces += t->leaf_mesh[l]->triangle_count;
+        any |= t->leaf_shell[l] != NULL;
+    }
+    if (!any)
+        return MCSG_OK;
+    if (!(e->face_group = mci_malloc_array(&e->ctx, faces + 1, sizeof *e->face_group)))
+        return mci_fail_nomem(err, "grouping shells");
+    for (size_t l = 0, f = 0; l < t->leaf_count; l++) {
+        const uint32_t *shell = t->leaf_shell[l];
+        for (size_t k = 0; k < t->leaf_mesh[l]->triangle_count; k++)
+            e->face_group[f++] = shell ? (uint32_t)(next + shell[k]) : (uint32_t)l;
+        next += t->leaf_shells[l];
+    }
+    e->no_whole_faces = true;
+    return MCSG_OK;
+}
+
 /* The scene of the pair tests and arrangements, through copies where they are safe. */
 static mcsg_status build_scene(eval_state *e, mcsg_error *err)
 {
     const mcsg_mesh *const *leaves = (const mcsg_mesh *const *)e->tree.leaf_mesh;
     bool coplanar = false;
     mcsg_status st = find_copies(e, err);
+    if (st == MCSG_OK && !e->face_group)
+        st = group_shells(e, err);
     if (st == MCSG_OK)
-        st = mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, e->alias, &e->scene,
-                                     err);
+        st = mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, e->alias,
+                                     e->face_group, &e->scene, err);
     if (st == MCSG_OK && e->alias)
         st = copies_meet_coplanar_faces(e, &coplanar, err);
     if (st != MCSG_OK || !coplanar)
@@ -643,7 +673,8 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
     mci_free(&e->ctx, e->alias);
     e->alias = NULL;
     e->stats.copied_primitives = 0;
-    return mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, NULL, &e->scene, err);
+    return mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, NULL, e->face_group,
+                                   &e->scene, err);
 }
 
 /* Faces that the result drops whole are found from the pair tests, before anything is
@@ -767,6 +798,7 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     mci_scene_free(&e.ctx, &e.scene);
     mci_ptree_free(&e.ctx, &e.tree);
     mci_free(&e.ctx, e.alias);
+    mci_free(&e.ctx, e.face_group);
     mci_pool_stop(&e.ctx);
     e.stats.seconds_total = mci_seconds_now() - t0;
     if (stats)

@@ -67,12 +67,14 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
 
 /* mci_scene_build in three steps. First the octree, the pair tests and what they tell
  * each touched face (arr_of, touch lists, neighbours, arr_contact), their records kept
- * in `pending`; alias (NULL: none) names each leaf's stand-in (see mci_scene.alias).
+ * in `pending`; alias (NULL: none) names each leaf's stand-in (see mci_scene.alias);
+ * face_group (NULL: none; see mci_octree_params) lets shells of one leaf meet.
  * Faces dropped whole can be decided then (mci_decide_whole_faces), before anything is
  * built for them. */
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
-                                    mci_scene *scene, mcsg_error *err);
+                                    const uint32_t *face_group, mci_scene *scene,
+                                    mcsg_error *err);
 
 /* Second, the arrangements from the pending records (then freed): those flagged in
  * arr_dropped (if any) get their corners only, and neither give nor receive points on
@@ -106,6 +108,13 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene);
 void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene);
 
 /* Corner k of global face f. */
+/* The group of face f: its leaf, or its shell in a leaf whose shells may cross (see
+ * mci_octree_params.face_group). Segments of one group do not cross. */
+static inline uint32_t mci_scene_face_group(const mci_scene *scene, uint32_t f)
+{
+    return scene->octree.face_group ? scene->octree.face_group[f] : scene->octree.face_leaf[f];
+}
+
 static inline const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)
 {
     return mci_octree_face_vertex(&scene->octree, f, k);

@@ -408,7 +408,7 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const mci_pair_hit 
         where[0] = end_location(corner, a, h->strict_ends & 1);
         where[1] = end_location(corner, b, h->strict_ends & 2);
         return mci_arr_add_crossing(j->ctx, arr, a, b, other, plane, j->ff->plane_rep[other],
-                                    s->octree.face_leaf[other],
+                                    mci_scene_face_group(s, other),
                                     h->along_edge[h->f == arr->face ? 1 : 0], where);
     case MCI_TT_POINT:
         a = hit_end(j->ctx, s, j->vt, arr, h, 0);
@@ -417,7 +417,7 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const mci_pair_hit 
         for (int i = 0; i < 3; i++)
             crease[i] = (j->ff->crease[other] >> i) & 1;
         return mci_arr_add_coplanar(j->ctx, arr, other, plane, crease,
-                                    s->octree.face_leaf[other]);
+                                    mci_scene_face_group(s, other));
     }
 }
 

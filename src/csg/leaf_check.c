@@ -78,10 +78,20 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     const char *label = mcsg_tree_node_label(job->tree, node);
     mcsg_check_report report;
     char problem[400];
-    mcsg_status st = mci_mesh_check(job->ctx, m, &report, err);
-    if (st != MCSG_OK)
+    uint32_t *shell = mci_malloc_array(job->ctx, m->triangle_count + 1, sizeof *shell);
+    mcsg_status st = shell ? mci_mesh_check_shells(job->ctx, m, &report, shell, err)
+                           : mci_fail_nomem(err, "checking the leaves");
+    if (st != MCSG_OK) {
+        mci_free(job->ctx, shell);
         return st;
+    }
     describe_problem(m, &report, problem, sizeof problem);
+    if (problem[0] == '\0' && report.components > 1) {
+        job->ptree->leaf_shell[k] = shell;
+        job->ptree->leaf_shells[k] = (uint32_t)report.components;
+        shell = NULL;
+    }
+    mci_free(job->ctx, shell);
     if (problem[0] == '\0') {
         job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0;
         return MCSG_OK;
@@ -91,7 +101,7 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 }
 
 static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          const mci_ptree *ptree, mcsg_error *err);
+                                          const mci_ptree *ptree, bool whole, mcsg_error *err);
 
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
@@ -99,14 +109,49 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptre
     leaf_check_job job = {tree, ptree, ctx};
     mcsg_status st = mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
     if (st == MCSG_OK && ctx->check_self_intersections)
-        st = find_self_intersecting(ctx, tree, ptree, err);
+        st = find_self_intersecting(ctx, tree, ptree, false, err);
     return st;
 }
 
-/* The first primitive that intersects itself, as an INVALID_MESH error; MCSG_OK if none
- * does (or an allocation failure). */
+/* The crossing pairs of leaf k's mesh, within each of its shells (shells may cross each
+ * other), or over the whole mesh: *pairs and an example (triangle indices of the whole
+ * mesh). */
+static mcsg_status shell_self_intersections(const mci_ctx *ctx, const mci_ptree *ptree, size_t k,
+                                            bool whole, const mcsg_options *opts, size_t *pairs,
+                                            uint32_t example[2], mcsg_error *err)
+{
+    const mcsg_mesh *m = ptree->leaf_mesh[k];
+    const uint32_t *shell = whole ? NULL : ptree->leaf_shell[k];
+    uint32_t *tris, *index;
+    mcsg_status st = MCSG_OK;
+    if (!shell)
+        return mcsg_mesh_self_intersections(m, opts, pairs, example, err);
+    tris = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *tris);
+    index = mci_malloc_array(ctx, m->triangle_count + 1, sizeof *index);
+    *pairs = 0;
+    if (!tris || !index)
+        st = mci_fail_nomem(err, "checking the leaves");
+    for (uint32_t s = 0; st == MCSG_OK && s < ptree->leaf_shells[k] && *pairs == 0; s++) {
+        mcsg_mesh part = {m->vertices, tris, m->vertex_count, 0};
+        for (size_t t = 0; t < m->triangle_count; t++)
+            if (shell[t] == s) {
+                memcpy(tris + 3 * part.triangle_count, m->triangles + 3 * t, 3 * sizeof *tris);
+                index[part.triangle_count++] = (uint32_t)t;
+            }
+        st = mcsg_mesh_self_intersections(&part, opts, pairs, example, err);
+        if (st == MCSG_OK && *pairs > 0)
+            example[0] = index[example[0]], example[1] = index[example[1]];
+    }
+    mci_free(ctx, tris);
+    mci_free(ctx, index);
+    return st;
+}
+
+/* The first primitive that intersects itself (one of its shells crosses itself, or with
+ * `whole` any two of its triangles cross), as an INVALID_MESH error; MCSG_OK if none does
+ * (or an allocation failure). */
 static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          const mci_ptree *ptree, mcsg_error *err)
+                                          const mci_ptree *ptree, bool whole, mcsg_error *err)
 {
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
@@ -119,8 +164,7 @@ static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *t
         const char *label = mcsg_tree_node_label(tree, node);
         size_t pairs;
         uint32_t example[2];
-        mcsg_status st = mcsg_mesh_self_intersections(ptree->leaf_mesh[k], &opts, &pairs,
-                                                      example, err);
+        mcsg_status st = shell_self_intersections(ctx, ptree, k, whole, &opts, &pairs, example, err);
         if (st != MCSG_OK)
             return st;
         if (pairs > 0)
@@ -138,7 +182,9 @@ mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree
     mcsg_status st;
     if (err)
         saved = *err;
-    st = find_self_intersecting(ctx, tree, ptree, &probe);
+    /* Every crossing pair, shells against each other too: shells that touch break the
+     * contract as well, and are found this way. */
+    st = find_self_intersecting(ctx, tree, ptree, true, &probe);
     if (st == MCSG_ERR_INVALID_MESH) {
         if (err)
             *err = probe;

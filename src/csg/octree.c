@@ -183,11 +183,23 @@ static void root_bounds(const mci_octree *t, mci_cell *root)
     make_cube(root);
 }
 
+/* The group of face f (mci_octree_params.face_group). */
+static uint32_t face_group(const mci_octree *t, uint32_t f)
+{
+    return t->face_group ? t->face_group[f] : t->face_leaf[f];
+}
+
+/* Whether face f's leaf has several groups (shells that may cross each other). */
+static bool in_grouped_leaf(const mci_octree *t, uint32_t f)
+{
+    return t->face_group && t->face_group[f] >= t->leaf_count;
+}
+
 static bool cell_is_critical(const mci_octree *t, const mci_cell *cell)
 {
     for (uint32_t i = 1; i < cell->count; i++) {
-        if (t->face_leaf[t->face_ids[cell->first + i]] !=
-            t->face_leaf[t->face_ids[cell->first]])
+        if (face_group(t, t->face_ids[cell->first + i]) !=
+            face_group(t, t->face_ids[cell->first]))
             return true;
     }
     return false;
@@ -640,6 +652,7 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
     b.params.max_cell_faces = params && params->max_cell_faces ? params->max_cell_faces
                                                                : DEFAULT_MAX_CELL_FACES;
     b.params.max_depth = params && params->max_depth ? params->max_depth : DEFAULT_MAX_DEPTH;
+    out->face_group = params ? params->face_group : NULL;
     st = index_faces(ctx, out, params ? params->skip_leaf : NULL) &&
                  (b.face_box = face_boxes(ctx, out)) != NULL
              ? build_cells(&b, err)
@@ -863,7 +876,10 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
         c->face = ids[i];
         c->cells = fc->start[ids[i]];
         memcpy(c->box, box + 6 * (size_t)ids[i], sizeof c->box);
-        c->run_end = i + 1 < n && t->face_leaf[ids[i + 1]] == t->face_leaf[ids[i]]
+        /* A grouped leaf's shells are not runs of ids: its faces meet every later face,
+         * those of their own group left out below. */
+        c->run_end = i + 1 < n && t->face_leaf[ids[i + 1]] == t->face_leaf[ids[i]] &&
+                             !in_grouped_leaf(t, ids[i])
                          ? out->faces[i + 1].run_end
                          : i + 1;
     }
@@ -879,6 +895,7 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
             return false;
         for (uint32_t j = a->run_end; j < n; j++)
             if (cell_faces_overlap(a, &out->faces[j]) &&
+                (!t->face_group || face_group(t, a->face) != face_group(t, out->faces[j].face)) &&
                 first_shared_cell(fc->cell + a->cells, fc->cell + out->faces[j].cells, k) &&
                 !(crowded && (face_plane_separates(t, &out->planes[i], out->faces[j].face) ||
                               face_plane_separates(t, &out->planes[j], a->face) ||

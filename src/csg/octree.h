@@ -31,6 +31,7 @@ typedef struct mci_octree {
     size_t leaf_count;
     uint32_t *face_base;   /* leaf_count + 1 entries: global id of each leaf's face 0 */
     uint32_t *face_leaf;   /* owning leaf per global face id */
+    const uint32_t *face_group; /* per global face id (mci_octree_params), or NULL */
     mci_cell *cells;
     size_t cell_count;
     uint32_t *face_ids;    /* the leaf cells' face lists */
@@ -50,6 +51,11 @@ typedef struct mci_octree_params {
     /* Optional (NULL: none): leaves whose faces are left out of the cells (they keep
      * their global face ids, but meet no other face and no ray). */
     const uint8_t *skip_leaf;
+    /* Optional (NULL: none): per global face, its group; faces of different groups are
+     * paired as faces of different leaves are. A leaf's faces have the leaf's index as
+     * group, or, for a leaf whose shells may cross each other, one group per shell
+     * numbered from the leaf count on. Must outlive the octree. */
+    const uint32_t *face_group;
 } mci_octree_params;
 
 /* Build the octree over the given leaves (which must outlive it). params may be NULL

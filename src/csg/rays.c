@@ -215,6 +215,15 @@ static int coincident_orientation(const double *a, const double *b, const double
     return normal_sign(a, b, c, axis) * sign;
 }
 
+/* Whether p, a point of the plane of a, b, c, lies in the open triangle. */
+static bool strictly_inside(const mci_point *p, const double *a, const double *b, const double *c)
+{
+    mci_plane plane;
+    int which;
+    mci_plane_init(&plane, a, b, c);
+    return mci_point_in_triangle(p, &plane, &which) == MCI_INSIDE;
+}
+
 /* The two windings from the ray's: it starts at p + (0, e, e^2), on side sigma of `at`
  * (0 when the plane is across the ray, which then leaves it towards nx), and crosses the
  * faces holding p right away when it heads towards the plane (their net orientation
@@ -249,8 +258,10 @@ bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci
                      *c = mci_octree_face_vertex(o, s->faces[i], 2);
         if (!ray_crossing(p, lo, hi, a, b, c, &beyond)) { /* the face holds p */
             int orientation = coincident_orientation(a, b, c, at);
-            if (orientation == 0)
-                return true; /* a face across the plane meets it at p */
+            /* Across the plane the face meets it at p; on the face's border, p is on the
+             * neighbours in the plane too, and each sheet must count once. */
+            if (orientation == 0 || !strictly_inside(p, a, b, c))
+                return true;
             coincident += orientation;
         }
     }

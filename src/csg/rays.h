@@ -32,7 +32,8 @@ bool mci_ray_winding_octree(const mci_ctx *ctx, const mci_point *p, const mci_oc
  * normal points) at p, a point of that plane where no face of m crosses the plane: the
  * faces holding p all lie in it (coincident faces, counted with their orientation: one
  * facing like `at` adds one behind). *decided is false when a face across the plane
- * holds p. Returns false when out of memory. */
+ * holds p, or p lies on the border of a face in it (where it could count twice). Returns
+ * false when out of memory. */
 bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
                                uint32_t m, const mci_plane *at, mci_ray_scratch *s,
                                int *behind, int *in_front, bool *decided);

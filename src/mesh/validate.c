@@ -463,8 +463,31 @@ mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
     return mci_mesh_check(&ctx, mesh, report, err);
 }
 
-mcsg_status mci_mesh_check(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
+mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err)
+{
+    return mci_mesh_check_shells(ctx, mesh, report, NULL, err);
+}
+
+/* shell[t] from the union-find roots: dense numbers in order of first triangles. */
+static void number_shells(const check_state *s, uint32_t *shell)
+{
+    uint32_t next = 0;
+    for (size_t t = 0; t < s->mesh->triangle_count; t++)
+        shell[t] = UINT32_MAX;
+    for (size_t t = 0; t < s->mesh->triangle_count; t++) {
+        uint32_t root;
+        if (!s->tri_ok[t])
+            continue;
+        root = mci_find_root(s->parent, (uint32_t)t);
+        if (shell[root] == UINT32_MAX)
+            shell[root] = next++;
+        shell[t] = shell[root];
+    }
+}
+
+mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
+                                  mcsg_check_report *report, uint32_t *shell, mcsg_error *err)
 {
     const mci_ctx ctx = *ctx_in;
     check_state s;
@@ -481,6 +504,8 @@ mcsg_status mci_mesh_check(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
     for (size_t t = 0; ok && t < mesh->triangle_count; t++)
         s.parent[t] = (uint32_t)t;
     ok = ok && run_checks(&s);
+    if (ok && shell && report->components > 1)
+        number_shells(&s, shell);
     mci_free(&ctx, s.canon);
     mci_free(&ctx, s.tri_ok);
     mci_free(&ctx, s.parent);

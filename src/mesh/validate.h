@@ -28,5 +28,11 @@ int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uin
 /* mcsg_mesh_check with the context's allocator; the mesh's counts must fit uint32_t. */
 mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err);
+/* The same, and when `shell` is not NULL (room for a value per triangle) and the mesh has
+ * several components, each triangle's component over shared edges, numbered
+ * 0 .. report->components - 1 in the order of their first triangles (valid triangles
+ * only; others get UINT32_MAX). With one component `shell` is left as it is. */
+mcsg_status mci_mesh_check_shells(const mci_ctx *ctx, const mcsg_mesh *mesh,
+                                  mcsg_check_report *report, uint32_t *shell, mcsg_error *err);
 
 #endif
