@@ -545,11 +545,11 @@ typedef struct mcsg_eval_stats {
  * empty; see docs/robustness.md). This is checked first;
  * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
  * (its label: file or primitive, and position in the CSG text) and an example of the
- * problem. Leaves must also not intersect themselves; that is checked up front only with
- * opts->check_self_intersections (it costs about as much as an evaluation). With a
- * self-intersecting leaf the result is unspecified (a mesh that may not be the intended
- * set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal consistency check
- * trips on it (see docs/robustness.md).
+ * problem. No shell of a leaf may intersect itself, and shells must not touch; that is
+ * checked up front only with opts->check_self_intersections (it costs about as much as
+ * an evaluation). With a self-intersecting leaf the result is unspecified (a mesh that
+ * may not be the intended set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal
+ * consistency check trips on it (see docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
  * doubles. Such a result is still returned with MCSG_OK (it is the best the rounding
@@ -558,6 +558,28 @@ typedef struct mcsg_eval_stats {
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
                       mcsg_provenance **provenance, mcsg_eval_stats *stats, mcsg_error *err);
+
+/* What mcsg_mesh_repair found and made. */
+typedef struct mcsg_repair_stats {
+    size_t shells_in;      /* the input's shells (components over shared edges) */
+    size_t crossing_pairs; /* pairs of triangles of different shells that meet */
+    size_t shells_out;     /* the result's shells */
+    size_t cavities;       /* ... of which face inward (holes inside the solid) */
+    mcsg_eval_stats eval;  /* the evaluation that made it */
+} mcsg_repair_stats;
+
+/* The solid of one mesh as a clean closed mesh: the set where the mesh's winding number
+ * is positive (mcsg_eval of the mesh alone), the everyday "make it printable" operation.
+ * Overlapping shells become one, a shell inside another disappears, an inward shell
+ * inside an outward one stays as a cavity, an inward shell on its own disappears. The
+ * input must be closed, consistently oriented and edge-manifold with finite
+ * coordinates, and no shell may cross itself or touch another (checked exactly first:
+ * MCSG_ERR_INVALID_MESH with one line naming the problem); shells crossing each other
+ * are what this resolves. The result carries mcsg_eval's guarantees and output check
+ * (stats->eval.output_check). *out receives the mesh (release with mcsg_mesh_free);
+ * stats may be NULL. */
+mcsg_status mcsg_mesh_repair(const mcsg_mesh *mesh, const mcsg_options *opts, mcsg_mesh *out,
+                             mcsg_repair_stats *stats, mcsg_error *err);
 
 #ifdef __cplusplus
 }

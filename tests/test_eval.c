@@ -494,8 +494,8 @@ TEST(leaves_with_several_shells)
     /* Shells crossing each other: [0,10], [5,15] and [2,12] cubes in one leaf. */
     {
         const double olo[] = {0, 5, 2}, ohi[] = {10, 15, 12};
-        const bool in_second[] = {false, true, false};
-        char *two = box_shells(olo, ohi, out_out, 2), *three = box_shells(olo, ohi, out_out, 3);
+        const bool in_second[] = {false, true, false}, outward[] = {false, false, false};
+        char *two = box_shells(olo, ohi, outward, 2), *three = box_shells(olo, ohi, outward, 3);
         char *minus = box_shells(olo, ohi, in_second, 2);
         expect_tree_volume("union", two, "", 1875, 1);
         expect_tree_volume("union", three, "", 3000 - 980 + 125, 1);
@@ -841,6 +841,57 @@ TEST(allocation_failures_leak_nothing)
     mcsg_tree_free(tree);
 }
 
+/* mcsg_mesh_repair: the solid of one mesh, with its shells counted. */
+static mcsg_mesh box_shells_mesh(const double *lo, const double *hi, const bool *inward, int n)
+{
+    char *text = box_shells(lo, hi, inward, n);
+    mcsg_tree *tree = parse(text);
+    mcsg_mesh m = {0};
+    mcsg_error err;
+    if (tree)
+        CHECK_OK(mcsg_mesh_copy(mcsg_tree_leaf_mesh(tree, mcsg_tree_root(tree)), NULL, &m, &err),
+                 &err);
+    mcsg_tree_free(tree);
+    free(text);
+    return m;
+}
+
+static mcsg_status repair_under(const void *ctx, const mcsg_options *opts, mcsg_error *err)
+{
+    mcsg_mesh out;
+    mcsg_status st = mcsg_mesh_repair(ctx, opts, &out, NULL, err);
+    if (st == MCSG_OK)
+        mcsg_mesh_free(&out, opts);
+    return st;
+}
+
+TEST(repair_joins_overlapping_shells)
+{
+    const double lo[] = {0, 5, 2}, hi[] = {10, 15, 8};
+    const bool out_out[] = {false, false, false}, out_in[] = {false, false, true};
+    mcsg_mesh two = box_shells_mesh(lo, hi, out_out, 2), hollow = box_shells_mesh(lo, hi, out_in, 3);
+    mcsg_mesh out;
+    mcsg_repair_stats st;
+    mcsg_check_report r;
+    mcsg_error err;
+    CHECK_OK(mcsg_mesh_repair(&two, NULL, &out, &st, &err), &err);
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
+    CHECK(st.shells_in == 2 && st.shells_out == 1 && st.cavities == 0 && st.crossing_pairs > 0);
+    CHECK(mcsg_check_report_is_valid(&r) && fabs(r.volume - 1875) < 1e-9);
+    mcsg_mesh_free(&out, NULL);
+    /* [0,10] and [5,15] overlapping, with an inward [2,8]: where it is inside both cubes
+     * the winding number stays 1, so the cavity is [2,8]^3 less [5,8]^3. */
+    CHECK_OK(mcsg_mesh_repair(&hollow, NULL, &out, &st, &err), &err);
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
+    CHECK(st.shells_in == 3 && st.shells_out == 2 && st.cavities == 1);
+    CHECK(mcsg_check_report_is_valid(&r) && fabs(r.volume - (1875 - (216 - 27))) < 1e-9);
+    mcsg_mesh_free(&out, NULL);
+    CHECK(mcsg_mesh_repair(NULL, NULL, &out, &st, &err) == MCSG_ERR_INVALID_ARG);
+    CHECK(test_allocation_failures("mcsg_mesh_repair", repair_under, &two, false) > 50);
+    mcsg_mesh_free(&two, NULL);
+    mcsg_mesh_free(&hollow, NULL);
+}
+
 /* Progress: the steps mcsg_progress_fn documents, in order, each started and ended; a
  * callback returning non-zero stops the evaluation there, cleanly. */
 typedef struct progress_log {
@@ -1109,5 +1160,6 @@ int main(void)
     RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
     RUN(leaves_with_several_shells);
+    RUN(repair_joins_overlapping_shells);
     return test_summary();
 }

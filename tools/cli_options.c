@@ -263,6 +263,7 @@ void cli_print_help(FILE *out, const char *version, const cli_command *commands,
     print_entry(out, "-h, --help", "print this help and exit");
     print_entry(out, "--version", "print the version and exit");
     fprintf(out, "\nexit status: 0 success (check: every mesh valid); 1 a problem was found "
-                 "or an\noperation failed; 2 usage error; 3 (eval) the result was written but "
-                 "rounding to\ndoubles broke one of its guarantees (a warning says which)\n");
+                 "or an\noperation failed; 2 usage error; 3 (eval, repair) the result was "
+                 "written but\nrounding to doubles broke one of its guarantees (a warning "
+                 "says which)\n");
 }
