@@ -132,6 +132,79 @@ TEST(octree_rays_know_the_box)
 /* Boxes on a quarter-unit grid (shared and touching sides are frequent), some long in
  * x as a plate under its holes: mci_box_overlaps must list exactly the pairs of closed
  * boxes that meet, each row in increasing index. */
+/* The winding numbers of leaf m just behind and in front of plane a, b, c at point x
+ * (which lies in it); *decided as mci_ray_windings_on_plane gives it. */
+static void windings_at(const mci_octree *o, uint32_t m, const double *a, const double *b,
+                        const double *c, const double x[3], int *behind, int *front,
+                        bool *decided)
+{
+    mci_ctx ctx;
+    mci_ray_scratch scratch = {0};
+    mci_plane at;
+    mci_point p;
+    mci_ctx_init(&ctx, NULL);
+    mci_plane_init(&at, a, b, c);
+    mci_point_explicit(&p, x);
+    CHECK(mci_ray_windings_on_plane(&ctx, &p, o, m, &at, &scratch, behind, front, decided));
+    mci_ray_scratch_free(&ctx, &scratch);
+}
+
+/* A unit cube given twice in one mesh (two coincident shells), and a tetrahedron: the
+ * numbers on both sides of a face from a point in it, for faces across the ray (x = 0),
+ * along it (z = 0) and slanted, either way round; a point on a face's border decides
+ * nothing (it would count a sheet twice). */
+TEST(windings_on_both_sides_of_a_face)
+{
+    static const double o0[3] = {0, 0, 0}, x1[3] = {1, 0, 0}, y1[3] = {0, 1, 0}, z1[3] = {0, 0, 1};
+    mcsg_mesh cube, twice, tetra;
+    const mcsg_mesh *leaves[2];
+    double unit[3] = {1, 1, 1};
+    const double on_x0[3] = {0, 0.3, 0.4}, on_z0[3] = {0.3, 0.4, 0}, on_slant[3] = {0.25, 0.25, 0.5};
+    const double on_diagonal[3] = {0.5, 0.5, 0};
+    static const double tv[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t tt[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    mci_octree o;
+    mci_ctx ctx;
+    mcsg_error err;
+    int behind, front;
+    bool decided;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mcsg_make_cube(unit, 0, NULL, &cube, &err), &err);
+    twice.vertex_count = 2 * cube.vertex_count;
+    twice.triangle_count = 2 * cube.triangle_count;
+    twice.vertices = malloc(3 * twice.vertex_count * sizeof *twice.vertices);
+    twice.triangles = malloc(3 * twice.triangle_count * sizeof *twice.triangles);
+    for (size_t i = 0; i < 3 * cube.vertex_count; i++)
+        twice.vertices[i] = twice.vertices[i + 3 * cube.vertex_count] = cube.vertices[i];
+    for (size_t i = 0; i < 3 * cube.triangle_count; i++) {
+        twice.triangles[i] = cube.triangles[i];
+        twice.triangles[i + 3 * cube.triangle_count] = cube.triangles[i] + (uint32_t)cube.vertex_count;
+    }
+    tetra = (mcsg_mesh){(double *)tv, (uint32_t *)tt, 4, 4};
+    leaves[0] = &twice;
+    leaves[1] = &tetra;
+    CHECK_OK(mci_octree_build(&ctx, leaves, 2, NULL, &o, &err), &err);
+    /* x = 0, outward normal -x: inside (2) behind it; seen from +x, the other way. */
+    windings_at(&o, 0, o0, z1, y1, on_x0, &behind, &front, &decided);
+    CHECK(decided && behind == 2 && front == 0);
+    windings_at(&o, 0, o0, y1, z1, on_x0, &behind, &front, &decided);
+    CHECK(decided && behind == 0 && front == 2);
+    windings_at(&o, 0, o0, y1, x1, on_z0, &behind, &front, &decided);
+    CHECK(decided && behind == 2 && front == 0);
+    windings_at(&o, 0, o0, x1, y1, on_z0, &behind, &front, &decided);
+    CHECK(decided && behind == 0 && front == 2);
+    windings_at(&o, 0, o0, y1, x1, on_diagonal, &behind, &front, &decided);
+    CHECK(!decided);
+    windings_at(&o, 1, x1, y1, z1, on_slant, &behind, &front, &decided);
+    CHECK(decided && behind == 1 && front == 0);
+    windings_at(&o, 1, x1, z1, y1, on_slant, &behind, &front, &decided);
+    CHECK(decided && behind == 0 && front == 1);
+    mci_octree_free(&ctx, &o);
+    mcsg_mesh_free(&cube, NULL);
+    free(twice.vertices);
+    free(twice.triangles);
+}
+
 TEST(box_overlaps_match_every_pair)
 {
     mci_ctx ctx;
@@ -175,5 +248,6 @@ int main(void)
     RUN(octree_rays_agree_with_brute_force);
     RUN(octree_rays_know_the_box);
     RUN(box_overlaps_match_every_pair);
+    RUN(windings_on_both_sides_of_a_face);
     return test_summary();
 }

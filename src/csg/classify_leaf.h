@@ -126,14 +126,11 @@ typedef struct mci_wind_sum {
 /* Adds one shell holding the separator, with the local labels of the region before and
  * of the region after with respect to it. */
 void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local);
-/* A point strictly inside the triangle a, b, c (input vertices): where a line through its
- * approximate centroid, along its approximate normal, pierces its plane (an LPI of input
- * vertices; `ends` holds the line's two ends, which the point refers to). False when the
- * doubles do not give a line crossing the plane or a point strictly inside (slivers). */
-bool mci_point_inside_triangle(const double *a, const double *b, const double *c,
-                               double ends[2][3], mci_point *out);
-/* The same for piece p (its corners may be implicit points), in the plane of its face
- * (*plane, which the point refers to as well). */
+/* A point strictly inside piece p: where a line through its corners' approximate
+ * centroid, along its face's approximate normal, pierces the face's plane (an LPI of
+ * input vertices: `ends` holds the line's two ends, and *plane the face's plane, which
+ * the point refers to). False when the doubles do not give a line crossing the plane or
+ * a point strictly inside (slivers). */
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, double ends[2][3], mci_point *out,
                            mci_plane *plane);
 

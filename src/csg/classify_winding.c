@@ -14,9 +14,9 @@
  *     of its sides. A ray gives it directly; across a separator on the primitive's surface
  *     the local test only tells on which side of that surface each of the two regions
  *     lies, so the number is carried over from the region before, one step per shell
- *     holding the separator (mci_wind_sheet). A
- *     region lying in that primitive's surface takes both numbers from a ray from a point
- *     inside one of its pieces (mci_ray_windings_on_plane).
+ *     holding the separator (mci_wind_sheet). A region lying in that primitive's surface
+ *     takes both numbers from a ray from a point inside one of its pieces
+ *     (mci_ray_windings_on_plane).
  */
 #include "csg/classify_leaf.h"
 #include "csg/rays.h"
@@ -60,18 +60,6 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, double en
     for (int i = 0; i < 3; i++)
         turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
     return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
-}
-
-bool mci_point_inside_triangle(const double *a, const double *b, const double *c,
-                               double ends[2][3], mci_point *out)
-{
-    mci_plane plane;
-    mci_point corner[3];
-    mci_plane_init(&plane, a, b, c);
-    mci_point_explicit(&corner[0], a);
-    mci_point_explicit(&corner[1], b);
-    mci_point_explicit(&corner[2], c);
-    return point_inside(corner, &plane, ends, out);
 }
 
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, double ends[2][3], mci_point *out,

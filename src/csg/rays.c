@@ -50,15 +50,14 @@ static bool point_on_triangle(const mci_point *p, const mci_plane *plane)
     return mci_orient3d(p, plane) == 0 && mci_point_in_triangle(p, plane, &which) != MCI_OUTSIDE;
 }
 
-static void add_crossing_ahead(const mci_point *p, const double *a, const double *b,
-                               const double *c, const mci_plane *plane, int *winding);
-
 /* One triangle's part in the ray test from p (bounds lo..hi): adds its crossing ahead
  * of p to *winding; false when p lies on the triangle (no ray decides then). */
 static bool ray_crossing(const mci_point *p, const double lo[3], const double hi[3],
                          const double *a, const double *b, const double *c, int *winding)
 {
+    mci_point pa, pb, pc;
     mci_plane plane;
+    int nx, side;
     bool misses_ray, misses_point;
     box_tests(a, b, c, lo, hi, &misses_ray, &misses_point);
     if (misses_ray)
@@ -66,27 +65,19 @@ static bool ray_crossing(const mci_point *p, const double lo[3], const double hi
     mci_plane_init(&plane, a, b, c);
     if (!misses_point && point_on_triangle(p, &plane))
         return false;
-    add_crossing_ahead(p, a, b, c, &plane, winding);
-    return true;
-}
-
-/* The crossing of the perturbed ray from p with triangle a, b, c (plane `plane`), which
- * does not hold p, added to *winding. */
-static void add_crossing_ahead(const mci_point *p, const double *a, const double *b,
-                               const double *c, const mci_plane *plane, int *winding)
-{
-    mci_point pa, pb, pc;
-    int nx, side;
     mci_point_explicit(&pa, a);
     mci_point_explicit(&pb, b);
     mci_point_explicit(&pc, c);
     nx = mci_orient2d_projected(&pa, &pb, &pc, 0); /* sign of the normal's x */
     if (nx == 0 || perturbed_orient_yz(&pa, &pb, p) != nx ||
         perturbed_orient_yz(&pb, &pc, p) != nx || perturbed_orient_yz(&pc, &pa, p) != nx)
-        return;
-    side = mci_orient3d(p, plane); /* not 0: p is not on the triangle */
+        return true;
+    side = mci_orient3d(p, &plane);
+    if (side == 0)
+        return false; /* unreachable: p would be on the triangle */
     if (side == -nx)
         *winding += nx; /* crossed ahead of p; leaving the solid when nx > 0 */
+    return true;
 }
 
 mci_label mci_ray_label(const mci_point *p, const mcsg_mesh *m)
