@@ -544,6 +544,21 @@ int csg_reachable_leaves(const csg_tree_spec *t)
 /* Whether two leaves of the tree are exact copies. Then the result may touch itself
  * along edges even in general position: (A | B) - (A & B) is non-manifold along the
  * curve where the surfaces of A and B cross. */
+/* Two leaves with the same primitive at the same place (in the shells family their inner
+ * shells and orientations may differ: the outer surfaces still coincide). */
+static bool same_primitive(const csg_leaf_spec *a, const csg_leaf_spec *b)
+{
+    csg_leaf_spec x = *a, y = *b;
+    x.inner = y.inner = 0;
+    memset(x.inner_scale, 0, sizeof x.inner_scale);
+    memset(y.inner_scale, 0, sizeof y.inner_scale);
+    memset(x.inner_shift, 0, sizeof x.inner_shift);
+    memset(y.inner_shift, 0, sizeof y.inner_shift);
+    memset(x.inward, 0, sizeof x.inward);
+    memset(y.inward, 0, sizeof y.inward);
+    return memcmp(&x, &y, sizeof x) == 0;
+}
+
 static bool has_copies(const csg_tree_spec *t)
 {
     bool reach[CSG_MAX_NODES];
@@ -552,8 +567,7 @@ static bool has_copies(const csg_tree_spec *t)
         for (int j = 0; j < i; j++)
             if (reach[i] && reach[j] && t->nodes[i].kind == MCSG_NODE_LEAF &&
                 t->nodes[j].kind == MCSG_NODE_LEAF &&
-                memcmp(&t->leaves[t->nodes[i].leaf], &t->leaves[t->nodes[j].leaf],
-                       sizeof(csg_leaf_spec)) == 0)
+                same_primitive(&t->leaves[t->nodes[i].leaf], &t->leaves[t->nodes[j].leaf]))
                 return true;
     return false;
 }

@@ -192,27 +192,40 @@ static bool label_from_inside(mci_leaf_work *w, uint32_t r, size_t c, const mci_
     return true;
 }
 
+/* Whether some label region r needs, of those looked for, is unknown. */
+static bool some_unknown(const mci_leaf_work *w, uint32_t r, bool winding_only)
+{
+    const uint8_t *lab = w->labels + (size_t)r * w->ncand;
+    for (size_t c = 0; c < w->ncand; c++)
+        if (lab[c] == MCI_LABEL_UNKNOWN && w->needed[c] && (!winding_only || w->cand_winding[c]))
+            return true;
+    return false;
+}
+
 bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only)
 {
     uint8_t *lab = w->labels + (size_t)r * w->ncand;
     bool learnt = false;
-    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && !learnt; k++) {
-        mci_point probe;
-        mci_plane at;
-        double ends[2][3];
-        if (!mci_leaf_piece_inside(w, w->reg_pieces[k], ends, &probe, &at))
-            continue;
-        for (size_t c = 0; c < w->ncand; c++) {
-            if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c] ||
-                (winding_only && !w->cand_winding[c]))
+    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1] && some_unknown(w, r, winding_only);
+         k++)
+        for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS && some_unknown(w, r, winding_only);
+             attempt++) {
+            mci_point probe;
+            mci_plane at;
+            double ends[2][3];
+            if (!mci_leaf_piece_inside(w, w->reg_pieces[k], attempt, ends, &probe, &at))
                 continue;
-            if (!label_from_inside(w, r, c, &probe, &at)) {
-                w->out_of_memory = true;
-                return false;
+            for (size_t c = 0; c < w->ncand; c++) {
+                if (lab[c] != MCI_LABEL_UNKNOWN || !w->needed[c] ||
+                    (winding_only && !w->cand_winding[c]))
+                    continue;
+                if (!label_from_inside(w, r, c, &probe, &at)) {
+                    w->out_of_memory = true;
+                    return false;
+                }
+                learnt = learnt || lab[c] != MCI_LABEL_UNKNOWN;
             }
-            learnt = learnt || lab[c] != MCI_LABEL_UNKNOWN;
         }
-    }
     return learnt;
 }
 
@@ -453,6 +466,22 @@ static void fill_unknown_labels(mci_leaf_work *w)
     }
 }
 
+/* Winding numbers still unknown after the sweep: its seed's pieces gave no point whose
+ * ray decides (every probe on a border of another surface's face), and the regions
+ * reached from it inherited the unknown. Any region of the part whose inside decides
+ * will do: it is asked, and the sweep's fill carries its numbers to the others. */
+static void retry_windings(mci_leaf_work *w)
+{
+    bool learnt = true;
+    while (learnt && !w->out_of_memory) {
+        learnt = false;
+        for (uint32_t r = 0; r < w->nreg && !learnt && !w->out_of_memory; r++)
+            learnt = some_unknown(w, r, true) && mci_leaf_labels_from_inside(w, r, true);
+        if (learnt)
+            fill_unknown_labels(w);
+    }
+}
+
 /* Breadth-first over regions across separators, seeding each unreached part. */
 static mcsg_status label_regions(mci_leaf_work *w)
 {
@@ -489,6 +518,8 @@ static mcsg_status label_regions(mci_leaf_work *w)
     if (w->out_of_memory)
         return mci_fail_nomem(w->err, "classifying faces");
     fill_unknown_labels(w);
+    if (w->wind)
+        retry_windings(w);
     if (w->own_front)
         fill_unknown_own(w);
     return MCSG_OK;

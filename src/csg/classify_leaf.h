@@ -126,13 +126,15 @@ typedef struct mci_wind_sum {
 /* Adds one shell holding the separator, with the local labels of the region before and
  * of the region after with respect to it. */
 void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local);
-/* A point strictly inside piece p: where a line through its corners' approximate
- * centroid, along its face's approximate normal, pierces the face's plane (an LPI of
- * input vertices: `ends` holds the line's two ends, and *plane the face's plane, which
- * the point refers to). False when the doubles do not give a line crossing the plane or
- * a point strictly inside (slivers). */
-bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, double ends[2][3], mci_point *out,
-                           mci_plane *plane);
+/* A point strictly inside piece p: where a line through a point of its corners'
+ * approximate triangle (the centroid for attempt 0, other weights for the others, up to
+ * MCI_INSIDE_ATTEMPTS), along its face's approximate normal, pierces the face's plane
+ * (an LPI of input vertices: `ends` holds the line's two ends, and *plane the face's
+ * plane, which the point refers to). False when the doubles do not give a line crossing
+ * the plane or a point strictly inside (slivers). */
+#define MCI_INSIDE_ATTEMPTS 4
+bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],
+                           mci_point *out, mci_plane *plane);
 
 mcsg_status mci_leaf_regions(mci_leaf_work *w);
 mcsg_status mci_leaf_trim(mci_leaf_work *w);

@@ -31,9 +31,14 @@
  * of input vertices; `ends` holds the line's two ends, which the point refers to). False
  * when the doubles do not give a line crossing the plane or a point strictly inside
  * (slivers). */
-static bool point_inside(const mci_point c[3], const mci_plane *plane, double ends[2][3],
-                         mci_point *out)
+static bool point_inside(const mci_point c[3], const mci_plane *plane, int attempt,
+                         double ends[2][3], mci_point *out)
 {
+    /* Barycentric weights, the centroid first: a point on the border of a face of another
+     * surface lying in this one decides nothing, and another point rarely is too. */
+    static const double weight[MCI_INSIDE_ATTEMPTS][3] = {
+        {1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.3, 0.2}, {0.2, 0.5, 0.3}, {0.3, 0.2, 0.5}};
+    const double *wt = weight[attempt];
     const double *a = plane->a, *b = plane->b, *d = plane->c;
     double x[3][3], n[3], size = 0, norm = 0;
     int axis, sign, turns[3];
@@ -49,7 +54,8 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, double en
     if (!(norm > 0) || !(size > 0) || !isfinite(norm) || !isfinite(size))
         return false;
     for (int k = 0; k < 3; k++) {
-        double centre = (x[0][k] + x[1][k] + x[2][k]) / 3, step = n[k] / norm * size;
+        double centre = wt[0] * x[0][k] + wt[1] * x[1][k] + wt[2] * x[2][k];
+        double step = n[k] / norm * size;
         ends[0][k] = centre + step;
         ends[1][k] = centre - step;
     }
@@ -62,25 +68,26 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, double en
     return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
 }
 
-bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, double ends[2][3], mci_point *out,
-                           mci_plane *plane)
+bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],
+                           mci_point *out, mci_plane *plane)
 {
     mci_point c[3];
     for (int i = 0; i < 3; i++)
         mci_leaf_piece_point(w, p, i, &c[i]);
     mci_scene_face_plane(w->s, w->pface[p], plane);
-    return point_inside(c, plane, ends, out);
+    return point_inside(c, plane, attempt, ends, out);
 }
 
 bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r)
 {
-    for (uint32_t k = w->reg_start[r]; k < w->reg_start[r + 1]; k++) {
+    for (uint32_t k = w->reg_start[r], attempt = 0; k < w->reg_start[r + 1];
+         attempt = (attempt + 1) % MCI_INSIDE_ATTEMPTS, k += attempt == 0) {
         double ends[2][3];
         mci_point q;
         mci_plane at;
         int behind, in_front;
         bool decided;
-        if (!mci_leaf_piece_inside(w, w->reg_pieces[k], ends, &q, &at))
+        if (!mci_leaf_piece_inside(w, w->reg_pieces[k], (int)attempt, ends, &q, &at))
             continue;
         w->stats->rays++;
         if (!mci_ray_windings_on_plane(w->ctx, &q, &w->s->octree, w->leaf, &at, &w->ray,
