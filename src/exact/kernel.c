@@ -229,6 +229,201 @@ static i128 i128_from_double(double x, int e0)
 #include "exact/kernel_eval.inc"
 
 /* ---------------------------------------------------------------------------------- */
+/* The exact stage in short integers (exact/wide.h)                                    */
+
+/* Whether a point's scaled coordinates fit the short path below: differences below
+ * 2^62 (D = top + 2 - e0 <= 62), so they are int64, a normal's components (below
+ * 2^(2D+1)) __int128, and an LPI's numbers (below 2^(4D+4)) and a TPI's (below
+ * 2^(7D+9), the bound of fits_i128) stay below 2^511, within mci_wide. */
+static bool fits_short(input_scale s)
+{
+    return s.top + 2 - s.e0 <= 62;
+}
+
+/* The scaled coordinates x 2^-e0 of a point's defining vertices (each below 2^61
+ * under fits_short), converted once: each vertex enters several differences. */
+static void scaled_vertices(int64_t c[9][3], const mci_point *p, int e0)
+{
+    for (int i = 0; i < mci_point_vertex_count(p); i++)
+        for (int k = 0; k < 3; k++)
+            c[i][k] = (int64_t)i128_from_double(p->v[i][k], e0);
+}
+
+static void short_vector(int64_t r[3], const int64_t a[3], const int64_t b[3])
+{
+    for (int k = 0; k < 3; k++)
+        r[k] = a[k] - b[k];
+}
+
+/* Normal (b - a) x (c - a) of the plane through a, b, c: components below 2^(2D+1). */
+static void short_normal(i128 n[3], const int64_t a[3], const int64_t b[3], const int64_t c[3])
+{
+    int64_t d1[3], d2[3];
+    short_vector(d1, b, a);
+    short_vector(d2, c, a);
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        n[k] = (i128)d1[i] * d2[j] - (i128)d1[j] * d2[i];
+    }
+}
+
+/* r = n . v. */
+static void short_dot(mci_wide *r, const mci_wide n[3], const int64_t v[3])
+{
+    mci_wide t;
+    mci_wide_mul_i64(r, &n[0], v[0]);
+    for (int k = 1; k < 3; k++) {
+        mci_wide_mul_i64(&t, &n[k], v[k]);
+        mci_wide_add(r, r, &t);
+    }
+}
+
+/* r = n . v for a normal n in __int128 (products below 2^(3D+1)). */
+static void lpi_dot(mci_wide4 *r, const i128 n[3], const int64_t v[3])
+{
+    mci_wide4 t;
+    mci_wide4_mul_i128_i64(r, n[0], v[0]);
+    for (int k = 1; k < 3; k++) {
+        mci_wide4_mul_i128_i64(&t, n[k], v[k]);
+        mci_wide4_add(r, r, &t);
+    }
+}
+
+/* The general LPI's numbers from the origin (l0 its base, n its plane's normal):
+ * W = n . u and s = n . (a - l0) below 2^(3D+3), x[k] = u_k s + l0_k W below 2^(4D+4),
+ * all within four limbs. */
+static void lpi_general(mci_wide x[3], mci_wide *w, const int64_t l0[3], const i128 n[3],
+                        const int64_t u[3], const int64_t to_plane[3])
+{
+    mci_wide4 w4, s4;
+    lpi_dot(&w4, n, u);
+    lpi_dot(&s4, n, to_plane);
+    for (int k = 0; k < 3; k++) {
+        mci_wide4 a, b;
+        mci_wide4_mul_i64(&a, &s4, u[k]);
+        mci_wide4_mul_i64(&b, &w4, l0[k]);
+        mci_wide4_add(&a, &a, &b);
+        mci_wide_from_wide4(&x[k], &a);
+    }
+    mci_wide_from_wide4(w, &w4);
+}
+
+/* The LPI numbers of EVAL(lpi) (the reduced formula on an axis-aligned plane, whose
+ * numbers fit __int128), from the origin: x[k] = u_k s + l0_k W. */
+static void short_lpi(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
+{
+    int64_t c[9][3], u[3], to_plane[3];
+    int axis = lpi_plane_axis(p);
+    scaled_vertices(c, p, e0);
+    short_vector(u, c[1], c[0]);
+    short_vector(to_plane, c[2], c[0]);
+    if (axis < 0) {
+        i128 n[3];
+        short_normal(n, c[2], c[3], c[4]);
+        lpi_general(x, w, c[0], n, u, to_plane);
+        return;
+    }
+    mci_wide_from_i128(w, u[axis]);
+    for (int k = 0; k < 3; k++)
+        mci_wide_from_i128(&x[k], (i128)u[k] * to_plane[axis] + (i128)c[0][k] * u[axis]);
+}
+
+/* Determinant of rows given by pointers to entries, expanded along row 0. */
+static void short_det3(mci_wide *r, const mci_wide *m[3][3])
+{
+    mci_wide_from_i128(r, 0);
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        mci_wide t, u;
+        mci_wide_mul(&t, m[1][i], m[2][j]);
+        mci_wide_mul(&u, m[1][j], m[2][i]);
+        mci_wide_sub(&t, &t, &u);
+        mci_wide_mul(&t, m[0][k], &t);
+        mci_wide_add(r, r, &t);
+    }
+}
+
+/* The TPI numbers of EVAL(tpi) from the origin: W = det N, x[col] = Cramer's numerator
+ * for col (N with that column replaced by the right-hand sides) + base_col W. */
+static void short_tpi(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
+{
+    int64_t c[9][3];
+    mci_wide n[3][3], rhs[3];
+    const mci_wide *m[3][3];
+    scaled_vertices(c, p, e0);
+    for (int i = 0; i < 3; i++) {
+        int64_t to_plane[3];
+        i128 normal[3];
+        short_normal(normal, c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+        for (int k = 0; k < 3; k++)
+            mci_wide_from_i128(&n[i][k], normal[k]);
+        short_vector(to_plane, c[3 * i], c[0]);
+        short_dot(&rhs[i], n[i], to_plane);
+    }
+    for (int col = -1; col < 3; col++) {
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                m[i][k] = k == col ? &rhs[i] : &n[i][k];
+        short_det3(col < 0 ? w : &x[col], m);
+    }
+    for (int k = 0; k < 3; k++) {
+        mci_wide t;
+        mci_wide_mul_i64(&t, w, c[0][k]);
+        mci_wide_add(&x[k], &x[k], &t);
+    }
+}
+
+/* A point's numbers from the origin under fits_short: those of EVAL(point_at). */
+static void short_point(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
+{
+    if (p->kind == MCI_POINT_EXPLICIT) {
+        mci_wide_from_i128(w, 1);
+        for (int k = 0; k < 3; k++)
+            mci_wide_from_i128(&x[k], i128_from_double(p->v[0][k], e0));
+    } else if (p->kind == MCI_POINT_LPI) {
+        short_lpi(x, w, p, e0);
+    } else {
+        short_tpi(x, w, p, e0);
+    }
+}
+
+static int wide4_sign(const mci_wide4 *a)
+{
+    if (a->limb[3] >> 63)
+        return -1;
+    return (a->limb[0] | a->limb[1] | a->limb[2] | a->limb[3]) != 0;
+}
+
+/* The sign of EVAL(w_sign)'s W under fits_short: an LPI's by the general formula (an
+ * LPI's W on an axis-aligned plane is computed there too, see EVAL(lpi)), a TPI's the
+ * determinant of its normals. */
+static int short_w_sign(const mci_point *p, int e0)
+{
+    int64_t c[9][3], u[3];
+    mci_wide n[3][3], w;
+    const mci_wide *m[3][3];
+    scaled_vertices(c, p, e0);
+    if (p->kind == MCI_POINT_LPI) {
+        i128 normal[3];
+        mci_wide4 w4;
+        short_vector(u, c[1], c[0]);
+        short_normal(normal, c[2], c[3], c[4]);
+        lpi_dot(&w4, normal, u);
+        return wide4_sign(&w4);
+    }
+    for (int i = 0; i < 3; i++) {
+        i128 normal[3];
+        short_normal(normal, c[3 * i], c[3 * i + 1], c[3 * i + 2]);
+        for (int k = 0; k < 3; k++) {
+            mci_wide_from_i128(&n[i][k], normal[k]);
+            m[i][k] = &n[i][k];
+        }
+    }
+    short_det3(&w, m);
+    return mci_wide_sign(&w);
+}
+
+/* ---------------------------------------------------------------------------------- */
 /* Planes and points                                                                   */
 
 bool mci_vertex_before(const double *a, const double *b)
@@ -374,6 +569,8 @@ static int exact_w_sign(const mci_point *p)
      * an LPI's W is the general formula's here (see EVAL(lpi)). */
     if (fits_i128(s, p->kind == MCI_POINT_LPI ? 4 : x_degree(p)))
         return i128_w_sign(p, s.e0);
+    if (fits_short(s) && p->kind != MCI_POINT_EXPLICIT)
+        return short_w_sign(p, s.e0);
     return big_w_sign(p, s.e0);
 }
 
@@ -526,6 +723,18 @@ static bool round_filtered(const mci_point *p, int k, double *out, double *guess
     return true;
 }
 
+/* p's numbers from the origin computed in short integers, as mci_big (whose quotient
+ * rounds them): the same integers as big_point_at's, at a tenth of the cost. */
+static void big_point_from_short(big_point *out, const mci_point *p, int e0)
+{
+    mci_wide x[3], w;
+    short_point(x, &w, p, e0);
+    for (int k = 0; k < 4; k++) {
+        mci_big *r = k < 3 ? &out->x[k] : &out->w;
+        r->size = mci_wide_export(k < 3 ? &x[k] : &w, r->limb, MCI_BIG_LIMBS);
+    }
+}
+
 void mci_point_round(const mci_point *p, double out[3])
 {
     static const double zero[3] = {0, 0, 0};
@@ -547,7 +756,10 @@ void mci_point_round(const mci_point *p, double out[3])
         return;
     /* X / W is the point in units of 2^e0 once X is measured from the origin. */
     s = scale_of(&p, 1, NULL, 0);
-    big_point_at(&exact, p, zero, s.e0, pending);
+    if (fits_short(s))
+        big_point_from_short(&exact, p, s.e0);
+    else
+        big_point_at(&exact, p, zero, s.e0, pending);
     for (int k = 0; k < 3; k++)
         if ((pending >> k) & 1)
             out[k] = mci_big_ratio_to_double(&exact.x[k], &exact.w, s.e0);
@@ -787,151 +999,6 @@ static bool coordinate_approx(const mci_exact_point *e, int k, double out[3])
                               out);
 }
 
-/* ---------------------------------------------------------------------------------- */
-/* Filling a cache entry in short integers                                             */
-
-/* Whether a point's scaled coordinates fit the short path below: differences below
- * 2^62 (D = top + 2 - e0 <= 62), so they are int64, a normal's components (below
- * 2^(2D+1)) __int128, and an LPI's numbers (below 2^(4D+4)) and a TPI's (below
- * 2^(7D+9), the bound of fits_i128) stay below 2^511, within mci_wide. */
-static bool fits_short(input_scale s)
-{
-    return s.top + 2 - s.e0 <= 62;
-}
-
-/* The scaled coordinates x 2^-e0 of a point's defining vertices (each below 2^61
- * under fits_short), converted once: each vertex enters several differences. */
-static void scaled_vertices(int64_t c[9][3], const mci_point *p, int e0)
-{
-    for (int i = 0; i < mci_point_vertex_count(p); i++)
-        for (int k = 0; k < 3; k++)
-            c[i][k] = (int64_t)i128_from_double(p->v[i][k], e0);
-}
-
-static void short_vector(int64_t r[3], const int64_t a[3], const int64_t b[3])
-{
-    for (int k = 0; k < 3; k++)
-        r[k] = a[k] - b[k];
-}
-
-/* Normal (b - a) x (c - a) of the plane through a, b, c: components below 2^(2D+1). */
-static void short_normal(i128 n[3], const int64_t a[3], const int64_t b[3], const int64_t c[3])
-{
-    int64_t d1[3], d2[3];
-    short_vector(d1, b, a);
-    short_vector(d2, c, a);
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        n[k] = (i128)d1[i] * d2[j] - (i128)d1[j] * d2[i];
-    }
-}
-
-/* r = n . v. */
-static void short_dot(mci_wide *r, const mci_wide n[3], const int64_t v[3])
-{
-    mci_wide t;
-    mci_wide_mul_i64(r, &n[0], v[0]);
-    for (int k = 1; k < 3; k++) {
-        mci_wide_mul_i64(&t, &n[k], v[k]);
-        mci_wide_add(r, r, &t);
-    }
-}
-
-/* r = n . v for a normal n in __int128 (products below 2^(3D+1)). */
-static void lpi_dot(mci_wide4 *r, const i128 n[3], const int64_t v[3])
-{
-    mci_wide4 t;
-    mci_wide4_mul_i128_i64(r, n[0], v[0]);
-    for (int k = 1; k < 3; k++) {
-        mci_wide4_mul_i128_i64(&t, n[k], v[k]);
-        mci_wide4_add(r, r, &t);
-    }
-}
-
-/* The general LPI's numbers from the origin (l0 its base, n its plane's normal):
- * W = n . u and s = n . (a - l0) below 2^(3D+3), x[k] = u_k s + l0_k W below 2^(4D+4),
- * all within four limbs. */
-static void lpi_general(mci_wide x[3], mci_wide *w, const int64_t l0[3], const i128 n[3],
-                        const int64_t u[3], const int64_t to_plane[3])
-{
-    mci_wide4 w4, s4;
-    lpi_dot(&w4, n, u);
-    lpi_dot(&s4, n, to_plane);
-    for (int k = 0; k < 3; k++) {
-        mci_wide4 a, b;
-        mci_wide4_mul_i64(&a, &s4, u[k]);
-        mci_wide4_mul_i64(&b, &w4, l0[k]);
-        mci_wide4_add(&a, &a, &b);
-        mci_wide_from_wide4(&x[k], &a);
-    }
-    mci_wide_from_wide4(w, &w4);
-}
-
-/* The LPI numbers of EVAL(lpi) (the reduced formula on an axis-aligned plane, whose
- * numbers fit __int128), from the origin: x[k] = u_k s + l0_k W. */
-static void short_lpi(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
-{
-    int64_t c[9][3], u[3], to_plane[3];
-    int axis = lpi_plane_axis(p);
-    scaled_vertices(c, p, e0);
-    short_vector(u, c[1], c[0]);
-    short_vector(to_plane, c[2], c[0]);
-    if (axis < 0) {
-        i128 n[3];
-        short_normal(n, c[2], c[3], c[4]);
-        lpi_general(x, w, c[0], n, u, to_plane);
-        return;
-    }
-    mci_wide_from_i128(w, u[axis]);
-    for (int k = 0; k < 3; k++)
-        mci_wide_from_i128(&x[k], (i128)u[k] * to_plane[axis] + (i128)c[0][k] * u[axis]);
-}
-
-/* Determinant of rows given by pointers to entries, expanded along row 0. */
-static void short_det3(mci_wide *r, const mci_wide *m[3][3])
-{
-    mci_wide_from_i128(r, 0);
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        mci_wide t, u;
-        mci_wide_mul(&t, m[1][i], m[2][j]);
-        mci_wide_mul(&u, m[1][j], m[2][i]);
-        mci_wide_sub(&t, &t, &u);
-        mci_wide_mul(&t, m[0][k], &t);
-        mci_wide_add(r, r, &t);
-    }
-}
-
-/* The TPI numbers of EVAL(tpi) from the origin: W = det N, x[col] = Cramer's numerator
- * for col (N with that column replaced by the right-hand sides) + base_col W. */
-static void short_tpi(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
-{
-    int64_t c[9][3];
-    mci_wide n[3][3], rhs[3];
-    const mci_wide *m[3][3];
-    scaled_vertices(c, p, e0);
-    for (int i = 0; i < 3; i++) {
-        int64_t to_plane[3];
-        i128 normal[3];
-        short_normal(normal, c[3 * i], c[3 * i + 1], c[3 * i + 2]);
-        for (int k = 0; k < 3; k++)
-            mci_wide_from_i128(&n[i][k], normal[k]);
-        short_vector(to_plane, c[3 * i], c[0]);
-        short_dot(&rhs[i], n[i], to_plane);
-    }
-    for (int col = -1; col < 3; col++) {
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++)
-                m[i][k] = k == col ? &rhs[i] : &n[i][k];
-        short_det3(col < 0 ? w : &x[col], m);
-    }
-    for (int k = 0; k < 3; k++) {
-        mci_wide t;
-        mci_wide_mul_i64(&t, w, c[0][k]);
-        mci_wide_add(&x[k], &x[k], &t);
-    }
-}
-
 /* p's exact homogeneous coordinates from the origin in units of 2^e->e0 into e's
  * numbers, for a point under fits_short: the same integers as big_point_at's, at a
  * few hundred instructions a point instead of thousands. False when a number does not
@@ -939,15 +1006,7 @@ static void short_tpi(mci_wide x[3], mci_wide *w, const mci_point *p, int e0)
 static bool short_entry_numbers(mci_exact_point *e, const mci_point *p)
 {
     mci_wide x[3], w;
-    if (p->kind == MCI_POINT_EXPLICIT) {
-        mci_wide_from_i128(&w, 1);
-        for (int k = 0; k < 3; k++)
-            mci_wide_from_i128(&x[k], i128_from_double(p->v[0][k], e->e0));
-    } else if (p->kind == MCI_POINT_LPI) {
-        short_lpi(x, &w, p, e->e0);
-    } else {
-        short_tpi(x, &w, p, e->e0);
-    }
+    short_point(x, &w, p, e->e0);
     for (int k = 0; k < 4; k++)
         if ((e->size[k] = mci_wide_export(k < 3 ? &x[k] : &w, e->limb[k],
                                           MCI_EXACT_LIMBS)) == INT_MIN)

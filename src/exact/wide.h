@@ -227,6 +227,16 @@ static inline void mci_wide_from_wide4(mci_wide *r, const mci_wide4 *a)
     mci_wide_trim(r);
 }
 
+static inline int mci_wide_sign(const mci_wide *a)
+{
+    if (mci_wide_negative(a))
+        return -1;
+    for (int i = 0; i < a->n; i++)
+        if (a->limb[i])
+            return 1;
+    return 0;
+}
+
 /* a as mci_big_export writes it: |a|'s limbs into out[0..capacity) and the signed limb
  * count, or INT_MIN when they do not fit. */
 static inline int mci_wide_export(const mci_wide *a, mp_limb_t *out, int capacity)
