@@ -12,6 +12,7 @@
  *
  *   positive tree, CSGlists   mci_ptree_build             csgtree.c          §5.1, §5.3
  *   input contract            mci_check_leaves            leaf_check.c       -
+ *   shells as groups          group_shells                eval.c             -
  *   copies of a leaf          find_copies                 eval.c             -
  *   octree                    mci_octree_build            octree.c           §3.1
  *   candidate pairs           mci_octree_candidate_pairs  octree.c           §3.1, §4.1
@@ -30,6 +31,9 @@
  *   classification            mci_classify_leaf           classify*.c        §5.2, §5.5
  *     first seeds (rays)      mci_ray_label_octree        rays.c             §5.2, §5.5
  *     across a separator      mci_local_label             local_test.c       Prop. 2
+ *     winding numbers         mci_wind_sheet,             classify_winding.c -
+ *       (leaves of several    mci_ray_windings_on_plane   rays.c
+ *       shells)
  *     trimmed CSGlist         mci_csglist_trim_sparse     csgtree.c          §5.3
  *     output tessellation     mci_arr_retessellate        retessellate.c     §5.4
  *   assembly                  assemble                    eval.c             -
