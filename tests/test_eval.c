@@ -457,6 +457,9 @@ static void expect_tree_volume(const char *op, const char *a, const char *b, dou
     free(text);
 }
 
+/* A slab crossing the shells of the boxes below. */
+static const char *const shell_slab = "translate([5,-1,-1]) cube([20,5,20]);";
+
 /* A leaf is where its winding number is positive: a box inside a box adds nothing, an
  * inward box inside one is a cavity, an inward box alone is empty; other leaves crossing
  * the shells, or lying on them, are classified by the numbers on each side. */
@@ -465,7 +468,7 @@ TEST(leaves_with_several_shells)
     const double lo[] = {0, 2, 4}, hi[] = {10, 8, 6};
     const bool out_out[] = {false, false}, out_in[] = {false, true}, in_out[] = {true, false};
     const bool out_in_out[] = {false, true, false}, in[] = {true};
-    const char *slab = "translate([5,-1,-1]) cube([20,5,20]);";
+    const char *slab = shell_slab;
     char *nested = box_shells(lo, hi, out_out, 2), *cavity = box_shells(lo, hi, out_in, 2);
     char *hollow = box_shells(lo, hi, in_out, 2), *triple = box_shells(lo, hi, out_in_out, 3);
     char *inverted = box_shells(lo, hi, in, 1);
@@ -491,28 +494,31 @@ TEST(leaves_with_several_shells)
     expect_tree_volume("difference", cavity, nested, 0, 0);
     expect_tree_volume("union", triple, cavity, 792, 3);
     expect_tree_volume("union", inverted, cavity, 784, 2);
-    /* Shells crossing each other: [0,10], [5,15] and [2,12] cubes in one leaf. */
-    {
-        const double olo[] = {0, 5, 2}, ohi[] = {10, 15, 12};
-        const bool in_second[] = {false, true, false}, outward[] = {false, false, false};
-        char *two = box_shells(olo, ohi, outward, 2), *three = box_shells(olo, ohi, outward, 3);
-        char *minus = box_shells(olo, ohi, in_second, 2);
-        expect_tree_volume("union", two, "", 1875, 1);
-        expect_tree_volume("union", three, "", 3000 - 980 + 125, 1);
-        expect_tree_volume("union", minus, "", 875, 1); /* the inward cube cuts the other */
-        expect_tree_volume("difference", two, slab, 1675, 1);
-        expect_tree_volume("difference", "cube(12);", two, 1728 - 1218, 1);
-        expect_tree_volume("intersection", two, three, 1875, 1);
-        expect_tree_volume("difference", three, two, 2145 - 1875, 1);
-        free(two);
-        free(three);
-        free(minus);
-    }
     free(nested);
     free(cavity);
     free(hollow);
     free(triple);
     free(inverted);
+}
+
+/* Shells of one leaf crossing each other: [0,10], [5,15] and [2,12] cubes. Overlapping
+ * outward shells are their union; an inward one cuts the others. */
+TEST(leaves_with_crossing_shells)
+{
+    const double lo[] = {0, 5, 2}, hi[] = {10, 15, 12};
+    const bool in_second[] = {false, true, false}, outward[] = {false, false, false};
+    char *two = box_shells(lo, hi, outward, 2), *three = box_shells(lo, hi, outward, 3);
+    char *minus = box_shells(lo, hi, in_second, 2);
+    expect_tree_volume("union", two, "", 1875, 1);
+    expect_tree_volume("union", three, "", 3000 - 980 + 125, 1);
+    expect_tree_volume("union", minus, "", 875, 1);
+    expect_tree_volume("difference", two, shell_slab, 1675, 1);
+    expect_tree_volume("difference", "cube(12);", two, 1728 - 1218, 1);
+    expect_tree_volume("intersection", two, three, 1875, 1);
+    expect_tree_volume("difference", three, two, 2145 - 1875, 1);
+    free(two);
+    free(three);
+    free(minus);
 }
 
 TEST(curved_volumes_add_up)
@@ -1160,6 +1166,7 @@ int main(void)
     RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
     RUN(leaves_with_several_shells);
+    RUN(leaves_with_crossing_shells);
     RUN(repair_joins_overlapping_shells);
     return test_summary();
 }
