@@ -1,9 +1,10 @@
 /*
  * The evaluator's input contract, checked before any geometry: every primitive must be
  * a closed, consistently oriented, edge-manifold mesh with finite coordinates and no
- * zero-area triangles (they have no plane). It may have several shells, nested or apart,
- * and shells may face inward: the primitive's solid is where its winding number is
- * positive, so an inward shell inside another is a cavity and one on its own is empty.
+ * zero-area triangles (they have no plane). It may have several shells, apart, nested or
+ * crossing each other (not touching), and shells may face inward: the primitive's solid
+ * is where its winding number is positive, so overlapping shells are their union, an
+ * inward shell inside another is a cavity and one on its own is empty.
  * Such primitives are marked for classification by winding numbers
  * (mci_ptree.leaf_winding). A leaf that breaks the contract is
  * named in a one-line message (its label says which file or primitive it came from, and
@@ -122,28 +123,36 @@ static mcsg_status shell_self_intersections(const mci_ctx *ctx, const mci_ptree 
 {
     const mcsg_mesh *m = ptree->leaf_mesh[k];
     const uint32_t *shell = whole ? NULL : ptree->leaf_shell[k];
-    uint32_t *tris, *index;
+    uint32_t shells = ptree->leaf_shells[k], *tris, *index, *start;
     mcsg_status st = MCSG_OK;
     if (!shell)
         return mcsg_mesh_self_intersections(m, opts, pairs, example, err);
     tris = mci_malloc_array(ctx, 3 * m->triangle_count + 1, sizeof *tris);
     index = mci_malloc_array(ctx, m->triangle_count + 1, sizeof *index);
+    start = mci_calloc_array(ctx, (size_t)shells + 2, sizeof *start);
     *pairs = 0;
-    if (!tris || !index)
+    if (!tris || !index || !start)
         st = mci_fail_nomem(err, "checking the leaves");
-    for (uint32_t s = 0; st == MCSG_OK && s < ptree->leaf_shells[k] && *pairs == 0; s++) {
-        mcsg_mesh part = {m->vertices, tris, m->vertex_count, 0};
-        for (size_t t = 0; t < m->triangle_count; t++)
-            if (shell[t] == s) {
-                memcpy(tris + 3 * part.triangle_count, m->triangles + 3 * t, 3 * sizeof *tris);
-                index[part.triangle_count++] = (uint32_t)t;
-            }
+    /* Triangles by shell (a counting sort): a file of thousands of parts is one pass. */
+    for (size_t t = 0; st == MCSG_OK && t < m->triangle_count; t++)
+        start[shell[t] + 2]++;
+    for (uint32_t s = 2; st == MCSG_OK && s < shells + 2; s++)
+        start[s] += start[s - 1];
+    for (size_t t = 0; st == MCSG_OK && t < m->triangle_count; t++) {
+        uint32_t at = start[shell[t] + 1]++;
+        memcpy(tris + 3 * (size_t)at, m->triangles + 3 * t, 3 * sizeof *tris);
+        index[at] = (uint32_t)t;
+    }
+    for (uint32_t s = 0; st == MCSG_OK && s < shells && *pairs == 0; s++) {
+        mcsg_mesh part = {m->vertices, tris + 3 * (size_t)start[s], m->vertex_count,
+                          start[s + 1] - start[s]};
         st = mcsg_mesh_self_intersections(&part, opts, pairs, example, err);
         if (st == MCSG_OK && *pairs > 0)
-            example[0] = index[example[0]], example[1] = index[example[1]];
+            example[0] = index[start[s] + example[0]], example[1] = index[start[s] + example[1]];
     }
     mci_free(ctx, tris);
     mci_free(ctx, index);
+    mci_free(ctx, start);
     return st;
 }
 

@@ -46,5 +46,11 @@ run 0 repair "$WORK/inverted.off" && contains '0 shells out (0 cavities), 0 vert
 shells "$WORK/folded.off" 0:10
 sed -i 's/^10 10 10$/5 5 -2/' "$WORK/folded.off"
 run 1 repair "$WORK/folded.off" && contains 'intersects itself'
+# The same fold in the second of two shells: named with triangles of that shell.
+shells "$WORK/folded2.off" 0:10 20:30
+sed -i 's/^30 30 30$/25 25 18/' "$WORK/folded2.off"
+run 1 repair "$WORK/folded2.off" && contains 'intersects itself'
+printf '%s' "$OUT" | grep -qE 'e\.g\. triangles (1[2-9]|2[0-3]) and (1[2-9]|2[0-3])$' && passed=$((passed + 1)) ||
+  { echo "FAIL: expected an example pair in the second shell: $OUT"; failed=$((failed + 1)); }
 
 finish
