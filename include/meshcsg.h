@@ -252,7 +252,7 @@ typedef struct mcsg_check_report {
     size_t inconsistent_edges;    /* used twice in the same direction */
     size_t duplicate_vertices;    /* coordinates identical to an earlier vertex (info) */
     size_t unused_vertices;       /* referenced by no triangle (info) */
-    size_t components;            /* connected components over shared edges */
+    size_t components;            /* shells: see self_touching_edges below */
     double volume;                /* signed volume, rounded (meaningful when closed) */
     int inverted;                 /* 1: closed, consistent, and the exact volume sign is
                                      negative: every triangle faces inward */
@@ -266,6 +266,17 @@ typedef struct mcsg_check_report {
     uint32_t example_boundary_edge[2];
     uint32_t example_nonmanifold_edge[2];
     uint32_t example_inconsistent_edge[2];
+    /* Closed as a chain (what mcsg_eval requires of a primitive): every edge is used
+     * equally often in each direction. Non-manifold edges that are not are counted here;
+     * boundary and inconsistent edges above never are. */
+    size_t unbalanced_edges;      /* more than two triangles, unequal directions */
+    uint32_t example_unbalanced_edge[2];
+    /* Shells (what `components` counts): triangles joined across edges, where at an edge
+     * of more than two triangles the k-th use in one direction is joined with the k-th
+     * in the other (in triangle order). An edge where one shell has more than two
+     * triangles is counted here: mcsg_eval does not take such a primitive. */
+    size_t self_touching_edges;
+    uint32_t example_self_touching_edge[2];
 } mcsg_check_report;
 
 /* Examine a mesh. Returns MCSG_OK when the examination ran (whatever it found); the

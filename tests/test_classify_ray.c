@@ -142,10 +142,14 @@ static void windings_at(const mci_octree *o, uint32_t m, const double *a, const 
     mci_ray_scratch scratch = {0};
     mci_plane at;
     mci_point p;
+    mci_plane_windings got;
     mci_ctx_init(&ctx, NULL);
     mci_plane_init(&at, a, b, c);
     mci_point_explicit(&p, x);
-    CHECK(mci_ray_windings_on_plane(&ctx, &p, o, m, &at, &scratch, behind, front, decided));
+    CHECK(mci_ray_windings_on_plane(&ctx, &p, o, m, &at, &scratch, &got));
+    *behind = got.behind;
+    *front = got.in_front;
+    *decided = got.decided;
     mci_ray_scratch_free(&ctx, &scratch);
 }
 

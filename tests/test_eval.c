@@ -409,10 +409,10 @@ TEST(cad_fan_plates)
 
 /* Exact volumes of curved solids are unknown, but they must add up: vol(A u B) +
  * vol(A n B) = vol(A) + vol(B) and vol(A - B) = vol(A) - vol(A n B), to rounding. */
-/* A polyhedron of axis-aligned boxes, one shell each: box k spans lo[k] .. hi[k] on every
- * axis and faces inward when inward[k]. OpenSCAD lists faces clockwise seen from
- * outside. */
-static char *box_shells(const double *lo, const double *hi, const bool *inward, int n)
+/* A polyhedron of axis-aligned boxes, one shell each: box k spans lo[k] .. hi[k] and
+ * faces inward when inward[k] (NULL: none does). OpenSCAD lists faces clockwise seen
+ * from outside. */
+static char *boxes_polyhedron(double (*lo)[3], double (*hi)[3], const bool *inward, int n)
 {
     static const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
@@ -422,19 +422,30 @@ static char *box_shells(const double *lo, const double *hi, const bool *inward, 
     for (int k = 0; k < n; k++)
         for (int c = 0; c < 8; c++)
             len += (size_t)snprintf(text + len, cap - len, "%s[%g,%g,%g]", k + c ? "," : "",
-                                    c & 4 ? hi[k] : lo[k], c & 2 ? hi[k] : lo[k],
-                                    c & 1 ? hi[k] : lo[k]);
+                                    c & 4 ? hi[k][0] : lo[k][0], c & 2 ? hi[k][1] : lo[k][1],
+                                    c & 1 ? hi[k][2] : lo[k][2]);
     len += (size_t)snprintf(text + len, cap - len, "], faces=[");
     for (int k = 0; k < n; k++)
         for (int f = 0; f < 6; f++) {
             int c[4];
+            bool flip = inward && inward[k];
             for (int i = 0; i < 4; i++)
-                c[i] = 8 * k + quads[f][inward[k] ? 3 - i : i];
+                c[i] = 8 * k + quads[f][flip ? 3 - i : i];
             len += (size_t)snprintf(text + len, cap - len, "%s[%d,%d,%d,%d]", k + f ? "," : "",
                                     c[0], c[1], c[2], c[3]);
         }
     snprintf(text + len, cap - len, "]);");
     return text;
+}
+
+/* The same for cubes: box k spans lo[k] .. hi[k] on every axis. */
+static char *box_shells(const double *lo, const double *hi, const bool *inward, int n)
+{
+    double l[3][3], h[3][3];
+    for (int k = 0; k < n && k < 3; k++)
+        for (int i = 0; i < 3; i++)
+            l[k][i] = lo[k], h[k][i] = hi[k];
+    return boxes_polyhedron(l, h, inward, n < 3 ? n : 3);
 }
 
 /* "op() { A B }" in a buffer of its own. */
@@ -519,6 +530,60 @@ TEST(leaves_with_crossing_shells)
     free(two);
     free(three);
     free(minus);
+}
+
+/* Leaves closed as chains but not manifold, each shell kept apart where edges are shared
+ * by four triangles: boxes sharing an edge or a face, a box listed twice (winding number
+ * 2), faces lying in each other facing either way. */
+TEST(leaves_closed_as_chains)
+{
+    static double edge_lo[2][3] = {{0, 0, 0}, {10, 10, 0}};
+    static double edge_hi[2][3] = {{10, 10, 10}, {20, 20, 10}};
+    static double face_lo[2][3] = {{0, 0, 0}, {10, 0, 0}};
+    static double face_hi[2][3] = {{10, 10, 10}, {20, 10, 10}};
+    static double part_lo[2][3] = {{0, 0, 0}, {10, 2, 2}};
+    static double part_hi[2][3] = {{10, 10, 10}, {20, 8, 8}};
+    static double inner_lo[2][3] = {{0, 0, 0}, {5, 2, 2}};
+    static double inner_hi[2][3] = {{10, 10, 10}, {10, 8, 8}};
+    static double twice_lo[2][3] = {{0, 0, 0}, {0, 0, 0}};
+    static double twice_hi[2][3] = {{10, 10, 10}, {10, 10, 10}};
+    static const bool second_inward[2] = {false, true};
+    char *edge = boxes_polyhedron(edge_lo, edge_hi, NULL, 2);
+    char *face = boxes_polyhedron(face_lo, face_hi, NULL, 2);
+    char *part = boxes_polyhedron(part_lo, part_hi, NULL, 2);
+    char *inner = boxes_polyhedron(inner_lo, inner_hi, NULL, 2);
+    char *twice = boxes_polyhedron(twice_lo, twice_hi, NULL, 2);
+    char *cancel = boxes_polyhedron(twice_lo, twice_hi, second_inward, 2);
+    char *cut = boxes_polyhedron(inner_lo, inner_hi, second_inward, 2);
+    const char *slab = "translate([5,-1,-1]) cube([20,3,20]);";
+    const char *block = "translate([3,3,3]) cube([12,12,4]);";
+    char *text;
+    expect_touching(text = tree_of("union", edge, ""), 2000, 2);
+    free(text);
+    expect_touching(text = tree_of("difference", edge, slab), 1900, 2);
+    free(text);
+    expect_tree_volume("union", face, "", 2000, 1);
+    expect_tree_volume("difference", face, slab, 1700, 1);
+    expect_tree_volume("intersection", face, block, 336, 1);
+    expect_tree_volume("union", part, "", 1360, 1);
+    expect_tree_volume("difference", part, slab, 1260, 1);
+    expect_tree_volume("intersection", part, block, 296, 1);
+    expect_tree_volume("union", inner, "", 1000, 1);
+    expect_tree_volume("difference", inner, slab, 900, 1);
+    expect_tree_volume("union", twice, "", 1000, 1);
+    expect_tree_volume("difference", twice, slab, 900, 1);
+    expect_tree_volume("intersection", twice, block, 196, 1);
+    expect_tree_volume("union", cancel, "", 0, 0);
+    expect_tree_volume("union", cancel, block, 576, 1);
+    expect_tree_volume("union", cut, "", 820, 1);
+    expect_tree_volume("difference", cut, slab, 720, 1);
+    free(edge);
+    free(face);
+    free(part);
+    free(inner);
+    free(twice);
+    free(cancel);
+    free(cut);
 }
 
 TEST(curved_volumes_add_up)
@@ -1104,7 +1169,8 @@ TEST(input_contract_is_checked)
     expect_contract_error(&m, "the surface is open: 3 boundary edges, e.g. from (");
     m.triangle_count = 13;
     memcpy(t + 36, t, 3 * sizeof *t);
-    expect_contract_error(&m, "non-manifold edges");
+    expect_contract_error(&m, "the surface does not close up: 3 edges of more than two "
+                              "triangles are used more often one way than the other, e.g. ");
     m.triangle_count = 12;
     t[0] = 0, t[1] = 1, t[2] = 2; /* one triangle flipped */
     expect_contract_error(&m, "not consistently oriented");
@@ -1167,6 +1233,7 @@ int main(void)
     RUN(input_contract_is_checked);
     RUN(leaves_with_several_shells);
     RUN(leaves_with_crossing_shells);
+    RUN(leaves_closed_as_chains);
     RUN(repair_joins_overlapping_shells);
     return test_summary();
 }

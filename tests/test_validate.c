@@ -110,7 +110,40 @@ TEST(duplicate_triangle_is_nonmanifold)
     CHECK_EQ_SIZE(r.duplicate_triangles, 1);
     CHECK_EQ_SIZE(r.example_duplicate_triangle, 12);
     CHECK_EQ_SIZE(r.nonmanifold_edges, 3);
+    CHECK_EQ_SIZE(r.unbalanced_edges, 3); /* used twice one way, once the other */
     CHECK(!mcsg_check_report_is_valid(&r));
+}
+
+/* Closed as a chain though not manifold: every edge used equally often each way. The
+ * shells are paired at the shared edges, so a cube listed twice is two shells, and two
+ * cubes sharing an edge stay apart. */
+TEST(balanced_edges_pair_shells)
+{
+    test_mesh m;
+    mcsg_check_report r;
+    make_cube(&m);
+    memcpy(m.t + 36, cube_triangles, sizeof cube_triangles);
+    m.mesh.triangle_count = 24;
+    r = check(&m.mesh);
+    CHECK_EQ_SIZE(r.nonmanifold_edges, 18);
+    CHECK_EQ_SIZE(r.unbalanced_edges + r.boundary_edges + r.inconsistent_edges, 0);
+    CHECK_EQ_SIZE(r.self_touching_edges, 0);
+    CHECK_EQ_SIZE(r.components, 2);
+    CHECK_EQ_DOUBLE(r.volume, 2.0);
+    /* A second cube at (1, 1, 0): it shares the edge from (1,1,0) to (1,1,1). */
+    make_cube(&m);
+    for (int i = 0; i < 24; i++)
+        m.v[24 + i] = cube_vertices[i] + (i % 3 < 2 ? 1 : 0);
+    for (int i = 0; i < 36; i++)
+        m.t[36 + i] = cube_triangles[i] + 8;
+    m.mesh.vertex_count = 16;
+    m.mesh.triangle_count = 24;
+    r = check(&m.mesh);
+    CHECK_EQ_SIZE(r.nonmanifold_edges, 1);
+    CHECK_EQ_SIZE(r.example_nonmanifold_edge[0], 2);
+    CHECK_EQ_SIZE(r.unbalanced_edges + r.self_touching_edges, 0);
+    CHECK_EQ_SIZE(r.components, 2);
+    CHECK_EQ_DOUBLE(r.volume, 2.0);
 }
 
 TEST(degenerate_triangles)
@@ -387,6 +420,7 @@ int main(void)
     RUN(flipped_triangle_gives_inconsistent_edges);
     RUN(inverted_cube_is_reported_and_flippable);
     RUN(duplicate_triangle_is_nonmanifold);
+    RUN(balanced_edges_pair_shells);
     RUN(degenerate_triangles);
     RUN(out_of_range_and_nonfinite);
     RUN(unwelded_cube_is_judged_by_geometry);

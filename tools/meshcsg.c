@@ -116,6 +116,10 @@ static void print_problems(const char *name, const mcsg_mesh *m, const mcsg_chec
                        "non-manifold edges (shared by more than two triangles)");
     print_edge_problem(name, m, r->inconsistent_edges, r->example_inconsistent_edge,
                        "inconsistently oriented edges (neighbours face opposite ways)");
+    if (r->nonmanifold_edges && !r->unbalanced_edges && !r->boundary_edges &&
+        !r->inconsistent_edges && !r->self_touching_edges)
+        printf("%s: note: closed as a chain (each edge used as often one way as the other): "
+               "eval and repair take it as %zu shells\n", name, r->components);
 }
 
 /* Check one mesh; flips it in place when it is consistently inverted. Returns 1 when

@@ -22,7 +22,10 @@ static mcsg_status winding_candidates(mci_leaf_work *w)
     for (size_t c = 0; c < w->ncand; c++)
         any |= (w->cand_winding[c] = winding[w->cand[c]]) != 0;
     if (winding[w->leaf]) {
-        if (!(w->own_front = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *w->own_front)))
+        w->own_front = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *w->own_front);
+        w->own_coin = mci_malloc_array(w->ctx, w->nreg + 1, sizeof *w->own_coin);
+        w->own_first = mci_malloc_array(w->ctx, w->nreg + 1, 1);
+        if (!w->own_front || !w->own_coin || !w->own_first)
             return mci_fail_nomem(w->err, "classifying faces");
         for (size_t r = 0; r < w->nreg; r++)
             w->own_front[r] = MCI_WIND_UNKNOWN;
@@ -179,16 +182,14 @@ static bool labels_from_vertices(mci_leaf_work *w, uint32_t r, size_t first, siz
 static bool label_from_inside(mci_leaf_work *w, uint32_t r, size_t c, const mci_point *q,
                               const mci_plane *at)
 {
-    int behind, in_front;
-    bool decided;
+    mci_plane_windings got;
     if (!w->cand_winding[c])
         return mci_leaf_label_by_ray(w, r, c, q);
     w->stats->rays++;
-    if (!mci_ray_windings_on_plane(w->ctx, q, &w->s->octree, w->cand[c], at, &w->ray, &behind,
-                                   &in_front, &decided))
+    if (!mci_ray_windings_on_plane(w->ctx, q, &w->s->octree, w->cand[c], at, &w->ray, &got))
         return false;
-    if (decided)
-        set_windings(w, r, c, behind, in_front);
+    if (got.decided)
+        set_windings(w, r, c, got.behind, got.in_front);
     return true;
 }
 
@@ -266,7 +267,7 @@ static void slot_points(const mci_leaf_work *w, size_t k, mci_point *x, mci_poin
 static mci_wind_sum wind_steps(mci_leaf_work *w, size_t k, size_t begin, size_t end)
 {
     const mci_scene *s = w->s;
-    mci_wind_sum sum = {0, 0, false};
+    mci_wind_sum sum = {0, 0, false, false};
     uint32_t seen[8];
     size_t nseen = 0, k1 = w->mate[k];
     mci_point x, y, far, x1, y1, far1;
@@ -306,13 +307,24 @@ static void winding_across(mci_leaf_work *w, uint32_t from, uint32_t r, size_t c
     set_windings(w, r, c, before + sum.front + w->coin[at] + sum.coincident, before + sum.front);
 }
 
-/* This leaf's own number in front of region r from region `from`'s, across shells of it
- * that cross the region's face. */
+/* Region r has this leaf's own numbers of region `from` (none of its faces lies between). */
+static void own_copy(mci_leaf_work *w, uint32_t from, uint32_t r)
+{
+    w->own_front[r] = w->own_front[from];
+    w->own_coin[r] = w->own_coin[from];
+    w->own_first[r] = w->own_first[from];
+}
+
+/* This leaf's own numbers of region r from region `from`'s, across shells of it that
+ * cross the region's face. Where another of its faces lies in either region, which
+ * shells lie in r is not carried over: a ray decides (mci_leaf_own_seed). */
 static void own_across(mci_leaf_work *w, uint32_t from, uint32_t r, mci_wind_sum sum)
 {
-    int32_t before = w->own_front[from];
-    w->own_front[r] = before == MCI_WIND_UNKNOWN || sum.unknown ? MCI_WIND_UNKNOWN
-                                                               : before + sum.front;
+    own_copy(w, from, r);
+    if (w->own_front[r] == MCI_WIND_UNKNOWN || sum.unknown || sum.coplanar)
+        w->own_front[r] = MCI_WIND_UNKNOWN;
+    else
+        w->own_front[r] += sum.front;
 }
 
 /* Labels of region r, whose piece has edge slot k, with respect to the leaves holding
@@ -367,7 +379,7 @@ static void inherit_labels(mci_leaf_work *w, uint32_t r1, uint32_t r2, size_t k)
                w->ncand * sizeof *w->coin);
     }
     if (w->own_front)
-        w->own_front[r2] = w->own_front[r1];
+        own_copy(w, r1, r2);
     local_labels_at(w, r2, k, false, r1);
     if (w->own_front && w->own_front[r2] == MCI_WIND_UNKNOWN && !w->out_of_memory)
         mci_leaf_own_seed(w, r2);
@@ -403,7 +415,7 @@ static void fill_unknown_own(mci_leaf_work *w)
                 if (separator_on_leaf(w, k, w->leaf))
                     local_labels_at(w, r, k, true, r2);
                 else
-                    w->own_front[r] = w->own_front[r2];
+                    own_copy(w, r2, r);
                 changed |= w->own_front[r] != MCI_WIND_UNKNOWN;
             }
     }

@@ -44,10 +44,15 @@ typedef struct mci_leaf_work {
      * ncand, that leaf's winding number in front of the region, MCI_WIND_UNKNOWN if not
      * known yet, and coin (the same size) how much more it is behind the region (not 0
      * where the region lies in that leaf's surface); own_front (NULL unless this leaf is
-     * one): per region, this leaf's winding number in front of it, or MCI_WIND_UNKNOWN. */
+     * one): per region, this leaf's winding number in front of it, or MCI_WIND_UNKNOWN;
+     * own_coin: how much more it is behind (1 unless other faces of the leaf lie in the
+     * region, as when a triangle is listed twice); own_first: the region's shell is the
+     * lowest group among those whose faces lie in it facing the same way (of coincident
+     * pieces that bound the solid, only that one is output). */
     uint8_t *cand_winding;
     int32_t *wind, *coin;
-    int32_t *own_front;
+    int32_t *own_front, *own_coin;
+    uint8_t *own_first;
     uint8_t *needed;  /* per candidate: in a subtree of the trimmed CSGlist */
     mci_csg_entry *list; /* the CSGlist, trimmed by the labels known for the whole leaf */
     size_t nlist;
@@ -110,8 +115,9 @@ bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only
 /* Winding numbers (classify_winding.c). */
 #define MCI_WIND_UNKNOWN INT32_MIN
 
-/* own_front[r] by a ray from a point inside one of region r's pieces; false when no
- * piece gives a point whose ray decides (w->out_of_memory set when out of memory). */
+/* own_front[r], own_coin[r] and own_first[r] by a ray from a point inside one of region
+ * r's pieces; false when no piece gives a point whose ray decides (w->out_of_memory set
+ * when out of memory). */
 bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r);
 /* The label of a region with the winding numbers behind and in front of it. */
 mci_label mci_label_of_windings(int32_t behind, int32_t in_front);
@@ -122,6 +128,7 @@ mci_label mci_label_of_windings(int32_t behind, int32_t in_front);
 typedef struct mci_wind_sum {
     int32_t front, coincident;
     bool unknown;
+    bool coplanar; /* a region on either side lies in a face of that leaf */
 } mci_wind_sum;
 /* Adds one shell holding the separator, with the local labels of the region before and
  * of the region after with respect to it. */

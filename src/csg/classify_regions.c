@@ -218,15 +218,23 @@ static bool list_sides_by_vertex(mci_leaf_work *w, size_t n, vertex_sides *vs, b
     return true;
 }
 
-/* Border slots of vertex `from` going to vertex `to`: how many, and the first. */
-static size_t sides_between(const vertex_sides *vs, uint32_t from, uint32_t to,
-                            uint32_t *first)
+/* The group of the face holding edge slot k: shells of one leaf that may cross each
+ * other (or lie in each other's faces) are paired each on its own. */
+static uint32_t slot_group(const mci_leaf_work *w, size_t k)
+{
+    return mci_scene_face_group(w->s, w->pface[k / 3]);
+}
+
+/* Border slots of vertex `from` going to vertex `to` in faces of group g: how many, and
+ * the first. */
+static size_t sides_between(const mci_leaf_work *w, const vertex_sides *vs, uint32_t from,
+                            uint32_t to, uint32_t g, uint32_t *first)
 {
     size_t count = 0;
     if (from < vs->first || from > vs->last)
         return 0;
     for (uint32_t i = vs->start[from - vs->first]; i < vs->start[from - vs->first + 1]; i++)
-        if (vs->sides[i].to == to && count++ == 0)
+        if (vs->sides[i].to == to && slot_group(w, vs->sides[i].slot) == g && count++ == 0)
             *first = vs->sides[i].slot;
     return count;
 }
@@ -251,13 +259,13 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
     ok = n > 0 && (vs.last - vs.first) / 8 < n && list_sides_by_vertex(w, n, &vs, nomem);
     for (size_t s = 0; ok && s < n; s++) {
         uint32_t k = vs.sides[s].slot, u = mci_leaf_slot_from(w, k), v = vs.sides[s].to;
-        uint32_t back = MCI_NONE, ignored;
+        uint32_t back = MCI_NONE, ignored, g = slot_group(w, k);
         uint64_t key = mci_edge_key(u, v);
         size_t ahead, behind;
         if (w->mate[k] != MCI_NONE)
             continue;
-        ahead = sides_between(&vs, u, v, &ignored);
-        behind = sides_between(&vs, v, u, &back);
+        ahead = sides_between(w, &vs, u, v, g, &ignored);
+        behind = sides_between(w, &vs, v, u, g, &back);
         if (u != v && ahead == 1 && behind == 1) {
             w->mate[k] = back;
             w->mate[back] = (uint32_t)k;
@@ -269,6 +277,31 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
     mci_free(w->ctx, vs.start);
     mci_free(w->ctx, vs.sides);
     return ok;
+}
+
+/* Pairs the n sides of one edge (a run of equal keys), each with the opposite side of
+ * its own group; the pairs are separators if `separator`. */
+static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
+{
+    for (size_t a = 0; a < n; a++) {
+        uint32_t k = run[a].ref;
+        size_t b = a + 1;
+        if (w->mate[k] != MCI_NONE)
+            continue;
+        while (b < n && (w->mate[run[b].ref] != MCI_NONE ||
+                         mci_leaf_slot_from(w, run[b].ref) != mci_leaf_slot_to(w, k) ||
+                         slot_group(w, run[b].ref) != slot_group(w, k)))
+            b++;
+        if (b == n)
+            return mci_fail(w->err, MCSG_ERR_INTERNAL,
+                            "leaf %u does not close up after splitting: an edge is shared by "
+                            "%zu pieces%s (inputs must be closed and edge-manifold)",
+                            w->leaf, n, n == 2 ? " with equal orientations" : "");
+        w->mate[k] = run[b].ref;
+        w->mate[run[b].ref] = k;
+        w->is_sep[k] = w->is_sep[run[b].ref] = separator;
+    }
+    return MCSG_OK;
 }
 
 /* Pair every directed piece edge with its opposite; a closed, consistently oriented
@@ -309,19 +342,9 @@ static mcsg_status pair_edges(mci_leaf_work *w)
             i = j;
             continue;
         }
-        if (j - i != 2 || mci_leaf_slot_from(w, e[i].ref) != mci_leaf_slot_to(w, e[i + 1].ref))
-            st = mci_fail(w->err, MCSG_ERR_INTERNAL,
-                          "leaf %u does not close up after splitting: an edge is shared by "
-                          "%zu pieces%s (inputs must be closed and edge-manifold)",
-                          w->leaf, j - i, j - i == 2 ? " with equal orientations" : "");
-        else {
-            w->mate[e[i].ref] = e[i + 1].ref;
-            w->mate[e[i + 1].ref] = e[i].ref;
-            while (sep < w->nsep && w->sep[sep].key < e[i].key)
-                sep++;
-            w->is_sep[e[i].ref] = w->is_sep[e[i + 1].ref] =
-                sep < w->nsep && w->sep[sep].key == e[i].key;
-        }
+        while (sep < w->nsep && w->sep[sep].key < e[i].key)
+            sep++;
+        st = pair_sides(w, e + i, j - i, sep < w->nsep && w->sep[sep].key == e[i].key);
         i = j;
     }
     mci_free(w->ctx, e);

@@ -188,11 +188,14 @@ static int region_accepts(mci_leaf_work *w, uint32_t r, size_t k)
                                       w->scratch);
 }
 
-/* Whether region r lies where this leaf's winding number is the same on both sides
- * (not 0 in front and 1 behind): then it bounds nothing of the leaf's solid. */
+/* Whether region r bounds nothing of this leaf's solid facing its way: the winding
+ * number is positive on both sides or on neither, or positive only in front (another
+ * face of the leaf lying in the region, facing the other way, bounds it), or another
+ * shell facing this way lies in the region and comes first (mci_leaf_work.own_first). */
 static bool off_own_boundary(const mci_leaf_work *w, uint32_t r)
 {
-    return w->own_front && w->own_front[r] != 0;
+    return w->own_front && !(w->own_front[r] <= 0 && w->own_front[r] + w->own_coin[r] > 0 &&
+                             w->own_first[r]);
 }
 
 /* keep[r] for every region, for this leaf (k = ncopies) or its copy k. */

@@ -85,18 +85,20 @@ bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r)
         double ends[2][3];
         mci_point q;
         mci_plane at;
-        int behind, in_front;
-        bool decided;
+        mci_plane_windings got;
         if (!mci_leaf_piece_inside(w, w->reg_pieces[k], (int)attempt, ends, &q, &at))
             continue;
         w->stats->rays++;
         if (!mci_ray_windings_on_plane(w->ctx, &q, &w->s->octree, w->leaf, &at, &w->ray,
-                                       &behind, &in_front, &decided)) {
+                                       &got)) {
             w->out_of_memory = true;
             return false;
         }
-        if (decided && behind == in_front + 1) { /* else another shell lies in the face */
-            w->own_front[r] = in_front;
+        if (got.decided) {
+            w->own_front[r] = got.in_front;
+            w->own_coin[r] = got.behind - got.in_front;
+            w->own_first[r] = got.first_same ==
+                              mci_scene_face_group(w->s, w->pface[w->reg_pieces[k]]);
             return true;
         }
     }
@@ -129,6 +131,8 @@ void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local)
         sum->unknown = true;
         return;
     }
+    sum->coplanar |= from_local == MCI_LABEL_SAME || from_local == MCI_LABEL_OPPO ||
+                     to_local == MCI_LABEL_SAME || to_local == MCI_LABEL_OPPO;
     sum->front += offset_in_front(to_local) - offset_in_front(from_local);
     sum->coincident += offset_behind(to_local) - offset_in_front(to_local) -
                        (offset_behind(from_local) - offset_in_front(from_local));

@@ -108,11 +108,10 @@ void mci_scene_free(const mci_ctx *ctx, mci_scene *scene);
 void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene);
 
 /* Corner k of global face f. */
-/* The group of face f: its leaf, or its shell in a leaf whose shells may cross (see
- * mci_octree_params.face_group). Segments of one group do not cross. */
+/* The group of face f (mci_octree_face_group). */
 static inline uint32_t mci_scene_face_group(const mci_scene *scene, uint32_t f)
 {
-    return scene->octree.face_group ? scene->octree.face_group[f] : scene->octree.face_leaf[f];
+    return mci_octree_face_group(&scene->octree, f);
 }
 
 static inline const double *mci_scene_corner(const mci_scene *scene, uint32_t f, int k)

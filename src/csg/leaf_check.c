@@ -48,11 +48,12 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
         format_point(b, sizeof b, m, r->example_boundary_edge[1]);
         snprintf(out, size, "the surface is open: %zu boundary edges, e.g. from %s to %s",
                  r->boundary_edges, a, b);
-    } else if (r->nonmanifold_edges) {
-        format_point(a, sizeof a, m, r->example_nonmanifold_edge[0]);
-        format_point(b, sizeof b, m, r->example_nonmanifold_edge[1]);
-        snprintf(out, size, "%zu non-manifold edges (shared by more than two triangles), "
-                 "e.g. from %s to %s", r->nonmanifold_edges, a, b);
+    } else if (r->unbalanced_edges) {
+        format_point(a, sizeof a, m, r->example_unbalanced_edge[0]);
+        format_point(b, sizeof b, m, r->example_unbalanced_edge[1]);
+        snprintf(out, size, "the surface does not close up: %zu edges of more than two "
+                 "triangles are used more often one way than the other, e.g. from %s to %s",
+                 r->unbalanced_edges, a, b);
     } else if (r->inconsistent_edges) {
         format_point(a, sizeof a, m, r->example_inconsistent_edge[0]);
         format_point(b, sizeof b, m, r->example_inconsistent_edge[1]);
@@ -62,9 +63,11 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
     } else if (r->degenerate_triangles) {
         snprintf(out, size, "%zu triangles of zero area (no plane), e.g. triangle %u",
                  r->degenerate_triangles, r->example_degenerate_triangle);
-    } else if (r->duplicate_triangles) {
-        snprintf(out, size, "%zu triangles repeat the three vertices of another, e.g. "
-                 "triangle %u", r->duplicate_triangles, r->example_duplicate_triangle);
+    } else if (r->self_touching_edges) {
+        format_point(a, sizeof a, m, r->example_self_touching_edge[0]);
+        format_point(b, sizeof b, m, r->example_self_touching_edge[1]);
+        snprintf(out, size, "not supported: %zu edges where one shell meets itself with "
+                 "more than two triangles, e.g. from %s to %s", r->self_touching_edges, a, b);
     } else if (r->volume_sign == 0 && r->components == 1) {
         snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
                  "other, e.g. all in one plane)");

@@ -65,6 +65,13 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                              mci_octree *out, mcsg_error *err);
 void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
 
+/* The group of face f: its leaf, or its shell in a leaf whose shells may cross (see
+ * mci_octree_params.face_group). Segments of one group do not cross. */
+static inline uint32_t mci_octree_face_group(const mci_octree *tree, uint32_t f)
+{
+    return tree->face_group ? tree->face_group[f] : tree->face_leaf[f];
+}
+
 /* Free the face boxes (once the candidate pairs are taken). */
 void mci_octree_free_boxes(const mci_ctx *ctx, mci_octree *tree);
 

@@ -235,12 +235,13 @@ static void windings_beside(const mci_plane *at, int beyond, int coincident, int
 
 bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
                                uint32_t m, const mci_plane *at, mci_ray_scratch *s,
-                               int *behind, int *in_front, bool *decided)
+                               mci_plane_windings *out)
 {
     double lo[3], hi[3];
     int beyond = 0, coincident = 0;
     mci_point_bounds(p, lo, hi);
-    *decided = false;
+    out->decided = false;
+    out->first_same = UINT32_MAX;
     if (!collect_ray_faces(ctx, o, m, lo, hi, s))
         return false;
     for (size_t i = 0; i < s->face_count; i++) {
@@ -254,10 +255,12 @@ bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci
             if (orientation == 0 || !strictly_inside(p, a, b, c))
                 return true;
             coincident += orientation;
+            if (orientation > 0 && mci_octree_face_group(o, s->faces[i]) < out->first_same)
+                out->first_same = mci_octree_face_group(o, s->faces[i]);
         }
     }
-    windings_beside(at, beyond, coincident, behind, in_front);
-    *decided = true;
+    windings_beside(at, beyond, coincident, &out->behind, &out->in_front);
+    out->decided = true;
     return true;
 }
 

@@ -28,15 +28,23 @@ void mci_ray_scratch_free(const mci_ctx *ctx, mci_ray_scratch *s);
 bool mci_ray_winding_octree(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
                             uint32_t m, mci_ray_scratch *s, int *winding, bool *decided);
 
+/* What mci_ray_windings_on_plane tells. */
+typedef struct mci_plane_windings {
+    int behind, in_front;
+    uint32_t first_same; /* the lowest face group (mci_octree_face_group) among the faces
+                          * holding p that face like the plane; UINT32_MAX if none */
+    bool decided;
+} mci_plane_windings;
+
 /* Leaf m's winding numbers just behind and just in front of the plane `at` (as its
  * normal points) at p, a point of that plane where no face of m crosses the plane: the
  * faces holding p all lie in it (coincident faces, counted with their orientation: one
- * facing like `at` adds one behind). *decided is false when a face across the plane
+ * facing like `at` adds one behind). out->decided is false when a face across the plane
  * holds p, or p lies on the border of a face in it (where it could count twice). Returns
  * false when out of memory. */
 bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci_octree *o,
                                uint32_t m, const mci_plane *at, mci_ray_scratch *s,
-                               int *behind, int *in_front, bool *decided);
+                               mci_plane_windings *out);
 
 /* mci_ray_label for the leaf m of octree o, testing only m's faces in the cells the ray
  * passes through (paper §5.2). Returns false when out of memory (*label unset). */

@@ -285,20 +285,56 @@ static void note_edge(uint32_t example[2], size_t *counter, uint64_t key)
     }
 }
 
+/* The k-th use of the edge in direction `forward`, or n. */
+static size_t kth_use(const edge_use *group, size_t n, uint32_t forward, size_t k)
+{
+    for (size_t i = 0; i < n; i++)
+        if (group[i].forward == forward && k-- == 0)
+            return i;
+    return n;
+}
+
+/* Joins the triangles of one edge into shells: both of a manifold edge; at a balanced
+ * edge of more than two, the k-th use each way (any pairing closes every shell up as a
+ * chain; this one keeps a file's parts, listed one after another, apart); all of an
+ * unbalanced one. */
+static void join_shells(check_state *s, const edge_use *group, size_t n, size_t forward)
+{
+    for (size_t i = 1; i < n && 2 * forward != n; i++)
+        unite(s->parent, group[0].tri, group[i].tri);
+    for (size_t k = 0; 2 * forward == n && k < forward; k++)
+        unite(s->parent, group[kth_use(group, n, 1, k)].tri, group[kth_use(group, n, 0, k)].tri);
+}
+
 static void classify_edge_group(check_state *s, const edge_use *group, size_t n)
 {
     mcsg_check_report *r = s->report;
     size_t forward = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++)
         forward += group[i].forward;
-        unite(s->parent, group[0].tri, group[i].tri);
-    }
+    join_shells(s, group, n, forward);
     if (n == 1)
         note_edge(r->example_boundary_edge, &r->boundary_edges, group[0].key);
     else if (n > 2)
         note_edge(r->example_nonmanifold_edge, &r->nonmanifold_edges, group[0].key);
     else if (forward != 1)
         note_edge(r->example_inconsistent_edge, &r->inconsistent_edges, group[0].key);
+    if (n > 2 && 2 * forward != n)
+        note_edge(r->example_unbalanced_edge, &r->unbalanced_edges, group[0].key);
+}
+
+/* After the shells are joined: a balanced edge of more than two triangles where one
+ * shell has two uses. */
+static void check_self_touching(check_state *s, const edge_use *group, size_t n)
+{
+    for (size_t i = 0; n > 2 && i < n; i++)
+        for (size_t j = i + 1; j < n; j++)
+            if (mci_find_root(s->parent, group[i].tri) == mci_find_root(s->parent, group[j].tri) &&
+                group[i].forward == group[j].forward) {
+                note_edge(s->report->example_self_touching_edge,
+                          &s->report->self_touching_edges, group[0].key);
+                return;
+            }
 }
 
 static bool check_edges(check_state *s)
@@ -313,6 +349,13 @@ static bool check_edges(check_state *s)
     for (size_t i = 1; ok && i <= n; i++) {
         if (i == n || sorted[i].key != sorted[start].key) {
             classify_edge_group(s, sorted + start, i - start);
+            start = i;
+        }
+    }
+    start = 0;
+    for (size_t i = 1; ok && s->report->nonmanifold_edges && i <= n; i++) {
+        if (i == n || sorted[i].key != sorted[start].key) {
+            check_self_touching(s, sorted + start, i - start);
             start = i;
         }
     }
@@ -431,6 +474,8 @@ static void report_init(mcsg_check_report *r, const mcsg_mesh *m)
     r->example_boundary_edge[0] = r->example_boundary_edge[1] = MCSG_NO_INDEX;
     r->example_nonmanifold_edge[0] = r->example_nonmanifold_edge[1] = MCSG_NO_INDEX;
     r->example_inconsistent_edge[0] = r->example_inconsistent_edge[1] = MCSG_NO_INDEX;
+    r->example_unbalanced_edge[0] = r->example_unbalanced_edge[1] = MCSG_NO_INDEX;
+    r->example_self_touching_edge[0] = r->example_self_touching_edge[1] = MCSG_NO_INDEX;
 }
 
 static bool run_checks(check_state *s)
@@ -442,10 +487,10 @@ static bool run_checks(check_state *s)
     check_degenerate(s);
     if (!check_duplicates(s) || !check_edges(s) || !count_components_and_unused(s))
         return false;
-    /* The volume (and so the orientation) means something only for closed, consistently
-     * oriented meshes with finite coordinates. */
+    /* The volume (and so the orientation) means something only for meshes closed as a
+     * chain with finite coordinates. */
     if (!r->out_of_range_indices && !r->nonfinite_vertices && !r->boundary_edges &&
-        !r->nonmanifold_edges && !r->inconsistent_edges)
+        !r->unbalanced_edges && !r->inconsistent_edges)
         compute_volume(s);
     return true;
 }

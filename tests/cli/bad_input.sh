@@ -20,7 +20,7 @@ eval_fails 'union() { cube(2); import("open.off"); }' \
 
 { cube_off; echo "3 0 2 1"; } | sed 's/^8 12 0$/8 13 0/' > "$WORK/nonmanifold.off"
 eval_fails 'difference() { cube(2); import("nonmanifold.off"); }' \
-  'import("nonmanifold.off")' 'non-manifold edges (shared by more than two triangles), e.g. from ('
+  'import("nonmanifold.off")' 'the surface does not close up: 3 edges of more than two triangles are used more often one way than the other, e.g. from ('
 
 { cube_off 1; echo "3 3 7 4"; } | sed "s/^8 11 0$/8 12 0/" > "$WORK/oneflip.off"
 eval_fails 'union() { import("oneflip.off"); sphere(1); }' \
