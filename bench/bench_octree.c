@@ -15,7 +15,7 @@
 #define RUNS 5
 
 /* The library defaults (src/csg/octree.c); MCSG_OCTREE_CELL_FACES overrides the cell size. */
-static mci_octree_params params = {48, 14, NULL, NULL};
+static mci_octree_params params = {48, 14, NULL, NULL, NULL};
 
 static void run(const char *name, const mcsg_mesh *const *leaves, size_t n)
 {

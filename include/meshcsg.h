@@ -121,9 +121,10 @@ typedef struct mcsg_options {
     void *progress_user;       /* passed to progress */
     int check_self_intersections; /* mcsg_eval: nonzero tests every shell of every leaf
                                      for self-intersections before evaluating (exact,
-                                     costs about as much as an evaluation; shells of one
-                                     leaf may cross each other) and names the first such
-                                     leaf with MCSG_ERR_INVALID_MESH */
+                                     costs about as much as an evaluation), and evaluates
+                                     a leaf with a shell that crosses itself exactly, by
+                                     its winding number, its faces intersected with each
+                                     other */
     int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
                                    triangles that cross each other (exact, costs about as
                                    much as an evaluation; see mcsg_output_check) */
@@ -547,20 +548,23 @@ typedef struct mcsg_eval_stats {
  * consistently oriented, edge-manifold triangle mesh whose vertices are the exact result
  * vertices rounded to double (only at the end). An empty result gives a mesh with no
  * triangles.
- * Input contract: every non-empty leaf the root reaches must pass mcsg_mesh_check
- * (mcsg_check_report_is_valid, and a non-zero volume when it has one component): closed,
- * consistently oriented, edge-manifold, finite, without zero-area or repeated triangles.
+ * Input contract: every non-empty leaf the root reaches must be closed as a chain (with
+ * vertices identified by coordinates, every edge used as often one way as the other;
+ * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
+ * coordinates, no zero-area triangles, no shell meeting itself at an edge with more than
+ * two triangles (self_touching_edges), and a non-zero volume when it has one shell.
  * A leaf is the set where its winding number is positive: it may have several shells,
- * facing out or in, nested or overlapping but not touching (overlapping outward shells are
- * their union, an inward shell inside an outward one is a cavity, one on its own is
- * empty; see docs/robustness.md). This is checked first;
- * the first leaf that fails it gives MCSG_ERR_INVALID_MESH with a message naming the leaf
- * (its label: file or primitive, and position in the CSG text) and an example of the
- * problem. No shell of a leaf may intersect itself, and shells must not touch; that is
- * checked up front only with opts->check_self_intersections (it costs about as much as
- * an evaluation). With a self-intersecting leaf the result is unspecified (a mesh that
- * may not be the intended set), or MCSG_ERR_INVALID_MESH naming the leaf when an internal
- * consistency check trips on it (see docs/robustness.md).
+ * facing out or in, nested, overlapping, sharing edges or faces, and repeated triangles
+ * (overlapping outward shells are their union, an inward shell inside an outward one is
+ * a cavity, one on its own is empty, a triangle listed twice counts twice; see
+ * docs/robustness.md). This is checked first; the first leaf that fails it gives
+ * MCSG_ERR_INVALID_MESH with a message naming the leaf (its label: file or primitive, and
+ * position in the CSG text) and an example of the problem. A shell that crosses itself
+ * is evaluated exactly when opts->check_self_intersections asks for the test up front
+ * (it costs about as much as an evaluation), or when an internal consistency check
+ * trips on it (the leaves are tested then, and the faces evaluated again); otherwise its
+ * faces are not compared with each other and the result is unspecified (a mesh that may
+ * not be the intended set; see docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
  * doubles. Such a result is still returned with MCSG_OK (it is the best the rounding
@@ -573,7 +577,8 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
 /* What mcsg_mesh_repair found and made. */
 typedef struct mcsg_repair_stats {
     size_t shells_in;      /* the input's shells (components over shared edges) */
-    size_t crossing_pairs; /* pairs of triangles of different shells that meet */
+    size_t crossing_pairs; /* pairs of triangles that meet: of different shells, or of a
+                              shell crossing itself (not sharing an edge) */
     size_t shells_out;     /* the result's shells */
     size_t cavities;       /* ... of which face inward (holes inside the solid) */
     mcsg_eval_stats eval;  /* the evaluation that made it */
@@ -582,11 +587,10 @@ typedef struct mcsg_repair_stats {
 /* The solid of one mesh as a clean closed mesh: the set where the mesh's winding number
  * is positive (mcsg_eval of the mesh alone), the everyday "make it printable" operation.
  * Overlapping shells become one, a shell inside another disappears, an inward shell
- * inside an outward one stays as a cavity, an inward shell on its own disappears. The
- * input must be closed, consistently oriented and edge-manifold with finite
- * coordinates, and no shell may cross itself or touch another (checked exactly first:
- * MCSG_ERR_INVALID_MESH with one line naming the problem); shells crossing each other
- * are what this resolves. The result carries mcsg_eval's guarantees and output check
+ * inside an outward one stays as a cavity, an inward shell on its own disappears, and a
+ * shell crossing itself becomes the set where its winding number is positive (every
+ * shell is tested exactly first). The input must meet mcsg_eval's contract for a leaf
+ * (closed as a chain, finite; MCSG_ERR_INVALID_MESH with one line naming the problem). The result carries mcsg_eval's guarantees and output check
  * (stats->eval.output_check). *out receives the mesh (release with mcsg_mesh_free);
  * stats may be NULL. */
 mcsg_status mcsg_mesh_repair(const mcsg_mesh *mesh, const mcsg_options *opts, mcsg_mesh *out,

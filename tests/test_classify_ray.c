@@ -35,7 +35,7 @@ static void build_scene(scene *s, const mci_ctx *ctx)
     double box[3] = {2, 3, 2}, unit[3] = {1, 1, 1};
     double shift[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.25, 0, 0, 1, -0.5};
     double grid[12] = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 0};
-    mci_octree_params params = {8, 10, NULL, NULL};
+    mci_octree_params params = {8, 10, NULL, NULL, NULL};
     CHECK_OK(mcsg_make_sphere(1.5, fine, NULL, &s->meshes[0], &err), &err);
     CHECK_OK(mcsg_make_cube(box, 1, NULL, &s->meshes[1], &err), &err);
     CHECK_OK(mcsg_make_cylinder(3, 1, 0.5, 1, coarse, NULL, &s->meshes[2], &err), &err);

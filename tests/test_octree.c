@@ -370,7 +370,7 @@ static void check_scene_lists(const mcsg_mesh *const *leaves, size_t n, uint32_t
     mci_ctx ctx;
     mci_octree tree;
     mcsg_error err;
-    mci_octree_params params = {max_faces, 10, NULL, NULL};
+    mci_octree_params params = {max_faces, 10, NULL, NULL, NULL};
     uint64_t *pairs;
     size_t count;
     mci_ctx_init(&ctx, NULL);
@@ -601,7 +601,7 @@ TEST(build_survives_allocation_failure)
         mcsg_options opts = test_allocator_options(&alloc);
         mci_ctx ctx;
         mci_octree tree;
-        mci_octree_params params = {4, 6, NULL, NULL};
+        mci_octree_params params = {4, 6, NULL, NULL, NULL};
         mcsg_status st;
         mci_ctx_init(&ctx, &opts);
         st = mci_octree_build(&ctx, leaves, 2, &params, &tree, &err);

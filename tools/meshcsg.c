@@ -696,7 +696,7 @@ static int cmd_repair(const cli_values *v, int argc, char **argv)
     }
     if (v->stats)
         print_eval_stats(&st.eval, -1);
-    printf("%zu shells in, %zu pairs of triangles of different shells meeting; %zu shells out "
+    printf("%zu shells in, %zu pairs of triangles meeting (shells crossing); %zu shells out "
            "(%zu cavities), %zu vertices, %zu triangles\n", st.shells_in, st.crossing_pairs,
            st.shells_out, st.cavities, result.vertex_count, result.triangle_count);
     mcsg_mesh_free(&result, &opts);
@@ -856,8 +856,9 @@ static const cli_option eval_options[] = {
      "also test the result for crossing triangles, exactly (about the cost of an "
      "evaluation; off by default; the other guarantees are always checked)"},
     {"check-inputs", 0, CLI_FLAG, NULL, 0, 0, VALUE(check_inputs),
-     "first test every leaf for self-intersections, exactly (about the cost of an "
-     "evaluation; off by default)"},
+     "first test every shell of every leaf for self-intersections, exactly, and evaluate "
+     "one that crosses itself by its winding number (about the cost of an evaluation; "
+     "off by default)"},
     END_OF_OPTIONS};
 static const cli_option repair_options[] = {
     OUTPUT("write the repaired mesh to FILE, format from its extension (default: none, "

@@ -218,15 +218,21 @@ static bool list_sides_by_vertex(mci_leaf_work *w, size_t n, vertex_sides *vs, b
     return true;
 }
 
-/* The group of the face holding edge slot k: shells of one leaf that may cross each
+/* The shell of the face holding edge slot k: shells of one leaf that may cross each
  * other (or lie in each other's faces) are paired each on its own. */
 static uint32_t slot_group(const mci_leaf_work *w, size_t k)
 {
-    return mci_scene_face_group(w->s, w->pface[k / 3]);
+    return mci_octree_face_shell(&w->s->octree, w->pface[k / 3]);
 }
 
-/* Border slots of vertex `from` going to vertex `to` in faces of group g: how many, and
- * the first. */
+/* Whether the leaf's faces are in several shells (mci_octree_face_shell tells them). */
+static bool leaf_has_shells(const mci_leaf_work *w)
+{
+    return w->cl->tree->leaf_shell[w->leaf] != NULL || w->cl->tree->leaf_crossing[w->leaf];
+}
+
+/* Border slots of vertex `from` going to vertex `to` in faces of shell g (any shell if g
+ * is MCI_NONE): how many, and the first. */
 static size_t sides_between(const mci_leaf_work *w, const vertex_sides *vs, uint32_t from,
                             uint32_t to, uint32_t g, uint32_t *first)
 {
@@ -234,7 +240,8 @@ static size_t sides_between(const mci_leaf_work *w, const vertex_sides *vs, uint
     if (from < vs->first || from > vs->last)
         return 0;
     for (uint32_t i = vs->start[from - vs->first]; i < vs->start[from - vs->first + 1]; i++)
-        if (vs->sides[i].to == to && slot_group(w, vs->sides[i].slot) == g && count++ == 0)
+        if (vs->sides[i].to == to && (g == MCI_NONE || slot_group(w, vs->sides[i].slot) == g) &&
+            count++ == 0)
             *first = vs->sides[i].slot;
     return count;
 }
@@ -249,7 +256,7 @@ static bool is_separator(const mci_leaf_work *w, uint64_t key)
 static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
 {
     vertex_sides vs = {UINT32_MAX, 0, NULL, NULL};
-    bool ok;
+    bool ok, shells = leaf_has_shells(w);
     for (size_t k = 0; k < 3 * w->np; k++) {
         if (w->mate[k] != MCI_NONE)
             continue;
@@ -259,11 +266,12 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
     ok = n > 0 && (vs.last - vs.first) / 8 < n && list_sides_by_vertex(w, n, &vs, nomem);
     for (size_t s = 0; ok && s < n; s++) {
         uint32_t k = vs.sides[s].slot, u = mci_leaf_slot_from(w, k), v = vs.sides[s].to;
-        uint32_t back = MCI_NONE, ignored, g = slot_group(w, k);
+        uint32_t back = MCI_NONE, ignored, g;
         uint64_t key = mci_edge_key(u, v);
         size_t ahead, behind;
         if (w->mate[k] != MCI_NONE)
             continue;
+        g = shells ? slot_group(w, k) : MCI_NONE;
         ahead = sides_between(w, &vs, u, v, g, &ignored);
         behind = sides_between(w, &vs, v, u, g, &back);
         if (u != v && ahead == 1 && behind == 1) {
@@ -283,6 +291,7 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
  * its own group; the pairs are separators if `separator`. */
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
+    bool shells = leaf_has_shells(w);
     for (size_t a = 0; a < n; a++) {
         uint32_t k = run[a].ref;
         size_t b = a + 1;
@@ -290,7 +299,7 @@ static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, 
             continue;
         while (b < n && (w->mate[run[b].ref] != MCI_NONE ||
                          mci_leaf_slot_from(w, run[b].ref) != mci_leaf_slot_to(w, k) ||
-                         slot_group(w, run[b].ref) != slot_group(w, k)))
+                         (shells && slot_group(w, run[b].ref) != slot_group(w, k))))
             b++;
         if (b == n)
             return mci_fail(w->err, MCSG_ERR_INTERNAL,

@@ -98,7 +98,7 @@ bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r)
             w->own_front[r] = got.in_front;
             w->own_coin[r] = got.behind - got.in_front;
             w->own_first[r] = got.first_same ==
-                              mci_scene_face_group(w->s, w->pface[w->reg_pieces[k]]);
+                              mci_octree_face_shell(&w->s->octree, w->pface[w->reg_pieces[k]]);
             return true;
         }
     }
@@ -131,8 +131,11 @@ void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local)
         sum->unknown = true;
         return;
     }
-    sum->coplanar |= from_local == MCI_LABEL_SAME || from_local == MCI_LABEL_OPPO ||
-                     to_local == MCI_LABEL_SAME || to_local == MCI_LABEL_OPPO;
+    /* The same label on both sides keeps whatever lies in the region (a coplanar
+     * neighbour of the face across the separator's edge looks like one). */
+    sum->coplanar |= from_local != to_local &&
+                     (from_local == MCI_LABEL_SAME || from_local == MCI_LABEL_OPPO ||
+                      to_local == MCI_LABEL_SAME || to_local == MCI_LABEL_OPPO);
     sum->front += offset_in_front(to_local) - offset_in_front(from_local);
     sum->coincident += offset_behind(to_local) - offset_in_front(to_local) -
                        (offset_behind(from_local) - offset_in_front(from_local));

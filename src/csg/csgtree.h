@@ -65,6 +65,10 @@ typedef struct mci_ptree {
      * 0 .. leaf_shells[l] - 1 (set by mci_check_leaves, owned). */
     uint32_t **leaf_shell;
     uint32_t *leaf_shells;
+    /* Per primitive: 1 when one of its shells crosses itself (found only when the options
+     * ask, mci_check_leaves): its faces are then intersected with each other one by one
+     * (see mci_octree_params.face_shell). Such a primitive is a winding one. */
+    uint8_t *leaf_crossing;
     size_t leaf_count;
 } mci_ptree;
 

@@ -96,6 +96,7 @@ typedef struct eval_state {
     bool no_whole_faces; /* split and classify every touched face (the fallback in run) */
     uint32_t *face_group; /* per global face (see mci_octree_params), NULL when no
                              primitive has several shells */
+    uint32_t *face_shell; /* the same, NULL unless a shell crosses itself */
 } eval_state;
 
 static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
@@ -633,26 +634,41 @@ static mcsg_status copies_meet_coplanar_faces(eval_state *e, bool *meet, mcsg_er
 }
 
 /* Face groups when a primitive has several shells: each shell its own group, so that
- * shells of one leaf that cross are intersected like different leaves. Faces dropped
- * whole are then not looked for: that decision takes a face's leaf to be clean. */
+ * shells of one leaf that cross are intersected like different leaves; in a primitive
+ * with a shell that crosses itself, each face its own group, and face_shell says which
+ * shell it is on. Faces dropped whole are then not looked for: that decision takes a
+ * face's leaf to be clean. */
 static mcsg_status group_shells(eval_state *e, mcsg_error *err)
 {
     const mci_ptree *t = &e->tree;
-    size_t faces = 0, next = t->leaf_count;
-    bool any = false;
+    size_t faces = 0, next = t->leaf_count, shells = t->leaf_count;
+    bool any = false, crossing = false;
     for (size_t l = 0; l < t->leaf_count; l++) {
         faces += t->leaf_mesh[l]->triangle_count;
-        any |= t->leaf_shell[l] != NULL;
+        any |= t->leaf_shell[l] != NULL || t->leaf_crossing[l];
+        crossing |= t->leaf_crossing[l] != 0;
     }
     if (!any)
         return MCSG_OK;
-    if (!(e->face_group = mci_malloc_array(&e->ctx, faces + 1, sizeof *e->face_group)))
+    if (faces + 2 * t->leaf_count >= UINT32_MAX)
+        return mci_fail(err, MCSG_ERR_LIMIT, "too many faces to group (%zu)", faces);
+    e->face_group = mci_malloc_array(&e->ctx, faces + 1, sizeof *e->face_group);
+    e->face_shell = crossing ? mci_malloc_array(&e->ctx, faces + 1, sizeof *e->face_shell) : NULL;
+    if (!e->face_group || (crossing && !e->face_shell))
         return mci_fail_nomem(err, "grouping shells");
     for (size_t l = 0, f = 0; l < t->leaf_count; l++) {
         const uint32_t *shell = t->leaf_shell[l];
-        for (size_t k = 0; k < t->leaf_mesh[l]->triangle_count; k++)
-            e->face_group[f++] = shell ? (uint32_t)(next + shell[k]) : (uint32_t)l;
-        next += t->leaf_shells[l];
+        for (size_t k = 0; k < t->leaf_mesh[l]->triangle_count; k++, f++) {
+            uint32_t own = shell ? (uint32_t)(shells + shell[k]) : (uint32_t)l;
+            e->face_group[f] = t->leaf_crossing[l] ? (uint32_t)(next + k)
+                               : shell              ? own
+                                                    : (uint32_t)l;
+            if (crossing)
+                e->face_shell[f] = own;
+        }
+        next += t->leaf_crossing[l] ? t->leaf_mesh[l]->triangle_count
+                                    : shell ? t->leaf_shells[l] : 0;
+        shells += shell ? t->leaf_shells[l] : 0;
     }
     e->no_whole_faces = true;
     return MCSG_OK;
@@ -668,7 +684,7 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
         st = group_shells(e, err);
     if (st == MCSG_OK)
         st = mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, e->alias,
-                                     e->face_group, &e->scene, err);
+                                     e->face_group, e->face_shell, &e->scene, err);
     if (st == MCSG_OK && e->alias)
         st = copies_meet_coplanar_faces(e, &coplanar, err);
     if (st != MCSG_OK || !coplanar)
@@ -678,7 +694,7 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
     e->alias = NULL;
     e->stats.copied_primitives = 0;
     return mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, NULL, e->face_group,
-                                   &e->scene, err);
+                                   e->face_shell, &e->scene, err);
 }
 
 /* Faces that the result drops whole are found from the pair tests, before anything is
@@ -739,6 +755,36 @@ static mcsg_status evaluate_faces_safely(eval_state *e, mcsg_error *err)
     return evaluate_faces(e, err);
 }
 
+/* Shells are not tested for crossing themselves up front unless the options ask (it
+ * costs about an evaluation). When an internal check trips, they are tested then, and
+ * if one crosses itself the faces are evaluated again with that primitive's faces
+ * intersected with each other. */
+static mcsg_status evaluate_faces_checked(eval_state *e, const mcsg_tree *tree, mcsg_error *err)
+{
+    mcsg_eval_stats before = e->stats;
+    mcsg_status st = evaluate_faces_safely(e, err);
+    size_t marked = 0;
+    mcsg_error probe;
+    if (st != MCSG_ERR_INTERNAL || e->ctx.check_self_intersections)
+        return st;
+    if (mci_mark_crossing_leaves(&e->ctx, tree, &e->tree, &marked, &probe) != MCSG_OK ||
+        marked == 0)
+        return st;
+    mci_log(&e->ctx, MCSG_LOG_INFO, "%zu primitives cross themselves: evaluating again with "
+            "their faces intersected with each other", marked);
+    mci_classifier_free(&e->ctx, &e->cl);
+    mci_kept_free(&e->ctx, &e->kept);
+    free_trimmed(e);
+    mci_scene_free(&e->ctx, &e->scene);
+    mci_free(&e->ctx, e->alias);
+    mci_free(&e->ctx, e->face_group);
+    mci_free(&e->ctx, e->face_shell);
+    e->alias = NULL;
+    e->face_group = e->face_shell = NULL;
+    e->stats = before;
+    return evaluate_faces_safely(e, err);
+}
+
 static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
                        mcsg_provenance **provenance, mcsg_error *err)
 {
@@ -759,7 +805,7 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     e->stats.seconds_check = mci_seconds_now() - t0;
     if (st != MCSG_OK)
         return st;
-    st = evaluate_faces_safely(e, err);
+    st = evaluate_faces_checked(e, tree, err);
     if (st == MCSG_OK)
         st = mci_progress(&e->ctx, "assemble", 0, err);
     if (st == MCSG_OK)
@@ -803,6 +849,7 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
     mci_ptree_free(&e.ctx, &e.tree);
     mci_free(&e.ctx, e.alias);
     mci_free(&e.ctx, e.face_group);
+    mci_free(&e.ctx, e.face_shell);
     mci_pool_stop(&e.ctx);
     e.stats.seconds_total = mci_seconds_now() - t0;
     if (stats)

@@ -45,7 +45,7 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build_touched(ctx, leaves, leaf_count, NULL, NULL, scene, err);
+    mcsg_status st = mci_scene_build_touched(ctx, leaves, leaf_count, NULL, NULL, NULL, scene, err);
     if (st != MCSG_OK)
         return st;
     st = mci_scene_arrange(ctx, scene, err);
@@ -58,11 +58,11 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
 
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
-                                    const uint32_t *face_group, mci_scene *scene,
-                                    mcsg_error *err)
+                                    const uint32_t *face_group, const uint32_t *face_shell,
+                                    mci_scene *scene, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
-    mci_octree_params params = {0, 0, NULL, face_group};
+    mci_octree_params params = {0, 0, NULL, face_group, face_shell};
     uint8_t *skip = NULL;
     mcsg_status st;
     memset(scene, 0, sizeof *scene);

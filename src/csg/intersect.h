@@ -68,13 +68,13 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
 /* mci_scene_build in three steps. First the octree, the pair tests and what they tell
  * each touched face (arr_of, touch lists, neighbours, arr_contact), their records kept
  * in `pending`; alias (NULL: none) names each leaf's stand-in (see mci_scene.alias);
- * face_group (NULL: none; see mci_octree_params) lets shells of one leaf meet.
- * Faces dropped whole can be decided then (mci_decide_whole_faces), before anything is
- * built for them. */
+ * face_group and face_shell (NULL: none; see mci_octree_params) let shells of one leaf,
+ * and faces of a shell that crosses itself, meet. Faces dropped whole can be decided then
+ * (mci_decide_whole_faces), before anything is built for them. */
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
-                                    const uint32_t *face_group, mci_scene *scene,
-                                    mcsg_error *err);
+                                    const uint32_t *face_group, const uint32_t *face_shell,
+                                    mci_scene *scene, mcsg_error *err);
 
 /* Second, the arrangements from the pending records (then freed): those flagged in
  * arr_dropped (if any) get their corners only, and neither give nor receive points on

@@ -1,18 +1,18 @@
 /*
- * The evaluator's input contract, checked before any geometry: every primitive must be
- * a closed, consistently oriented, edge-manifold mesh with finite coordinates and no
- * zero-area triangles (they have no plane). It may have several shells, apart, nested or
- * crossing each other (not touching), and shells may face inward: the primitive's solid
- * is where its winding number is positive, so overlapping shells are their union, an
- * inward shell inside another is a cavity and one on its own is empty.
+ * The evaluator's input contract, checked before any geometry (docs/robustness.md):
+ * every primitive must be closed as a chain (each edge used as often one way as the
+ * other, vertices identified by coordinates) with finite coordinates and no zero-area
+ * triangles (they have no plane). It may have several shells (paired at edges of more
+ * than two triangles, mcsg_check_report), apart, nested, crossing or lying in each other,
+ * facing out or in: the primitive's solid is where its winding number is positive.
  * Such primitives are marked for classification by winding numbers
- * (mci_ptree.leaf_winding). A leaf that breaks the contract is
- * named in a one-line message (its label says which file or primitive it came from, and
- * where in the CSG text) with the first offending edge, triangle or vertex, so that the
- * user can find it; nothing is evaluated. Self-intersecting leaves are looked for up
- * front only when the options ask (that costs an intersection pass of its own); but when evaluation stops on an
- * internal consistency check, which a self-intersecting leaf can trip, the leaves are
- * tested then, and a leaf that intersects itself is named instead of reporting a bug.
+ * (mci_ptree.leaf_winding). A leaf that breaks the contract is named in a one-line
+ * message (its label says which file or primitive it came from, and where in the CSG
+ * text) with the first offending edge, triangle or vertex; nothing is evaluated.
+ * Shells crossing themselves are looked for only when the options ask (that costs an
+ * intersection pass of its own) or when evaluation stops on an internal consistency
+ * check; the primitives with one are marked (mci_ptree.leaf_crossing) and evaluated
+ * with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
@@ -105,15 +105,16 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 }
 
 static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          const mci_ptree *ptree, bool whole, mcsg_error *err);
+                                          mci_ptree *ptree, bool whole, mcsg_error *err);
 
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
 {
     leaf_check_job job = {tree, ptree, ctx};
     mcsg_status st = mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
+    size_t marked;
     if (st == MCSG_OK && ctx->check_self_intersections)
-        st = find_self_intersecting(ctx, tree, ptree, false, err);
+        st = mci_mark_crossing_leaves(ctx, tree, ptree, &marked, err);
     return st;
 }
 
@@ -159,11 +160,11 @@ static mcsg_status shell_self_intersections(const mci_ctx *ctx, const mci_ptree 
     return st;
 }
 
-/* The first primitive that intersects itself (one of its shells crosses itself, or with
- * `whole` any two of its triangles cross), as an INVALID_MESH error; MCSG_OK if none does
- * (or an allocation failure). */
-static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          const mci_ptree *ptree, bool whole, mcsg_error *err)
+/* Every leaf a shell of which crosses itself is marked (mci_ptree.leaf_crossing) and
+ * counted in *count; with `whole`, the first leaf any two of whose triangles cross
+ * (shells touching each other too) is an INVALID_MESH error instead. */
+static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
+                               bool whole, size_t *count, mcsg_error *err)
 {
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
@@ -171,6 +172,7 @@ static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *t
     opts.log = ctx->log;
     opts.log_user = ctx->log_user;
     opts.threads = ctx->threads;
+    *count = 0;
     for (size_t k = 0; k < ptree->leaf_count; k++) {
         mcsg_node_id node = ptree->leaf_source[k];
         const char *label = mcsg_tree_node_label(tree, node);
@@ -179,16 +181,33 @@ static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *t
         mcsg_status st = shell_self_intersections(ctx, ptree, k, whole, &opts, &pairs, example, err);
         if (st != MCSG_OK)
             return st;
-        if (pairs > 0)
+        if (pairs > 0 && whole)
             return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s intersects itself: %zu "
                             "pairs of its triangles cross or overlap, e.g. triangles %u and %u",
                             node, label[0] ? ", " : "", label, pairs, example[0], example[1]);
+        if (pairs > 0 && !ptree->leaf_crossing[k]) {
+            ptree->leaf_crossing[k] = ptree->leaf_winding[k] = 1;
+            ++*count;
+        }
     }
     return MCSG_OK;
 }
 
+static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
+                                          mci_ptree *ptree, bool whole, mcsg_error *err)
+{
+    size_t count;
+    return scan_leaves(ctx, tree, ptree, whole, &count, err);
+}
+
+mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
+                                     mci_ptree *ptree, size_t *marked, mcsg_error *err)
+{
+    return scan_leaves(ctx, tree, ptree, false, marked, err);
+}
+
 mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
-                                       const mci_ptree *ptree, mcsg_error *err)
+                                       mci_ptree *ptree, mcsg_error *err)
 {
     mcsg_error saved, probe;
     mcsg_status st;

@@ -4,14 +4,22 @@
 
 #include "csg/csgtree.h"
 
-/* MCSG_OK when every primitive of ptree is a closed, consistently oriented,
- * edge-manifold mesh with finite coordinates and no zero-area or repeated triangles, and
- * encloses some volume if it has one shell (and, with ctx->check_self_intersections, no
- * shell of it intersects itself); otherwise MCSG_ERR_INVALID_MESH naming the first such leaf
- * (lowest primitive number) and its first problem. Sets ptree->leaf_winding for the
- * primitives with several shells or a negative volume. */
+/* MCSG_OK when every primitive of ptree is closed as a chain (each edge used as often
+ * one way as the other) with finite coordinates and no zero-area triangles, no shell
+ * meeting itself at an edge with more than two triangles, and encloses some volume if
+ * it has one shell; otherwise MCSG_ERR_INVALID_MESH naming the first such leaf (lowest
+ * primitive number) and its first problem. Sets ptree->leaf_winding for the primitives
+ * with several shells or a negative volume, and numbers their shells; with
+ * ctx->check_self_intersections, marks those with a shell crossing itself
+ * (mci_mark_crossing_leaves). */
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err);
+
+/* Tests every shell of every primitive for self-intersections (exact), and marks those
+ * with a shell that crosses itself (ptree->leaf_crossing, and leaf_winding): their
+ * faces are then intersected with each other. *marked: how many were newly marked. */
+mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
+                                     mci_ptree *ptree, size_t *marked, mcsg_error *err);
 
 /* Called when evaluation failed with MCSG_ERR_INTERNAL: if a primitive intersects
  * itself (two of its triangles cross or overlap: a shell crossing itself, or shells that
@@ -19,6 +27,6 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptre
  * MCSG_ERR_INVALID_MESH with a message naming it; otherwise MCSG_ERR_INTERNAL with *err
  * unchanged. */
 mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
-                                       const mci_ptree *ptree, mcsg_error *err);
+                                       mci_ptree *ptree, mcsg_error *err);
 
 #endif

@@ -653,6 +653,7 @@ mcsg_status mci_octree_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                                                : DEFAULT_MAX_CELL_FACES;
     b.params.max_depth = params && params->max_depth ? params->max_depth : DEFAULT_MAX_DEPTH;
     out->face_group = params ? params->face_group : NULL;
+    out->face_shell = params ? params->face_shell : NULL;
     st = index_faces(ctx, out, params ? params->skip_leaf : NULL) &&
                  (b.face_box = face_boxes(ctx, out)) != NULL
              ? build_cells(&b, err)
@@ -858,6 +859,22 @@ static bool first_shared_cell(const uint32_t *a, const uint32_t *b, uint32_t cel
     return true;
 }
 
+/* Faces of one shell that crosses itself (a group each) sharing an edge: they meet only
+ * along it, unless folded onto each other (outside the input contract). */
+static bool shell_neighbours(const mci_octree *t, uint32_t f, uint32_t g)
+{
+    int common = 0;
+    if (!t->face_shell || t->face_shell[f] != t->face_shell[g] ||
+        t->face_leaf[f] != t->face_leaf[g])
+        return false;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            const double *p = mci_octree_face_vertex(t, f, i), *q = mci_octree_face_vertex(t, g, j);
+            common += p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+        }
+    return common >= 2;
+}
+
 /* A cell lists its faces in increasing id order, so each leaf's faces form one run: a
  * face is paired with the faces after its run only. `k`: the cell's position among the
  * critical leaves. */
@@ -900,7 +917,8 @@ static bool collect_cell_pairs(const mci_ctx *ctx, const mci_octree *t, const fl
                 !(crowded && (face_plane_separates(t, &out->planes[i], out->faces[j].face) ||
                               face_plane_separates(t, &out->planes[j], a->face) ||
                               coplanar_touch_at_corner_only(t, &out->planes[i], a->face,
-                                                            out->faces[j].face))))
+                                                            out->faces[j].face))) &&
+                !shell_neighbours(t, a->face, out->faces[j].face))
                 out->pairs[out->count++] = (uint64_t)a->face << 32 | out->faces[j].face;
     }
     return true;

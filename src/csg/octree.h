@@ -32,6 +32,7 @@ typedef struct mci_octree {
     uint32_t *face_base;   /* leaf_count + 1 entries: global id of each leaf's face 0 */
     uint32_t *face_leaf;   /* owning leaf per global face id */
     const uint32_t *face_group; /* per global face id (mci_octree_params), or NULL */
+    const uint32_t *face_shell; /* per global face id (mci_octree_params), or NULL */
     mci_cell *cells;
     size_t cell_count;
     uint32_t *face_ids;    /* the leaf cells' face lists */
@@ -56,6 +57,10 @@ typedef struct mci_octree_params {
      * group, or, for a leaf whose shells may cross each other, one group per shell
      * numbered from the leaf count on. Must outlive the octree. */
     const uint32_t *face_group;
+    /* Optional (NULL: the groups): per global face, its shell, where a shell that crosses
+     * itself has a group per face. Faces of one shell sharing an edge are not paired:
+     * they meet only there (unless folded onto each other). Must outlive the octree. */
+    const uint32_t *face_shell;
 } mci_octree_params;
 
 /* Build the octree over the given leaves (which must outlive it). params may be NULL
@@ -70,6 +75,13 @@ void mci_octree_free(const mci_ctx *ctx, mci_octree *tree);
 static inline uint32_t mci_octree_face_group(const mci_octree *tree, uint32_t f)
 {
     return tree->face_group ? tree->face_group[f] : tree->face_leaf[f];
+}
+
+/* The shell of face f (mci_octree_params.face_shell): pieces of one shell join across
+ * edges, and coincident shells are told apart by it. */
+static inline uint32_t mci_octree_face_shell(const mci_octree *tree, uint32_t f)
+{
+    return tree->face_shell ? tree->face_shell[f] : mci_octree_face_group(tree, f);
 }
 
 /* Free the face boxes (once the candidate pairs are taken). */

@@ -300,6 +300,10 @@ static size_t kth_use(const edge_use *group, size_t n, uint32_t forward, size_t 
  * unbalanced one. */
 static void join_shells(check_state *s, const edge_use *group, size_t n, size_t forward)
 {
+    if (n == 2) { /* nearly every edge */
+        unite(s->parent, group[0].tri, group[1].tri);
+        return;
+    }
     for (size_t i = 1; i < n && 2 * forward != n; i++)
         unite(s->parent, group[0].tri, group[i].tri);
     for (size_t k = 0; 2 * forward == n && k < forward; k++)

@@ -32,7 +32,7 @@ shells() {
 
 shells "$WORK/overlap.off" 0:10 5:15
 run 0 repair "$WORK/overlap.off" -o "$WORK/union.off" &&
-  contains '2 shells in, 6 pairs of triangles of different shells meeting; 1 shells out (0 cavities)'
+  contains '2 shells in, 6 pairs of triangles meeting (shells crossing); 1 shells out (0 cavities)'
 run 0 check "$WORK/union.off" && contains 'volume 1875'
 
 shells "$WORK/cavity.off" 0:10 2:8:in
@@ -42,15 +42,18 @@ run 0 check "$WORK/hollow.off" && contains 'volume 784'
 shells "$WORK/inverted.off" 0:10:in
 run 0 repair "$WORK/inverted.off" && contains '0 shells out (0 cavities), 0 vertices, 0 triangles'
 
-# A cube whose corner vertex is pushed through the opposite face crosses itself.
+# A cube whose corner vertex is pushed through the opposite face crosses itself: its
+# faces are intersected with each other, and the result is where its winding number is
+# positive (a generalized-winding-number estimate gives 301.1 and 1301.5).
 shells "$WORK/folded.off" 0:10
 sed -i 's/^10 10 10$/5 5 -2/' "$WORK/folded.off"
-run 1 repair "$WORK/folded.off" && contains 'intersects itself'
-# The same fold in the second of two shells: named with triangles of that shell.
+run 0 repair "$WORK/folded.off" -o "$WORK/unfolded.off" && contains '1 shells out (0 cavities)'
+run 0 check --self-intersections "$WORK/unfolded.off" && contains 'ok: no self-intersections'
+run 0 check "$WORK/unfolded.off" && contains '1 component, volume 300.925925925925'
+# The same fold in the second of two shells.
 shells "$WORK/folded2.off" 0:10 20:30
 sed -i 's/^30 30 30$/25 25 18/' "$WORK/folded2.off"
-run 1 repair "$WORK/folded2.off" && contains 'intersects itself'
-printf '%s' "$OUT" | grep -qE 'e\.g\. triangles (1[2-9]|2[0-3]) and (1[2-9]|2[0-3])$' && passed=$((passed + 1)) ||
-  { echo "FAIL: expected an example pair in the second shell: $OUT"; failed=$((failed + 1)); }
+run 0 repair "$WORK/folded2.off" -o "$WORK/unfolded.off" && contains '2 shells out (0 cavities)'
+run 0 check "$WORK/unfolded.off" && contains '2 components, volume 1300.925925925925'
 
 finish
