@@ -500,6 +500,29 @@ static void add_shells(csg_tree_spec *t)
     }
 }
 
+/* Exact copies (the same shell, or glued along a face, an edge or a corner) and pushed
+ * corners for the primitives of a free tree, from a stream of their own. */
+static void add_folds(csg_tree_spec *t)
+{
+    uint64_t rng = csg_mix_seed(t->seed ^ 0xf01d5);
+    for (int i = 0; i < t->leaf_count; i++) {
+        csg_leaf_spec *l = &t->leaves[i];
+        if (l->shape == CSG_MODEL || test_random_int(&rng, 0, 1) == 0)
+            continue;
+        l->inner = test_random_int(&rng, 0, 2);
+        l->pushed = test_random_int(&rng, 0, 2) == 0;
+        for (int k = 0; k < 3; k++)
+            l->inward[k] = test_random_int(&rng, 0, 3) == 0;
+        for (int k = 0; k < l->inner; k++) {
+            int axes = test_random_int(&rng, 0, 3); /* 0: the same shell again */
+            l->exact_copy[k] = true;
+            l->inner_scale[k] = 1;
+            for (int a = 0; a < axes; a++)
+                l->inner_shift[k][test_random_int(&rng, 0, 2)] = test_random_int(&rng, 0, 1) ? 1 : -1;
+        }
+    }
+}
+
 void csg_random_tree(csg_tree_spec *t, uint64_t seed)
 {
     uint64_t rng = seed;
@@ -514,9 +537,12 @@ void csg_random_tree(csg_tree_spec *t, uint64_t seed)
     t->leaf_count = 5 + (int)((CSG_MAX_LEAVES - 5 + 1) * pow(uniform(&rng), 3.0));
     random_leaves(t, &rng);
     random_operations(t, &rng);
-    if (t->family == CSG_FREE && csg_mix_seed(seed) % 3 == 0) {
-        t->family = CSG_SHELLS;
-        add_shells(t);
+    if (t->family == CSG_FREE && csg_mix_seed(seed) % 6 < 2) {
+        t->family = csg_mix_seed(seed) % 6 == 0 ? CSG_SHELLS : CSG_FOLDS;
+        if (t->family == CSG_SHELLS)
+            add_shells(t);
+        else
+            add_folds(t);
     }
 }
 
@@ -556,6 +582,8 @@ static bool same_primitive(const csg_leaf_spec *a, const csg_leaf_spec *b)
     memset(y.inner_shift, 0, sizeof y.inner_shift);
     memset(x.inward, 0, sizeof x.inward);
     memset(y.inward, 0, sizeof y.inward);
+    memset(x.exact_copy, 0, sizeof x.exact_copy);
+    memset(y.exact_copy, 0, sizeof y.exact_copy);
     return memcmp(&x, &y, sizeof x) == 0;
 }
 
@@ -576,6 +604,12 @@ static bool has_copies(const csg_tree_spec *t)
 static bool touching_allowed(const csg_tree_spec *t)
 {
     return (t->family != CSG_FREE && t->family != CSG_SHELLS) || has_copies(t);
+}
+
+/* The folds family's leaves may cross themselves: their shells are tested first. */
+static bool check_inputs(const csg_tree_spec *t)
+{
+    return t->family == CSG_FOLDS;
 }
 
 static mcsg_status make_primitive_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_error *err)
@@ -602,11 +636,13 @@ static void write_shell(const csg_leaf_spec *l, const mcsg_mesh *m, const double
 {
     double s = k == 0 ? 1 : l->inner_scale[k - 1];
     const double *shift = k == 0 ? NULL : l->inner_shift[k - 1];
+    bool exact = k > 0 && l->exact_copy[k - 1];
     size_t base = (size_t)k * m->vertex_count, tri = (size_t)k * m->triangle_count;
     for (size_t v = 0; v < 3 * m->vertex_count; v++)
         out->vertices[3 * base + v] =
-            k == 0 ? m->vertices[v]
-                   : c[v % 3] + s * (m->vertices[v] - c[v % 3]) + shift[v % 3] * size[v % 3];
+            k == 0  ? m->vertices[v]
+            : exact ? m->vertices[v] + shift[v % 3] * size[v % 3]
+                    : c[v % 3] + s * (m->vertices[v] - c[v % 3]) + shift[v % 3] * size[v % 3];
     for (size_t t = 0; t < m->triangle_count; t++)
         for (int i = 0; i < 3; i++)
             out->triangles[3 * (tri + t) + (size_t)i] =
@@ -621,7 +657,7 @@ static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_e
     double c[3], size[3];
     mcsg_status st = make_primitive_mesh(l, &m, err);
     int shells = 1 + l->inner;
-    if (st != MCSG_OK || (l->inner == 0 && !l->inward[0])) {
+    if (st != MCSG_OK || (l->inner == 0 && !l->inward[0] && !l->pushed)) {
         *out = m;
         return st;
     }
@@ -633,6 +669,8 @@ static mcsg_status make_leaf_mesh(const csg_leaf_spec *l, mcsg_mesh *out, mcsg_e
         c[k] = (lo[k] + hi[k]) / 2;
         size[k] = hi[k] - lo[k];
     }
+    for (int k = 0; l->pushed && k < 3; k++) /* through the centre, past the far side */
+        m.vertices[k] = c[k] - 1.25 * (m.vertices[k] - c[k]);
     out->vertex_count = (size_t)shells * m.vertex_count;
     out->triangle_count = (size_t)shells * m.triangle_count;
     out->vertices = malloc(3 * out->vertex_count * sizeof *out->vertices);
@@ -688,7 +726,7 @@ static void print_leaf(FILE *f, const csg_leaf_spec *l)
     fprintf(f, "multmatrix([[%.17g, %.17g, %.17g, %.17g], [%.17g, %.17g, %.17g, %.17g], "
                "[%.17g, %.17g, %.17g, %.17g], [0, 0, 0, 1]]) ",
             m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]);
-    if (l->inner > 0 || l->inward[0]) {
+    if (l->inner > 0 || l->inward[0] || l->pushed) {
         print_polyhedron(f, l);
         return;
     }
@@ -727,7 +765,8 @@ static void print_node(FILE *f, const csg_tree_spec *t, int node, int depth)
     fputs("}\n", f);
 }
 
-const char *const csg_family_names[CSG_FAMILIES] = {"free", "grid", "tilted", "export", "shells"};
+const char *const csg_family_names[CSG_FAMILIES] = {"free",   "grid",   "tilted",
+                                                    "export", "shells", "folds"};
 
 void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
 {
@@ -738,7 +777,8 @@ void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
     print_node(f, t, t->root, 0);
 }
 
-bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance)
+bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance,
+                     bool *check_inputs)
 {
     char family[16], touch[8], prov[8];
     if (sscanf(text, "// fuzz-csg: seed %" SCNx64 " family %15s touching %7s provenance %7[a-z]",
@@ -746,6 +786,7 @@ bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *wit
         return false;
     *touching = strcmp(touch, "yes") == 0;
     *with_provenance = strcmp(prov, "yes") == 0;
+    *check_inputs = strcmp(family, csg_family_names[CSG_FOLDS]) == 0;
     return true;
 }
 
@@ -1280,7 +1321,8 @@ static bool check_points(const tree_facts *f, const tree_facts *claim, uint64_t 
 bool csg_self_check;
 
 bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed,
-                    bool with_provenance, bool allow_touching, csg_result *r)
+                    bool with_provenance, bool allow_touching, bool check_inputs,
+                    csg_result *r)
 {
     tree_facts f = {0}, cf = {0};
     mcsg_mesh out = {0};
@@ -1311,6 +1353,7 @@ bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed
     {
         mcsg_options opts = {0};
         opts.check_output_crossings = csg_self_check;
+        opts.check_self_intersections = check_inputs;
         st = mcsg_eval(tree, &opts, &out, with_provenance ? &prov : NULL, &stats, &err);
     }
     if (st != MCSG_OK) {
@@ -1376,7 +1419,7 @@ bool csg_run_case(const csg_tree_spec *t, const csg_tree_spec *claim, bool with_
     memset(r, 0, sizeof *r);
     if (build_tree(t, &tree, r) == MCSG_OK && (!claim || build_tree(claim, &claim_tree, r) == MCSG_OK))
         ok = csg_check_tree(tree, claim_tree, t->seed, with_provenance,
-                            touching_allowed(t), r);
+                            touching_allowed(t), check_inputs(t), r);
     mcsg_tree_free(tree);
     mcsg_tree_free(claim_tree);
     return ok;

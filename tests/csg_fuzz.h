@@ -32,9 +32,21 @@ typedef enum csg_shape { CSG_CUBE, CSG_SPHERE, CSG_CYLINDER, CSG_MODEL } csg_sha
  * carry smaller copies of themselves (one or two, inside or crossing them, each facing
  * out or in), and may face inward themselves: leaves whose solid is where their winding
  * number is positive, with nested and overlapping shells, cavities, and shells that are
- * empty on their own. */
-typedef enum csg_family { CSG_FREE, CSG_GRID, CSG_TILTED, CSG_EXPORT, CSG_SHELLS } csg_family;
-#define CSG_FAMILIES 5
+ * empty on their own; folds: free trees whose primitives carry exact copies of themselves
+ * (the same shell again, or moved by the box's size along one, two or three axes so that
+ * they share a face, an edge or a corner with it, each facing out or in), and may have a
+ * corner pushed through the opposite side so that they cross themselves: leaves closed
+ * only as chains, evaluated with their shells tested first
+ * (mcsg_options.check_self_intersections). */
+typedef enum csg_family {
+    CSG_FREE,
+    CSG_GRID,
+    CSG_TILTED,
+    CSG_EXPORT,
+    CSG_SHELLS,
+    CSG_FOLDS
+} csg_family;
+#define CSG_FAMILIES 6
 /* The families' names, as the case files' first line and the reports write them. */
 extern const char *const csg_family_names[CSG_FAMILIES];
 
@@ -52,6 +64,11 @@ typedef struct csg_leaf_spec {
     int inner;
     double inner_scale[2], inner_shift[2][3];
     bool inward[3];
+    /* Folds family: copy k is exact (vertex + inner_shift[k] times the box's size, the
+     * shift -1, 0 or 1 on each axis), and the primitive's first vertex is pushed through
+     * to the far side of its box's centre. */
+    bool exact_copy[2];
+    bool pushed;
     double m[12];     /* row-major 3x4 placement */
 } csg_leaf_spec;
 
@@ -105,12 +122,14 @@ int csg_reachable_leaves(const csg_tree_spec *t);
 /* A random leaf of the free family (for hand-made cases). */
 void csg_free_leaf(uint64_t *rng, csg_leaf_spec *l);
 
-/* Evaluates `tree` and checks it: status, mesh validity (edge-non-manifold output only
- * with allow_touching), provenance, membership at a few hundred points against the
- * oracle evaluating `claim` (NULL: the same tree; same leaves, maybe other operations),
- * volume. False with r->why on the first problem. */
+/* Evaluates `tree` (its leaves' shells tested first if check_inputs) and checks it:
+ * status, mesh validity (edge-non-manifold output only with allow_touching), provenance,
+ * membership at a few hundred points against the oracle evaluating `claim` (NULL: the
+ * same tree; same leaves, maybe other operations), volume. False with r->why on the
+ * first problem. */
 bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed,
-                    bool with_provenance, bool allow_touching, csg_result *r);
+                    bool with_provenance, bool allow_touching, bool check_inputs,
+                    csg_result *r);
 /* The same for a spec (claim may be NULL). */
 bool csg_run_case(const csg_tree_spec *t, const csg_tree_spec *claim, bool with_provenance,
                   csg_result *r);
@@ -121,7 +140,9 @@ void csg_shrink(csg_tree_spec *t, bool with_provenance, double budget);
  * "// fuzz-csg: seed 0x... family F touching T provenance P". Models are imported by
  * file name: parse with import paths relative to tests/data/models. */
 void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance);
-/* Parses that first line; false if it is not there. */
-bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance);
+/* Parses that first line; false if it is not there. *check_inputs: the family is one
+ * whose shells are tested first (csg_check_tree). */
+bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance,
+                     bool *check_inputs);
 
 #endif

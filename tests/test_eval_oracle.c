@@ -130,7 +130,7 @@ static void run_saved_case(const char *dir, const char *name, const char *models
     char path[8192];
     char *text;
     uint64_t seed;
-    bool touching, with_provenance;
+    bool touching, with_provenance, check_inputs;
     mcsg_tree *tree = NULL;
     mcsg_error err;
     csg_result r;
@@ -139,12 +139,13 @@ static void run_saved_case(const char *dir, const char *name, const char *models
     CHECK_MSG(text != NULL, "cannot read %s", path);
     if (!text)
         return;
-    CHECK_MSG(csg_read_header(text, &seed, &touching, &with_provenance),
+    CHECK_MSG(csg_read_header(text, &seed, &touching, &with_provenance, &check_inputs),
               "%s: the first line is not a fuzz-csg header", name);
     if (mcsg_scad_read_memory(text, strlen(text), name, models, NULL, &tree, &err) != MCSG_OK) {
         CHECK_MSG(false, "%s: %s", name, err.message);
     } else {
-        bool passed = csg_check_tree(tree, NULL, seed, with_provenance, touching, &r);
+        bool passed = csg_check_tree(tree, NULL, seed, with_provenance, touching, check_inputs,
+                                     &r);
         CHECK_MSG(passed, "%s: %s", name, r.why);
         add_result(s, &r);
         s->trees++;
