@@ -661,7 +661,7 @@ static mcsg_status group_shells(eval_state *e, mcsg_error *err)
         for (size_t k = 0; k < t->leaf_mesh[l]->triangle_count; k++, f++) {
             uint32_t own = shell ? (uint32_t)(shells + shell[k]) : (uint32_t)l;
             e->face_group[f] = t->leaf_crossing[l] ? (uint32_t)(next + k)
-                               : shell              ? own
+                               : shell              ? (uint32_t)(next + shell[k])
                                                     : (uint32_t)l;
             if (crossing)
                 e->face_shell[f] = own;
