@@ -590,8 +590,8 @@ typedef struct mcsg_repair_stats {
  * inside an outward one stays as a cavity, an inward shell on its own disappears, and a
  * shell crossing itself becomes the set where its winding number is positive (every
  * shell is tested exactly first). The input must meet mcsg_eval's contract for a leaf
- * (closed as a chain, finite; MCSG_ERR_INVALID_MESH with one line naming the problem). The result carries mcsg_eval's guarantees and output check
- * (stats->eval.output_check). *out receives the mesh (release with mcsg_mesh_free);
+ * (closed as a chain, finite; MCSG_ERR_INVALID_MESH with one line naming the problem).
+ * The result carries mcsg_eval's guarantees and output check (stats->eval.output_check). *out receives the mesh (release with mcsg_mesh_free);
  * stats may be NULL. */
 mcsg_status mcsg_mesh_repair(const mcsg_mesh *mesh, const mcsg_options *opts, mcsg_mesh *out,
                              mcsg_repair_stats *stats, mcsg_error *err);
