@@ -517,9 +517,9 @@ static void add_folds(csg_tree_spec *t)
             int axes = test_random_int(&rng, 0, 3); /* 0: the same shell again */
             l->exact_copy[k] = true;
             l->inner_scale[k] = 1;
-            for (int a = 0; a < axes; a++) {
-                int axis = test_random_int(&rng, 0, 2);
-                l->inner_shift[k][axis] = test_random_int(&rng, 0, 1) ? 1 : -1;
+            for (int a = 0; a < axes; a++) { /* the sign first, as gcc drew them */
+                double sign = test_random_int(&rng, 0, 1) ? 1 : -1;
+                l->inner_shift[k][test_random_int(&rng, 0, 2)] = sign;
             }
         }
     }
