@@ -59,7 +59,7 @@ typedef struct mci_classify_stats {
  * append those that belong to the result to kept[leaf] (reversed for a complemented
  * primitive); for a leaf with copies (scene->alias), to each copy's kept[] as well, and
  * nothing for a copy itself. Fails with MCSG_ERR_INTERNAL when the leaf's pieces do not close up (an
- * input that is not closed and edge-manifold) or a label cannot be decided. */
+ * input that is not closed as a chain) or a label cannot be decided. */
 mcsg_status mci_classify_leaf(const mci_ctx *ctx, const mci_classifier *cl, uint32_t leaf,
                               mci_kept *kept, mci_classify_stats *stats, mcsg_error *err);
 

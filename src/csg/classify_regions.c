@@ -220,7 +220,7 @@ static bool list_sides_by_vertex(mci_leaf_work *w, size_t n, vertex_sides *vs, b
 
 /* The shell of the face holding edge slot k: shells of one leaf that may cross each
  * other (or lie in each other's faces) are paired each on its own. */
-static uint32_t slot_group(const mci_leaf_work *w, size_t k)
+static uint32_t slot_shell(const mci_leaf_work *w, size_t k)
 {
     return mci_octree_face_shell(&w->s->octree, w->pface[k / 3]);
 }
@@ -240,7 +240,7 @@ static size_t sides_between(const mci_leaf_work *w, const vertex_sides *vs, uint
     if (from < vs->first || from > vs->last)
         return 0;
     for (uint32_t i = vs->start[from - vs->first]; i < vs->start[from - vs->first + 1]; i++)
-        if (vs->sides[i].to == to && (g == MCI_NONE || slot_group(w, vs->sides[i].slot) == g) &&
+        if (vs->sides[i].to == to && (g == MCI_NONE || slot_shell(w, vs->sides[i].slot) == g) &&
             count++ == 0)
             *first = vs->sides[i].slot;
     return count;
@@ -271,7 +271,7 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
         size_t ahead, behind;
         if (w->mate[k] != MCI_NONE)
             continue;
-        g = shells ? slot_group(w, k) : MCI_NONE;
+        g = shells ? slot_shell(w, k) : MCI_NONE;
         ahead = sides_between(w, &vs, u, v, g, &ignored);
         behind = sides_between(w, &vs, v, u, g, &back);
         if (u != v && ahead == 1 && behind == 1) {
@@ -288,7 +288,7 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
 }
 
 /* Pairs the n sides of one edge (a run of equal keys), each with the opposite side of
- * its own group; the pairs are separators if `separator`. */
+ * its own shell; the pairs are separators if `separator`. */
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
     bool shells = leaf_has_shells(w);
@@ -299,12 +299,12 @@ static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, 
             continue;
         while (b < n && (w->mate[run[b].ref] != MCI_NONE ||
                          mci_leaf_slot_from(w, run[b].ref) != mci_leaf_slot_to(w, k) ||
-                         (shells && slot_group(w, run[b].ref) != slot_group(w, k))))
+                         (shells && slot_shell(w, run[b].ref) != slot_shell(w, k))))
             b++;
         if (b == n)
             return mci_fail(w->err, MCSG_ERR_INTERNAL,
                             "leaf %u does not close up after splitting: an edge is shared by "
-                            "%zu pieces%s (inputs must be closed and edge-manifold)",
+                            "%zu pieces%s (inputs must be closed as chains)",
                             w->leaf, n, n == 2 ? " with equal orientations" : "");
         w->mate[k] = run[b].ref;
         w->mate[run[b].ref] = k;
@@ -313,8 +313,9 @@ static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, 
     return MCSG_OK;
 }
 
-/* Pair every directed piece edge with its opposite; a closed, consistently oriented
- * edge-manifold surface has exactly one. Sides on face borders are sorted by edge key
+/* Pair every directed piece edge with its opposite; a surface closed as a chain has one
+ * in each shell (where more than two pieces share an edge, pair_sides pairs them shell
+ * by shell). Sides on face borders are sorted by edge key
  * and walked along the sorted separators (collect_separators), which marks the
  * separator slots (is_sep); leaves with dense vertex ids are paired by vertex first
  * (pair_by_vertex). */

@@ -104,9 +104,6 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
                     label[0] ? ", " : "", label, problem);
 }
 
-static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          mci_ptree *ptree, bool whole, mcsg_error *err);
-
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
 {
@@ -193,13 +190,6 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
     return MCSG_OK;
 }
 
-static mcsg_status find_self_intersecting(const mci_ctx *ctx, const mcsg_tree *tree,
-                                          mci_ptree *ptree, bool whole, mcsg_error *err)
-{
-    size_t count;
-    return scan_leaves(ctx, tree, ptree, whole, &count, err);
-}
-
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                      mci_ptree *ptree, size_t *marked, mcsg_error *err)
 {
@@ -211,11 +201,12 @@ mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree
 {
     mcsg_error saved, probe;
     mcsg_status st;
+    size_t count;
     if (err)
         saved = *err;
-    /* Every crossing pair, shells against each other too: shells that touch break the
-     * contract as well, and are found this way. */
-    st = find_self_intersecting(ctx, tree, ptree, true, &probe);
+    /* Every pair that meets, shells against each other too: the leaf whose surfaces
+     * cross or touch is the likeliest cause, and naming it helps more than a bug report. */
+    st = scan_leaves(ctx, tree, ptree, true, &count, &probe);
     if (st == MCSG_ERR_INVALID_MESH) {
         if (err)
             *err = probe;

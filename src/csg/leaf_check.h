@@ -21,9 +21,9 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptre
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                      mci_ptree *ptree, size_t *marked, mcsg_error *err);
 
-/* Called when evaluation failed with MCSG_ERR_INTERNAL: if a primitive intersects
- * itself (two of its triangles cross or overlap: a shell crossing itself, or shells that
- * touch, break the input contract in ways the stages cannot always notice), returns
+/* Called when evaluation failed with MCSG_ERR_INTERNAL (after self-crossing shells were
+ * marked and evaluated again): if two triangles of a primitive cross or meet other than
+ * in their shared edge (the likeliest cause of such a failure), returns
  * MCSG_ERR_INVALID_MESH with a message naming it; otherwise MCSG_ERR_INTERNAL with *err
  * unchanged. */
 mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
