@@ -272,10 +272,14 @@ typedef struct mcsg_check_report {
      * boundary and inconsistent edges above never are. */
     size_t unbalanced_edges;      /* more than two triangles, unequal directions */
     uint32_t example_unbalanced_edge[2];
-    /* Shells (what `components` counts): triangles joined across edges, where at an edge
-     * of more than two triangles the k-th use in one direction is joined with the k-th
-     * in the other (in triangle order). An edge where one shell has more than two
-     * triangles is counted here: mcsg_eval does not take such a primitive. */
+    /* Shells (what `components` counts): triangles joined across edges. At an edge of
+     * more than two triangles, each is joined with the one it bounds a wedge of solid
+     * with, by angle about the edge, where directions alternate around it (triangles in
+     * one half-plane, such as a face listed twice, taken in an order that makes them
+     * alternate); where they cannot, the k-th use in one direction is joined with the
+     * k-th in the other (in triangle order). An edge where they cannot and one shell has
+     * more than two triangles is counted here: mcsg_eval does not take such a
+     * primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;
@@ -552,7 +556,8 @@ typedef struct mcsg_eval_stats {
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
  * coordinates, no zero-area triangles, no shell meeting itself at an edge with more than
- * two triangles (self_touching_edges), and a non-zero volume when it has one shell.
+ * two triangles whose directions cannot alternate around it (self_touching_edges), and
+ * a non-zero volume when it has one shell.
  * A leaf is the set where its winding number is positive: it may have several shells,
  * facing out or in, nested, overlapping, sharing edges or faces, and repeated triangles
  * (overlapping outward shells are their union, an inward shell inside an outward one is

@@ -586,6 +586,67 @@ TEST(leaves_closed_as_chains)
     free(cut);
 }
 
+/* The surface of unit cells (scaled by 10) as a polyhedron: each face between a cell and
+ * an empty one is a quad with corners of its own (they are identified by coordinates). */
+static char *cells_polyhedron(const int (*cell)[3], int n)
+{
+    static const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                    {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    static const int step[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
+                                   {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
+    size_t cap = 64 + (size_t)n * 6 * 160, len = 0, quads_out = 0;
+    char *points = malloc(cap), *faces = malloc(cap), *text = malloc(2 * cap);
+    for (int k = 0; k < n; k++)
+        for (int f = 0; f < 6; f++) {
+            bool covered = false;
+            for (int j = 0; j < n; j++)
+                covered |= cell[j][0] == cell[k][0] + step[f][0] &&
+                           cell[j][1] == cell[k][1] + step[f][1] &&
+                           cell[j][2] == cell[k][2] + step[f][2];
+            for (int i = 0; !covered && i < 4; i++) {
+                int c = quads[f][i];
+                len += (size_t)snprintf(points + len, cap - len, "%s[%d,%d,%d]",
+                                        quads_out + (size_t)i ? "," : "",
+                                        10 * (cell[k][0] + (c >> 2 & 1)),
+                                        10 * (cell[k][1] + (c >> 1 & 1)),
+                                        10 * (cell[k][2] + (c & 1)));
+            }
+            quads_out += !covered;
+        }
+    faces[0] = '\0';
+    for (size_t q = 0, flen = 0; q < quads_out; q++)
+        flen += (size_t)snprintf(faces + flen, cap - flen, "%s[%zu,%zu,%zu,%zu]", q ? "," : "",
+                                 4 * q, 4 * q + 1, 4 * q + 2, 4 * q + 3);
+    snprintf(text, 2 * cap, "polyhedron(points=[%s], faces=[%s]);", points, faces);
+    free(points);
+    free(faces);
+    return text;
+}
+
+/* One connected surface that meets itself along an edge of four triangles: cells (0,0,0)
+ * and (1,1,0) touch along x = y = 10 and are joined through the layer above. Its
+ * triangles there are paired by angle (each with the one it bounds a wedge of solid
+ * with), so the two cells stay apart at the edge; its upper end is not split, since the
+ * layer above joins the cells around it. */
+TEST(leaf_touching_itself_along_an_edge)
+{
+    static const int cells[5][3] = {{0, 0, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}};
+    char *bent = cells_polyhedron(cells, 5), *text;
+    expect_touching(text = tree_of("union", bent, ""), 5000, 1); /* the lower end only */
+    free(text);
+    expect_touching(text = tree_of("difference", bent, "translate([-1,-1,15]) cube(30);"),
+                    3500, 1);
+    free(text);
+    expect_touching(text = tree_of("difference", bent, "translate([-1,-1,3]) cube([30,30,2]);"),
+                    4600, 3);
+    free(text);
+    expect_touching(text = tree_of("intersection", bent, "translate([5,5,2]) cube([10,10,4]);"),
+                    200, 2);
+    free(text);
+    expect_tree_volume("difference", bent, "translate([5,5,-1]) cube([10,10,30]);", 3750, 1);
+    free(bent);
+}
+
 TEST(curved_volumes_add_up)
 {
     static const char *a = "sphere(1, $fn=24);";
@@ -1255,6 +1316,7 @@ int main(void)
     RUN(leaves_with_several_shells);
     RUN(leaves_with_crossing_shells);
     RUN(leaves_closed_as_chains);
+    RUN(leaf_touching_itself_along_an_edge);
     RUN(leaves_crossing_themselves);
     RUN(repair_joins_overlapping_shells);
     return test_summary();

@@ -117,6 +117,23 @@ TEST(duplicate_triangle_is_nonmanifold)
 /* Closed as a chain though not manifold: every edge used equally often each way. The
  * shells are paired at the shared edges, so a cube listed twice is two shells, and two
  * cubes sharing an edge stay apart. */
+/* Moves the second of the triangles that use both vertices a and b to the end. */
+static void move_last_on_edge(test_mesh *m, uint32_t a, uint32_t b)
+{
+    size_t n = m->mesh.triangle_count, found = 0;
+    for (size_t t = 0; t < n; t++) {
+        uint32_t *c = m->t + 3 * t, moved[3];
+        bool has_a = c[0] == a || c[1] == a || c[2] == a;
+        bool has_b = c[0] == b || c[1] == b || c[2] == b;
+        if (!(has_a && has_b) || ++found < 2)
+            continue;
+        memcpy(moved, c, sizeof moved);
+        memmove(c, c + 3, 3 * (n - 1 - t) * sizeof *c);
+        memcpy(m->t + 3 * (n - 1), moved, sizeof moved);
+        return;
+    }
+}
+
 TEST(balanced_edges_pair_shells)
 {
     test_mesh m;
@@ -144,6 +161,12 @@ TEST(balanced_edges_pair_shells)
     CHECK_EQ_SIZE(r.unbalanced_edges + r.self_touching_edges, 0);
     CHECK_EQ_SIZE(r.components, 2);
     CHECK_EQ_DOUBLE(r.volume, 2.0);
+    /* The same with the first cube's second triangle on that edge listed last: in
+     * triangle order its uses would pair with the other cube's, by angle they do not. */
+    move_last_on_edge(&m, 2, 6); /* (1,1,0) and (1,1,1) */
+    r = check(&m.mesh);
+    CHECK_EQ_SIZE(r.unbalanced_edges + r.self_touching_edges, 0);
+    CHECK_EQ_SIZE(r.components, 2);
 }
 
 TEST(degenerate_triangles)

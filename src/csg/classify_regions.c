@@ -287,29 +287,51 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
     return ok;
 }
 
+/* Which sides pair_sides may join, pass by pass, where one shell meets itself at an edge
+ * (the leaf has angle mates, mci_ptree.leaf_mates): first the two sides of a cut
+ * through one face, then sides of faces the leaf check paired by angle there, then any. */
+typedef enum side_pass { SAME_FACE, ANGLE_MATES, ANY_FACE } side_pass;
+
+static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool shells,
+                        side_pass pass)
+{
+    const mci_edge_mates *mates = &w->cl->tree->leaf_mates[w->leaf];
+    uint32_t f = w->pface[k / 3], g = w->pface[j / 3];
+    if (w->mate[j] != MCI_NONE || mci_leaf_slot_from(w, j) != mci_leaf_slot_to(w, k) ||
+        (shells && slot_shell(w, j) != slot_shell(w, k)))
+        return false;
+    if (pass == SAME_FACE)
+        return f == g;
+    return pass == ANY_FACE ||
+           mci_edge_mates_has(mates, f - w->face_base, g - w->face_base);
+}
+
 /* Pairs the n sides of one edge (a run of equal keys), each with the opposite side of
- * its own shell; the pairs are separators if `separator`. */
+ * its own shell (see side_pass where a shell meets itself); the pairs are separators if
+ * `separator`. */
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
     bool shells = leaf_has_shells(w);
-    for (size_t a = 0; a < n; a++) {
-        uint32_t k = run[a].ref;
-        size_t b = a + 1;
-        if (w->mate[k] != MCI_NONE)
-            continue;
-        while (b < n && (w->mate[run[b].ref] != MCI_NONE ||
-                         mci_leaf_slot_from(w, run[b].ref) != mci_leaf_slot_to(w, k) ||
-                         (shells && slot_shell(w, run[b].ref) != slot_shell(w, k))))
-            b++;
-        if (b == n)
-            return mci_fail(w->err, MCSG_ERR_INTERNAL,
-                            "leaf %u does not close up after splitting: an edge is shared by "
-                            "%zu pieces%s (inputs must be closed as chains)",
-                            w->leaf, n, n == 2 ? " with equal orientations" : "");
-        w->mate[k] = run[b].ref;
-        w->mate[run[b].ref] = k;
-        w->is_sep[k] = w->is_sep[run[b].ref] = separator;
-    }
+    side_pass pass = n > 2 && w->cl->tree->leaf_mates[w->leaf].count > 0 ? SAME_FACE : ANY_FACE;
+    for (; pass <= ANY_FACE; pass++)
+        for (size_t a = 0; a < n; a++) {
+            uint32_t k = run[a].ref;
+            size_t b = a + 1;
+            if (w->mate[k] != MCI_NONE)
+                continue;
+            while (b < n && !sides_match(w, k, run[b].ref, shells, pass))
+                b++;
+            if (b == n && pass == ANY_FACE)
+                return mci_fail(w->err, MCSG_ERR_INTERNAL,
+                                "leaf %u does not close up after splitting: an edge is shared "
+                                "by %zu pieces%s (inputs must be closed as chains)", w->leaf, n,
+                                n == 2 ? " with equal orientations" : "");
+            if (b == n)
+                continue;
+            w->mate[k] = run[b].ref;
+            w->mate[run[b].ref] = k;
+            w->is_sep[k] = w->is_sep[run[b].ref] = separator;
+        }
     return MCSG_OK;
 }
 

@@ -159,11 +159,12 @@ mcsg_status mci_ptree_build(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree
     out->leaf_shell = mci_calloc_array(ctx, n, sizeof *out->leaf_shell);
     out->leaf_shells = mci_calloc_array(ctx, n, sizeof *out->leaf_shells);
     out->leaf_crossing = mci_calloc_array(ctx, n, 1);
+    out->leaf_mates = mci_calloc_array(ctx, n, sizeof *out->leaf_mates);
     b.stack = mci_malloc_array(ctx, n, sizeof *b.stack);
     b.done = mci_malloc_array(ctx, n, sizeof *b.done);
     if (!out->nodes || !out->child || !out->leaf_node || !out->leaf_mesh ||
         !out->leaf_source || !out->leaf_winding || !out->leaf_shell || !out->leaf_shells ||
-        !out->leaf_crossing || !b.stack || !b.done) {
+        !out->leaf_crossing || !out->leaf_mates || !b.stack || !b.done) {
         mci_free(ctx, b.stack);
         mci_free(ctx, b.done);
         mci_ptree_free(ctx, out);
@@ -188,6 +189,9 @@ void mci_ptree_free(const mci_ctx *ctx, mci_ptree *t)
     mci_free(ctx, t->leaf_shell);
     mci_free(ctx, t->leaf_shells);
     mci_free(ctx, t->leaf_crossing);
+    for (size_t l = 0; t->leaf_mates && l < t->leaf_count; l++)
+        mci_edge_mates_free(ctx, &t->leaf_mates[l]);
+    mci_free(ctx, t->leaf_mates);
     memset(t, 0, sizeof *t);
 }
 

@@ -10,6 +10,7 @@
 #define MESHCSG_CSG_CSGTREE_H
 
 #include "base/core.h"
+#include "mesh/validate.h"
 
 /* Where a face (or a point of it) is with respect to a solid. SAME / OPPO: on the
  * solid's boundary, with the solid's outward normal equal / opposite to the face's. */
@@ -65,6 +66,10 @@ typedef struct mci_ptree {
      * 0 .. leaf_shells[l] - 1 (set by mci_check_leaves, owned). */
     uint32_t **leaf_shell;
     uint32_t *leaf_shells;
+    /* Per primitive: where one of its shells meets itself at an edge of more than two
+     * triangles, the triangles paired there by angle (empty for the others; set by
+     * mci_check_leaves, owned). Its pieces at such an edge are paired the same way. */
+    mci_edge_mates *leaf_mates;
     /* Per primitive: 1 when one of its shells crosses itself (found only when the options
      * ask, mci_check_leaves): its faces are then intersected with each other one by one
      * (see mci_octree_params.face_shell). Such a primitive is a winding one. */

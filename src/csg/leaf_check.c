@@ -67,7 +67,9 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
         format_point(a, sizeof a, m, r->example_self_touching_edge[0]);
         format_point(b, sizeof b, m, r->example_self_touching_edge[1]);
         snprintf(out, size, "not supported: %zu edges where one shell meets itself with "
-                 "more than two triangles, e.g. from %s to %s", r->self_touching_edges, a, b);
+                 "more than two triangles that do not alternate in direction around the "
+                 "edge (surfaces crossing there), e.g. from %s to %s", r->self_touching_edges,
+                 a, b);
     } else if (r->volume_sign == 0 && r->components == 1) {
         snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
                  "other, e.g. all in one plane)");
@@ -83,7 +85,8 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     mcsg_check_report report;
     char problem[400];
     uint32_t *shell = mci_malloc_array(job->ctx, m->triangle_count + 1, sizeof *shell);
-    mcsg_status st = shell ? mci_mesh_check_shells(job->ctx, m, &report, shell, err)
+    mci_edge_mates *mates = &job->ptree->leaf_mates[k];
+    mcsg_status st = shell ? mci_mesh_check_shells(job->ctx, m, &report, shell, mates, err)
                            : mci_fail_nomem(err, "checking the leaves");
     if (st != MCSG_OK) {
         mci_free(job->ctx, shell);

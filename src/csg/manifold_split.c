@@ -78,49 +78,6 @@ static uint32_t slot_third(const mcsg_mesh *m, uint32_t s)
     return m->triangles[prev_in_triangle(s)];
 }
 
-/* Sign of the turn from half-plane a to half-plane b about the axis u -> v: +1 when b
- * is within (0, pi) counter-clockwise of a. */
-static int turn(const double *u, const double *v, const double *a, const double *b)
-{
-    mci_plane plane;
-    mci_point p;
-    mci_plane_init(&plane, u, v, a);
-    mci_point_explicit(&p, b);
-    return mci_orient3d(&p, &plane);
-}
-
-/* For a and b in one plane with the axis: whether they are on the same side of it. */
-static bool same_side(const double *u, const double *v, const double *a, const double *b)
-{
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        int sa = mci_orient2d(u[i], u[j], v[i], v[j], a[i], a[j]);
-        if (sa != 0)
-            return sa == mci_orient2d(u[i], u[j], v[i], v[j], b[i], b[j]);
-    }
-    return true;
-}
-
-/* Angle class of half-plane w relative to the reference r: 0 same, 1 in (0, pi), 2 pi,
- * 3 in (pi, 2 pi). */
-static int angle_class(const double *u, const double *v, const double *r, const double *w)
-{
-    int t = turn(u, v, r, w);
-    if (t != 0)
-        return t > 0 ? 1 : 3;
-    return same_side(u, v, r, w) ? 0 : 2;
-}
-
-/* Whether w1 comes before w2 in the turn about u -> v starting at r. */
-static bool angle_before(const double *u, const double *v, const double *r, const double *w1,
-                         const double *w2)
-{
-    int c1 = angle_class(u, v, r, w1), c2 = angle_class(u, v, r, w2);
-    if (c1 != c2)
-        return c1 < c2;
-    return (c1 == 1 || c1 == 3) && turn(u, v, w1, w2) > 0;
-}
-
 static void pair_slots(splitter *sp, uint32_t a, uint32_t b)
 {
     sp->mate[a] = b;
@@ -185,8 +142,9 @@ static void sort_by_angle(const splitter *sp, uint32_t *slots, size_t n)
     uint32_t u = slot_from(m, slots[0]), v = slot_to(m, slots[0]);
     const double *pu = vertex(m, u), *pv = vertex(m, v), *r = vertex(m, slot_third(m, slots[0]));
     for (size_t i = 1; i < n; i++) /* insertion sort: n is small */
-        for (size_t j = i; j > 0 && angle_before(pu, pv, r, vertex(m, slot_third(m, slots[j])),
-                                                 vertex(m, slot_third(m, slots[j - 1])));
+        for (size_t j = i;
+             j > 0 && mci_half_plane_before(pu, pv, r, vertex(m, slot_third(m, slots[j])),
+                                            vertex(m, slot_third(m, slots[j - 1])));
              j--) {
             uint32_t t = slots[j];
             slots[j] = slots[j - 1];

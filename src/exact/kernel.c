@@ -23,6 +23,7 @@
 #include "exact/kernel.h"
 #include "exact/big.h"
 #include "exact/exact_cache.h"
+#include "exact/predicates.h"
 #include "exact/wide.h"
 
 #include <float.h>
@@ -949,6 +950,37 @@ int mci_orient3d_vertices(const double *a, const double *b, const double *c, con
         return s;
     mci_plane_init(&plane, a, b, c);
     return orient3d_vertex_beyond_filter(d, &plane);
+}
+
+/* For a and b in one plane with the axis u -> v: whether they are on the same side of
+ * it (the first projection where the axis is not a point decides). */
+static bool same_side_of_axis(const double *u, const double *v, const double *a,
+                              const double *b)
+{
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        int sa = mci_orient2d(u[i], u[j], v[i], v[j], a[i], a[j]);
+        if (sa != 0)
+            return sa == mci_orient2d(u[i], u[j], v[i], v[j], b[i], b[j]);
+    }
+    return true;
+}
+
+int mci_half_plane_class(const double *u, const double *v, const double *r, const double *w)
+{
+    int t = mci_orient3d_vertices(u, v, r, w);
+    if (t != 0)
+        return t > 0 ? 1 : 3;
+    return same_side_of_axis(u, v, r, w) ? 0 : 2;
+}
+
+bool mci_half_plane_before(const double *u, const double *v, const double *r,
+                           const double *w1, const double *w2)
+{
+    int c1 = mci_half_plane_class(u, v, r, w1), c2 = mci_half_plane_class(u, v, r, w2);
+    if (c1 != c2)
+        return c1 < c2;
+    return (c1 == 1 || c1 == 3) && mci_orient3d_vertices(u, v, w1, w2) > 0;
 }
 
 /* ---------------------------------------------------------------------------------- */

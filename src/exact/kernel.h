@@ -166,6 +166,18 @@ int mci_orient3d_vertex(const double *x, const mci_plane *plane);
  * (b - a) x (c - a): sign((b - a) x (c - a) . (d - a)); 0 when a, b, c are collinear. */
 int mci_orient3d_vertices(const double *a, const double *b, const double *c, const double *d);
 
+/* Half-planes about the axis u -> v, each bounded by the axis and holding an input
+ * vertex off it (a triangle on edge u-v, by its third corner). The class of half-plane
+ * w relative to the reference r: 0 the same half-plane, 1 within (0, pi) of r in the
+ * positive turn about u -> v (the side (v - u) x (r - u) points to), 2 opposite, 3
+ * within (pi, 2 pi). */
+int mci_half_plane_class(const double *u, const double *v, const double *r, const double *w);
+
+/* Whether half-plane w1 comes strictly before w2 in the positive turn about u -> v
+ * that starts at r. */
+bool mci_half_plane_before(const double *u, const double *v, const double *r,
+                           const double *w1, const double *w2);
+
 /* sign(a[axis] - b[axis]), axis in 0..2. */
 int mci_compare_coord(const mci_point *a, const mci_point *b, int axis);
 

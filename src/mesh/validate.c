@@ -10,6 +10,7 @@
  */
 #include "mesh/validate.h"
 #include "base/sort.h"
+#include "exact/kernel.h"
 #include "exact/predicates.h"
 
 #include <float.h>
@@ -30,6 +31,8 @@ typedef struct check_state {
     uint32_t *canon;    /* canonical vertex id per vertex */
     uint8_t *tri_ok;    /* triangle has valid indices */
     uint32_t *parent;   /* union-find over triangles */
+    mci_edge_mates *mates; /* optional output: pairs by angle where a shell meets itself */
+    size_t mates_room;
 } check_state;
 
 static uint64_t hash_mix(uint64_t h)
@@ -294,14 +297,120 @@ static size_t kth_use(const edge_use *group, size_t n, uint32_t forward, size_t 
     return n;
 }
 
+enum { ANGLE_PAIRING_MAX = 64 };
+
+/* The corner of use e's triangle off the edge (canonical coordinates), or NULL for a
+ * triangle with a repeated corner. */
+static const double *third_corner(const check_state *s, const edge_use *e)
+{
+    for (size_t k = 0; k < 3; k++) {
+        uint32_t v = s->canon[s->mesh->triangles[3 * (size_t)e->tri + k]];
+        if (v != (uint32_t)(e->key >> 32) && v != (uint32_t)e->key)
+            return s->mesh->vertices + 3 * (size_t)v;
+    }
+    return NULL;
+}
+
+/* Sorts order[0 .. n) (positions in group) by the angle of their triangles about the
+ * edge, from its smaller to its larger vertex; tie[i] is set when order[i] lies in the
+ * same half-plane as order[i - 1] (coincident or overlapping faces). False when a
+ * triangle has no third corner. */
+static bool sort_by_angle(const check_state *s, const edge_use *group, size_t n,
+                          uint8_t *order, bool *tie)
+{
+    const double *u = s->mesh->vertices + 3 * (size_t)(group[0].key >> 32);
+    const double *v = s->mesh->vertices + 3 * (size_t)(uint32_t)group[0].key;
+    const double *w[ANGLE_PAIRING_MAX];
+    for (size_t i = 0; i < n; i++) {
+        order[i] = (uint8_t)i;
+        if (!(w[i] = third_corner(s, &group[i])))
+            return false;
+    }
+    for (size_t i = 1; i < n; i++) /* insertion sort: n is small */
+        for (size_t j = i; j > 0 && mci_half_plane_before(u, v, w[0], w[order[j]],
+                                                         w[order[j - 1]]); j--) {
+            uint8_t t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    tie[0] = false;
+    for (size_t i = 1; i < n; i++)
+        tie[i] = mci_half_plane_class(u, v, w[order[i - 1]], w[order[i]]) == 0;
+    return true;
+}
+
+/* Reorders each run of ties in order[] so that directions alternate around the edge,
+ * forward uses at positions of parity `phase`; false when a run holds the wrong number
+ * of forward uses for that. */
+static bool alternate_ties(const edge_use *group, size_t n, const bool *tie, int phase,
+                           uint8_t *order)
+{
+    for (size_t start = 0, end; start < n; start = end) {
+        uint8_t fwd[ANGLE_PAIRING_MAX], back[ANGLE_PAIRING_MAX];
+        size_t nf = 0, nb = 0, wanted = 0;
+        for (end = start + 1; end < n && tie[end]; end++)
+            ;
+        for (size_t i = start; i < end; i++) {
+            if (group[order[i]].forward)
+                fwd[nf++] = order[i];
+            else
+                back[nb++] = order[i];
+            wanted += (i & 1) == (size_t)phase;
+        }
+        if (nf != wanted)
+            return false;
+        for (size_t i = start; i < end; i++)
+            order[i] = (i & 1) == (size_t)phase ? fwd[--nf] : back[--nb];
+    }
+    return true;
+}
+
+/* Pairs the uses of a balanced edge of more than two triangles by angle, as
+ * csg/manifold_split.c pairs the output's: each use from the smaller vertex to the
+ * larger with the one just before it in the turn, which must run the other way (the two
+ * triangles then bound one solid wedge). Triangles in one half-plane (a sliver folded
+ * flat, a face listed twice) may be taken in any order that makes directions alternate;
+ * such a pair bounds a wedge of no width. mate[i] is i's partner (positions in group).
+ * False when the edge has too many uses or directions that cannot alternate (surfaces
+ * crossing at the edge). */
+static bool pair_by_angle(const check_state *s, const edge_use *group, size_t n,
+                          uint8_t *mate)
+{
+    uint8_t order[ANGLE_PAIRING_MAX];
+    bool tie[ANGLE_PAIRING_MAX];
+    size_t forward = 0;
+    int phase = 0;
+    for (size_t i = 0; i < n; i++)
+        forward += group[i].forward;
+    if (n > ANGLE_PAIRING_MAX || 2 * forward != n || !sort_by_angle(s, group, n, order, tie))
+        return false;
+    while (phase < 2 && !alternate_ties(group, n, tie, phase, order))
+        phase++;
+    if (phase == 2)
+        return false;
+    for (size_t i = 0; i < n; i++) {
+        uint8_t here = order[i], before = order[(i + n - 1) % n];
+        if (group[here].forward)
+            mate[here] = before, mate[before] = here;
+    }
+    return true;
+}
+
 /* Joins the triangles of one edge into shells: both of a manifold edge; at a balanced
- * edge of more than two, the k-th use each way (any pairing closes every shell up as a
- * chain; this one keeps a file's parts, listed one after another, apart); all of an
- * unbalanced one. */
+ * edge of more than two, the pairs by angle (pair_by_angle), else (coincident faces,
+ * surfaces crossing at the edge) the k-th use each way (any pairing closes every shell
+ * up as a chain; this one keeps a file's parts, listed one after another, apart); all of
+ * an unbalanced one. */
 static void join_shells(check_state *s, const edge_use *group, size_t n, size_t forward)
 {
+    uint8_t mate[ANGLE_PAIRING_MAX];
     if (n == 2) { /* nearly every edge */
         unite(s->parent, group[0].tri, group[1].tri);
+        return;
+    }
+    if (pair_by_angle(s, group, n, mate)) {
+        for (size_t i = 0; i < n; i++)
+            unite(s->parent, group[i].tri, group[mate[i]].tri);
         return;
     }
     for (size_t i = 1; i < n && 2 * forward != n; i++)
@@ -327,18 +436,40 @@ static void classify_edge_group(check_state *s, const edge_use *group, size_t n)
         note_edge(r->example_unbalanced_edge, &r->unbalanced_edges, group[0].key);
 }
 
-/* After the shells are joined: a balanced edge of more than two triangles where one
- * shell has two uses. */
-static void check_self_touching(check_state *s, const edge_use *group, size_t n)
+/* Lists the pairs of one edge's uses, both ways (t << 32 | u), in s->mates. */
+static bool add_mates(check_state *s, const edge_use *group, size_t n, const uint8_t *mate)
 {
+    mci_edge_mates *m = s->mates;
+    if (m->count + n > s->mates_room) {
+        size_t room = 2 * s->mates_room + n + 16;
+        uint64_t *grown = mci_realloc_array(s->ctx, m->pairs, room, sizeof *grown);
+        if (!grown)
+            return false;
+        m->pairs = grown;
+        s->mates_room = room;
+    }
+    for (size_t i = 0; i < n; i++)
+        m->pairs[m->count++] = (uint64_t)group[i].tri << 32 | group[mate[i]].tri;
+    return true;
+}
+
+/* After the shells are joined: a balanced edge of more than two triangles where one
+ * shell has two uses. Where pair_by_angle pairs the edge, the shell's pairs there are
+ * listed (s->mates); elsewhere such an edge is counted as not supported. */
+static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
+{
+    uint8_t mate[ANGLE_PAIRING_MAX];
     for (size_t i = 0; n > 2 && i < n; i++)
         for (size_t j = i + 1; j < n; j++)
             if (mci_find_root(s->parent, group[i].tri) == mci_find_root(s->parent, group[j].tri) &&
                 group[i].forward == group[j].forward) {
+                if (pair_by_angle(s, group, n, mate))
+                    return !s->mates || add_mates(s, group, n, mate);
                 note_edge(s->report->example_self_touching_edge,
                           &s->report->self_touching_edges, group[0].key);
-                return;
+                return true;
             }
+    return true;
 }
 
 static bool check_edges(check_state *s)
@@ -359,7 +490,7 @@ static bool check_edges(check_state *s)
     start = 0;
     for (size_t i = 1; ok && s->report->nonmanifold_edges && i <= n; i++) {
         if (i == n || sorted[i].key != sorted[start].key) {
-            check_self_touching(s, sorted + start, i - start);
+            ok = check_self_touching(s, sorted + start, i - start);
             start = i;
         }
     }
@@ -515,7 +646,7 @@ mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
 mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err)
 {
-    return mci_mesh_check_shells(ctx, mesh, report, NULL, err);
+    return mci_mesh_check_shells(ctx, mesh, report, NULL, NULL, err);
 }
 
 /* shell[t] from the union-find roots: dense numbers in order of first triangles. */
@@ -536,7 +667,8 @@ static void number_shells(const check_state *s, uint32_t *shell)
 }
 
 mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
-                                  mcsg_check_report *report, uint32_t *shell, mcsg_error *err)
+                                  mcsg_check_report *report, uint32_t *shell,
+                                  mci_edge_mates *mates, mcsg_error *err)
 {
     const mci_ctx ctx = *ctx_in;
     check_state s;
@@ -546,6 +678,9 @@ mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
     s.ctx = &ctx;
     s.mesh = mesh;
     s.report = report;
+    s.mates = mates;
+    if (mates)
+        memset(mates, 0, sizeof *mates);
     s.canon = mci_malloc_array(&ctx, mesh->vertex_count, sizeof *s.canon);
     s.tri_ok = mci_malloc_array(&ctx, mesh->triangle_count, 1);
     s.parent = mci_malloc_array(&ctx, mesh->triangle_count, sizeof *s.parent);
@@ -555,14 +690,39 @@ mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
     ok = ok && run_checks(&s);
     if (ok && shell && report->components > 1)
         number_shells(&s, shell);
+    if (ok && mates)
+        mci_sort_u64(mates->pairs, mates->count);
     mci_free(&ctx, s.canon);
     mci_free(&ctx, s.tri_ok);
     mci_free(&ctx, s.parent);
     if (!ok) {
+        if (mates)
+            mci_edge_mates_free(&ctx, mates);
         report_init(report, mesh);
         return mci_fail_nomem(err, "checking a mesh");
     }
     return MCSG_OK;
+}
+
+void mci_edge_mates_free(const mci_ctx *ctx, mci_edge_mates *mates)
+{
+    mci_free(ctx, mates->pairs);
+    mates->pairs = NULL;
+    mates->count = 0;
+}
+
+bool mci_edge_mates_has(const mci_edge_mates *mates, uint32_t t, uint32_t u)
+{
+    uint64_t key = (uint64_t)t << 32 | u;
+    size_t lo = 0, hi = mates ? mates->count : 0;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (mates->pairs[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < (mates ? mates->count : 0) && mates->pairs[lo] == key;
 }
 
 int mcsg_check_report_is_valid(const mcsg_check_report *r)

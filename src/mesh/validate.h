@@ -28,11 +28,30 @@ int mci_triangles_volume_sign(const double *xyz, const uint32_t *tris, const uin
 /* mcsg_mesh_check with the context's allocator; the mesh's counts must fit uint32_t. */
 mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err);
+/* Where one shell meets itself at an edge of more than two triangles (two boxes of one
+ * connected surface touching along an edge), the triangles there are paired by angle
+ * about the edge, each with the one it bounds a solid wedge with: both orders of each
+ * pair (t << 32 | u, triangle indices), sorted. */
+typedef struct mci_edge_mates {
+    uint64_t *pairs;
+    size_t count;
+} mci_edge_mates;
+
+void mci_edge_mates_free(const mci_ctx *ctx, mci_edge_mates *mates);
+
+/* Whether triangles t and u are paired at such an edge (mates may be NULL: no). */
+bool mci_edge_mates_has(const mci_edge_mates *mates, uint32_t t, uint32_t u);
+
 /* The same, and when `shell` is not NULL (room for a value per triangle) and the mesh has
  * several components, each triangle's component over shared edges, numbered
  * 0 .. report->components - 1 in the order of their first triangles (valid triangles
- * only; others get UINT32_MAX). With one component `shell` is left as it is. */
+ * only; others get UINT32_MAX). With one component `shell` is left as it is. At edges
+ * of more than two triangles the shells are joined by angle where the triangles' angles
+ * about the edge alternate in direction, else the k-th use each way. `mates` (optional)
+ * receives the angle pairs where a shell meets itself (allocated with ctx: free with
+ * mci_edge_mates_free; empty on error). */
 mcsg_status mci_mesh_check_shells(const mci_ctx *ctx, const mcsg_mesh *mesh,
-                                  mcsg_check_report *report, uint32_t *shell, mcsg_error *err);
+                                  mcsg_check_report *report, uint32_t *shell,
+                                  mci_edge_mates *mates, mcsg_error *err);
 
 #endif
