@@ -278,8 +278,8 @@ typedef struct mcsg_check_report {
      * one half-plane, such as a face listed twice, taken in an order that makes them
      * alternate); where they cannot, the k-th use in one direction is joined with the
      * k-th in the other (in triangle order). An edge where they cannot and one shell has
-     * more than two triangles is counted here: mcsg_eval does not take such a
-     * primitive. */
+     * more than two triangles (surfaces crossing at the edge) is counted here: mcsg_eval
+     * does not take such a primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;
@@ -538,6 +538,11 @@ typedef struct mcsg_eval_stats {
                                         output is edge- and vertex-manifold */
     mcsg_output_check output_check; /* the result against its guarantees; a failure is
                                        also logged as a warning */
+    size_t rounding_reevaluations;  /* rounds of evaluating the rounded result again, alone
+                                       by its winding number, because rounding broke a
+                                       guarantee (docs/robustness.md); at most 3 */
+    int rounding_reevaluation_kept; /* 1 when the result is such a round's, whose check
+                                       passed (output_check is then that round's) */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */
@@ -572,8 +577,11 @@ typedef struct mcsg_eval_stats {
  * not be the intended set; see docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
- * doubles. Such a result is still returned with MCSG_OK (it is the best the rounding
- * gives), the failure is logged as a warning, and mcsg_output_check_failed tells it.
+ * doubles. Then the rounded mesh is evaluated again, alone, by its winding number (up to
+ * three rounds; a round whose check passes replaces the result, its provenance mapped
+ * back to the tree's leaves; stats->rounding_reevaluations). When none does, the first
+ * result is still returned with MCSG_OK, the failure is logged as a warning, and
+ * mcsg_output_check_failed tells it.
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,

@@ -647,6 +647,28 @@ TEST(leaf_touching_itself_along_an_edge)
     free(bent);
 }
 
+/* Surfaces of one shell crossing at an edge: the cube [0,10]^3 and a prism inside it
+ * on the edge x = y = 10, one shell since the cube's second triangle on that edge is
+ * listed last. No angle pairs the four triangles there (the prism's wedge lies inside
+ * the cube's): refused with the edge named. */
+TEST(leaf_crossing_itself_at_an_edge_is_refused)
+{
+    static const char *const nested =
+        "polyhedron(points=[[0,0,0],[0,0,10],[0,10,0],[0,10,10],[10,0,0],[10,0,10],[10,10,0],"
+        "[10,10,10],[10,10,0],[1,4,0],[4,1,0],[10,10,10],[1,4,10],[4,1,10]], faces=[[0,2,3],["
+        "0,3,1],[4,5,7],[4,7,6],[0,1,5],[0,5,4],[2,7,3],[0,4,6],[0,6,2],[1,3,7],[1,7,5],[9,10"
+        ",8],[13,12,11],[12,9,8],[11,12,8],[13,10,9],[12,13,9],[11,8,10],[13,11,10],[2,6,7]])"
+        ";";
+    mcsg_tree *tree = parse(nested);
+    mcsg_mesh out;
+    mcsg_error err;
+    CHECK(tree && mcsg_eval(tree, NULL, &out, NULL, NULL, &err) == MCSG_ERR_INVALID_MESH);
+    CHECK_CONTAINS(err.message, "1 edges where one shell meets itself with more than two "
+                                "triangles that do not alternate");
+    CHECK_CONTAINS(err.message, "from (10 10 0) to (10 10 10)");
+    mcsg_tree_free(tree);
+}
+
 TEST(curved_volumes_add_up)
 {
     static const char *a = "sphere(1, $fn=24);";
@@ -1172,6 +1194,47 @@ TEST(output_check_tells_what_rounding_broke)
     }
 }
 
+/* example018 moved off the origin: rounding folds a sliver onto its neighbour (four
+ * triangles on an edge once welded). The rounded result, evaluated again alone by its
+ * winding number, keeps every guarantee; its triangles still name faces of the tree's
+ * leaves. With crossings checked as well, the rounds do not settle (rounding makes new
+ * ones), and the first result stays with its report. */
+TEST(rounding_broken_result_is_evaluated_again)
+{
+    mcsg_options opts = {0};
+    mcsg_tree *tree = NULL;
+    mcsg_mesh out;
+    mcsg_provenance *prov = NULL;
+    mcsg_eval_stats st;
+    mcsg_check_report r;
+    mcsg_error err;
+    CHECK_OK(mcsg_scad_read(test_data("rounding/example018-moved.scad"), NULL, &tree, &err),
+             &err);
+    if (!tree)
+        return;
+    CHECK_OK(mcsg_eval(tree, NULL, &out, &prov, &st, &err), &err);
+    CHECK(st.rounding_reevaluations == 1 && st.rounding_reevaluation_kept == 1);
+    CHECK(!mcsg_output_check_failed(&st.output_check));
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
+    CHECK(mcsg_check_report_is_valid(&r) && r.components == 1);
+    CHECK_MSG(fabs(r.volume - 175969.18382477) < 1e-6, "volume %.17g", r.volume);
+    for (size_t t = 0; prov && t < out.triangle_count; t++) {
+        const mcsg_mesh *leaf = mcsg_tree_leaf_mesh(tree, prov[t].leaf);
+        CHECK_MSG(leaf && prov[t].face < leaf->triangle_count, "triangle %zu: leaf %u face %u",
+                  t, prov[t].leaf, prov[t].face);
+        if (!leaf)
+            break;
+    }
+    mcsg_free(prov, NULL);
+    mcsg_mesh_free(&out, NULL);
+    opts.check_output_crossings = 1;
+    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    CHECK(st.rounding_reevaluations > 0 && st.rounding_reevaluation_kept == 0);
+    CHECK(st.output_check.welded_nonmanifold_edges == 4 && st.output_check.crossing_pairs > 0);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_tree_free(tree);
+}
+
 /* A cube with one change: a triangle dropped, flipped, repeated, or a vertex moved. */
 static const double contract_cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
                                          0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1};
@@ -1317,6 +1380,8 @@ int main(void)
     RUN(leaves_with_crossing_shells);
     RUN(leaves_closed_as_chains);
     RUN(leaf_touching_itself_along_an_edge);
+    RUN(leaf_crossing_itself_at_an_edge_is_refused);
+    RUN(rounding_broken_result_is_evaluated_again);
     RUN(leaves_crossing_themselves);
     RUN(repair_joins_overlapping_shells);
     return test_summary();

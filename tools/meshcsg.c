@@ -599,6 +599,10 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     if (s->touching_vertices_split)
         printf("  touching parts: %zu vertices given separate copies\n",
                s->touching_vertices_split);
+    if (s->rounding_reevaluations)
+        printf("  rounding broke a guarantee: the rounded result evaluated again %zu times, "
+               "%s\n", s->rounding_reevaluations,
+               s->rounding_reevaluation_kept ? "the last one kept" : "none kept");
     printf("  total            %8.3f s\n", s->seconds_total);
 }
 

@@ -287,9 +287,9 @@ static bool pair_by_vertex(mci_leaf_work *w, size_t n, bool *nomem)
     return ok;
 }
 
-/* Which sides pair_sides may join, pass by pass, where one shell meets itself at an edge
- * (the leaf has angle mates, mci_ptree.leaf_mates): first the two sides of a cut
- * through one face, then sides of faces the leaf check paired by angle there, then any. */
+/* Which sides pair_sides may join, pass by pass, where more than two sides meet: first
+ * the two sides of a cut through one face, then sides of faces the leaf check paired by
+ * angle (where one shell meets itself, mci_ptree.leaf_mates), then any. */
 typedef enum side_pass { SAME_FACE, ANGLE_MATES, ANY_FACE } side_pass;
 
 static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool shells,
@@ -307,12 +307,11 @@ static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool she
 }
 
 /* Pairs the n sides of one edge (a run of equal keys), each with the opposite side of
- * its own shell (see side_pass where a shell meets itself); the pairs are separators if
- * `separator`. */
+ * its own shell (see side_pass); the pairs are separators if `separator`. */
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
     bool shells = leaf_has_shells(w);
-    side_pass pass = n > 2 && w->cl->tree->leaf_mates[w->leaf].count > 0 ? SAME_FACE : ANY_FACE;
+    side_pass pass = n > 2 ? SAME_FACE : ANY_FACE;
     for (; pass <= ANY_FACE; pass++)
         for (size_t a = 0; a < n; a++) {
             uint32_t k = run[a].ref;

@@ -43,6 +43,7 @@
  *     touching parts          mci_split_touching          manifold_split.c   -
  *     void shells             mci_drop_void_shells        void_shells.c      -
  *     guarantees checked      mci_check_output            output_check.c     -
+ *   rounding broke them       mci_reevaluate_rounded      reevaluate.c       -
  *
  * Glossary.
  *   leaf        a mesh of the CSG tree (mcsg_tree), as the user gave it.
@@ -76,6 +77,7 @@
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
 #include "csg/output_check.h"
+#include "csg/reevaluate.h"
 #include "csg/rounding_repair.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
@@ -97,6 +99,8 @@ typedef struct eval_state {
     uint32_t *face_group; /* per global face (see mci_octree_params), NULL when no
                              primitive has several shells */
     uint32_t *face_shell; /* the same, NULL unless a shell crosses itself */
+    double *touching;     /* where the exact result touches itself (output_check.h) */
+    size_t touching_count;
 } eval_state;
 
 static void count_faces(const mci_ptree *t, mcsg_eval_stats *st)
@@ -468,11 +472,11 @@ static mcsg_status drop_void_shells(eval_state *e, mcsg_mesh *out, uint32_t *kep
 static mcsg_status check_output(eval_state *e, const mcsg_mesh *out, const rounded *r,
                                 mcsg_error *err)
 {
-    mci_exact_result exact = {e->kept.tris, e->kept.count, r->dense, r->xyz};
-    mcsg_status st = mci_check_output(&e->ctx, out, &exact, &e->stats.output_check, err);
-    if (st == MCSG_OK)
-        mci_log_output_check(&e->ctx, &e->stats.output_check);
-    return st;
+    mci_exact_result exact = {e->kept.tris, e->kept.count, r->dense, r->xyz, NULL, 0};
+    if (!mci_list_touching_edges(&e->ctx, &exact, &e->touching, &e->touching_count))
+        return mci_fail_nomem(err, "checking the result");
+    exact = (mci_exact_result){NULL, 0, NULL, NULL, e->touching, e->touching_count};
+    return mci_check_output(&e->ctx, out, &exact, &e->stats.output_check, err);
 }
 
 static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size_t n,
@@ -819,6 +823,66 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     return st;
 }
 
+/* run, then everything it built freed (e->stats stays). */
+static mcsg_status evaluate(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
+                            mcsg_provenance **provenance, mcsg_error *err)
+{
+    mcsg_status st = run(e, tree, out, provenance, err);
+    mci_classifier_free(&e->ctx, &e->cl);
+    mci_kept_free(&e->ctx, &e->kept);
+    free_trimmed(e);
+    mci_scene_free(&e->ctx, &e->scene);
+    mci_ptree_free(&e->ctx, &e->tree);
+    mci_free(&e->ctx, e->alias);
+    mci_free(&e->ctx, e->face_group);
+    mci_free(&e->ctx, e->face_shell);
+    return st;
+}
+
+mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_mesh *out,
+                                mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                                mcsg_error *err)
+{
+    eval_state e;
+    double t0 = mci_seconds_now();
+    mcsg_status st;
+    memset(&e, 0, sizeof e);
+    e.ctx = *ctx;
+    if (provenance)
+        *provenance = NULL;
+    st = evaluate(&e, tree, out, provenance, err);
+    mci_free(&e.ctx, e.touching);
+    e.stats.seconds_total = mci_seconds_now() - t0;
+    if (stats)
+        *stats = e.stats;
+    return st;
+}
+
+/* Where rounding broke a guarantee, the rounded result evaluated again (reevaluate.h);
+ * then what still fails is logged. */
+static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenance **provenance,
+                                   mcsg_error *err)
+{
+    double t0 = mci_seconds_now();
+    mcsg_status st = MCSG_OK;
+    if (!mcsg_output_check_failed(&e->stats.output_check))
+        return MCSG_OK;
+    st = mci_progress(&e->ctx, "evaluate rounded result again", 0, err);
+    if (st == MCSG_OK)
+        st = mci_reevaluate_rounded(&e->ctx, e->touching, e->touching_count, out, provenance,
+                                    &e->stats, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "evaluate rounded result again", 1, err);
+    if (st == MCSG_OK && e->stats.rounding_reevaluation_kept)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "rounding to doubles broke the result's guarantees; "
+                "the rounded result was evaluated again by its winding number (%zu rounds), "
+                "which keeps them", e->stats.rounding_reevaluations);
+    if (st == MCSG_OK)
+        mci_log_output_check(&e->ctx, &e->stats.output_check);
+    e->stats.seconds_assemble += mci_seconds_now() - t0;
+    return st;
+}
+
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
                       mcsg_provenance **provenance, mcsg_eval_stats *stats, mcsg_error *err)
 {
@@ -840,16 +904,18 @@ mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh
      * (exact/exact_cache.c) is allocated once per evaluation, not per loop, and the
      * points a step leaves in it may serve the next */
     scratch_entered = mci_scratch_enter(&scratch, &e.ctx.alloc);
-    st = run(&e, tree, out, provenance, err);
+    st = evaluate(&e, tree, out, provenance, err);
+    if (st == MCSG_OK)
+        st = settle_rounding(&e, out, provenance, err);
+    if (st != MCSG_OK) {
+        mci_mesh_free(&e.ctx, out);
+        if (provenance) {
+            mci_free(&e.ctx, *provenance);
+            *provenance = NULL;
+        }
+    }
+    mci_free(&e.ctx, e.touching);
     mci_scratch_leave(&scratch, scratch_entered);
-    mci_classifier_free(&e.ctx, &e.cl);
-    mci_kept_free(&e.ctx, &e.kept);
-    free_trimmed(&e);
-    mci_scene_free(&e.ctx, &e.scene);
-    mci_ptree_free(&e.ctx, &e.tree);
-    mci_free(&e.ctx, e.alias);
-    mci_free(&e.ctx, e.face_group);
-    mci_free(&e.ctx, e.face_shell);
     mci_pool_stop(&e.ctx);
     e.stats.seconds_total = mci_seconds_now() - t0;
     if (stats)

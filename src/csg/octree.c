@@ -860,19 +860,37 @@ static bool first_shared_cell(const uint32_t *a, const uint32_t *b, uint32_t cel
 }
 
 /* Faces of one shell that crosses itself (a group each) sharing an edge: they meet only
- * along it, unless folded onto each other (outside the input contract). */
+ * along it, unless folded onto each other (their third corners in one half-plane about
+ * the edge, as where rounding flattened a sliver): then they overlap and are tested. */
 static bool shell_neighbours(const mci_octree *t, uint32_t f, uint32_t g)
 {
+    const double *shared[3] = {NULL, NULL, NULL}, *third_f = NULL, *third_g = NULL;
     int common = 0;
     if (!t->face_shell || t->face_shell[f] != t->face_shell[g] ||
         t->face_leaf[f] != t->face_leaf[g])
         return false;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            const double *p = mci_octree_face_vertex(t, f, i), *q = mci_octree_face_vertex(t, g, j);
-            common += p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+    for (int i = 0; i < 3; i++) {
+        const double *p = mci_octree_face_vertex(t, f, i);
+        bool found = false;
+        for (int j = 0; j < 3 && !found; j++) {
+            const double *q = mci_octree_face_vertex(t, g, j);
+            found = p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
         }
-    return common >= 2;
+        if (found)
+            shared[common++] = p;
+        else
+            third_f = p;
+    }
+    if (common != 2)
+        return false;
+    for (int j = 0; j < 3 && !third_g; j++) {
+        const double *q = mci_octree_face_vertex(t, g, j);
+        if (!(q[0] == shared[0][0] && q[1] == shared[0][1] && q[2] == shared[0][2]) &&
+            !(q[0] == shared[1][0] && q[1] == shared[1][1] && q[2] == shared[1][2]))
+            third_g = q;
+    }
+    return third_f && third_g &&
+           mci_half_plane_class(shared[0], shared[1], third_f, third_g) != 0;
 }
 
 /* A cell lists its faces in increasing id order, so each leaf's faces form one run: a

@@ -111,6 +111,13 @@ static edge_ends *exact_touching_edges(const mci_ctx *ctx, const mci_exact_resul
     edge_ends *out;
     uint64_t *keys;
     uint64_t ids = 0;
+    if (!x->tris) { /* listed before */
+        out = mci_malloc_array(ctx, x->touching_count + 1, sizeof *out);
+        if (out && x->touching_count > 0)
+            memcpy(out, x->touching, x->touching_count * sizeof *out);
+        *n = x->touching_count;
+        return out;
+    }
     for (size_t i = 0; i < 3 * x->count; i++)
         ids = x->tris[i] >= ids ? (uint64_t)x->tris[i] + 1 : ids;
     if (ids > MAX_PACKED_ID) { /* none known: every overfull edge fails */
@@ -131,6 +138,14 @@ static edge_ends *exact_touching_edges(const mci_ctx *ctx, const mci_exact_resul
     }
     mci_free(ctx, keys);
     return out;
+}
+
+bool mci_list_touching_edges(const mci_ctx *ctx, const mci_exact_result *exact, double **ends,
+                             size_t *n)
+{
+    edge_ends *list = exact_touching_edges(ctx, exact, n);
+    *ends = list ? list->p : NULL;
+    return list != NULL;
 }
 
 /* The welded overfull edges (keys of welded ids) split into those
@@ -224,16 +239,22 @@ static size_t degenerate_triangles(const mcsg_mesh *m)
     return count;
 }
 
-static mcsg_status check_crossings(const mci_ctx *ctx, const mcsg_mesh *m,
-                                   mcsg_output_check *check, mcsg_error *err)
+mcsg_status mci_count_crossings(const mci_ctx *ctx, const mcsg_mesh *m, size_t *pairs,
+                                mcsg_error *err)
 {
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
     opts.allocator = ctx->alloc;
     opts.threads = ctx->threads;
     opts.pool = ctx->pool;
+    return mcsg_mesh_self_intersections(m, &opts, pairs, NULL, err);
+}
+
+static mcsg_status check_crossings(const mci_ctx *ctx, const mcsg_mesh *m,
+                                   mcsg_output_check *check, mcsg_error *err)
+{
     check->crossings_checked = 1;
-    return mcsg_mesh_self_intersections(m, &opts, &check->crossing_pairs, NULL, err);
+    return mci_count_crossings(ctx, m, &check->crossing_pairs, err);
 }
 
 mcsg_status mci_check_output(const mci_ctx *ctx, const mcsg_mesh *m,

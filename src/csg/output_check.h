@@ -18,13 +18,28 @@ typedef struct mci_exact_result {
     size_t count;
     const uint32_t *dense;
     const double *xyz;
+    /* Or, when tris is NULL: those edges already listed by mci_list_touching_edges (the
+     * exact result of an earlier evaluation, to judge a mesh derived from it). */
+    const double *touching;
+    size_t touching_count;
 } mci_exact_result;
+
+/* The edges where the exact result touches itself (more than two triangles by exact
+ * identity), as their rounded ends (6 doubles each, sorted): *ends allocated with ctx,
+ * *n of them. False when out of memory. */
+bool mci_list_touching_edges(const mci_ctx *ctx, const mci_exact_result *exact, double **ends,
+                             size_t *n);
 
 /* Fills *check for mesh m (see mcsg_output_check); crossings only when
  * ctx->check_output_crossings. Fails only when out of memory. */
 mcsg_status mci_check_output(const mci_ctx *ctx, const mcsg_mesh *m,
                              const mci_exact_result *exact, mcsg_output_check *check,
                              mcsg_error *err);
+
+/* The pairs of m's triangles that cross (mcsg_mesh_self_intersections on ctx's
+ * allocator, threads and pool). */
+mcsg_status mci_count_crossings(const mci_ctx *ctx, const mcsg_mesh *m, size_t *pairs,
+                                mcsg_error *err);
 
 /* One warning line naming what the check found broken, if anything. */
 void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *check);

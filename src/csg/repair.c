@@ -5,11 +5,10 @@
  * orientation.
  */
 #include "base/core.h"
+#include "csg/reevaluate.h"
 #include "mesh/validate.h"
 
 #include <string.h>
-
-static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
 /* The result's shells, and how many of them face inward (negative exact volume). */
 static mcsg_status count_shells(const mci_ctx *ctx, const mcsg_mesh *out, mcsg_repair_stats *st,
@@ -40,7 +39,6 @@ mcsg_status mcsg_mesh_repair(const mcsg_mesh *mesh, const mcsg_options *opts, mc
     mci_ctx ctx;
     mcsg_options checked;
     mcsg_tree *tree = NULL;
-    mcsg_node_id leaf, root;
     mcsg_check_report report;
     mcsg_repair_stats st;
     mcsg_status s;
@@ -59,13 +57,7 @@ mcsg_status mcsg_mesh_repair(const mcsg_mesh *mesh, const mcsg_options *opts, mc
     s = mcsg_mesh_check(mesh, opts, &report, err);
     st.shells_in = s == MCSG_OK ? report.components : 0;
     if (s == MCSG_OK)
-        s = mcsg_tree_create(opts, &tree, err);
-    if (s == MCSG_OK)
-        s = mcsg_tree_add_leaf(tree, mesh, identity, "the mesh", &leaf, err);
-    if (s == MCSG_OK)
-        s = mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, &root, err);
-    if (s == MCSG_OK)
-        s = mcsg_tree_set_root(tree, root, err);
+        s = mci_tree_of_one_mesh(opts, mesh, "the mesh", &tree, err);
     if (s == MCSG_OK)
         s = mcsg_eval(tree, &checked, out, NULL, &st.eval, err);
     st.crossing_pairs = st.eval.intersect.intersecting_pairs + st.eval.intersect.coplanar_pairs;
