@@ -8,9 +8,9 @@
  * closed as a chain, so it is a valid leaf: evaluated alone by its winding number (its
  * shells tested for crossings and cut where they cross, coincident faces of opposite
  * orientation cancelled, edges of four triangles paired by angle), its exact result has
- * none of those defects, and only the new intersection vertices are rounded again. Each
- * round's mesh is nearer the last one's, so few rounds settle; the result is kept only
- * when its own check passes, and otherwise the first result stays (with its report).
+ * none of those defects, and only the new intersection vertices are rounded again. Those
+ * can break a guarantee in turn, so a round is kept only when its own check passes, up to
+ * three rounds are tried, and otherwise the first result stays (with its report).
  */
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
@@ -93,8 +93,9 @@ static void round_state_free(const mci_ctx *ctx, round_state *r)
     memset(r, 0, sizeof *r);
 }
 
-/* One round from `from` (mesh and sources): *to, and whether its check passed. A round
- * that fails for any reason but memory leaves *to empty and returns MCSG_OK. */
+/* One round from `from` (mesh and sources): *to, with its sources mapped back to the
+ * tree's leaves. A round that fails for any reason but memory (a region whose winding
+ * number no ray decides, a leaf refused) is logged and leaves *to empty. */
 static mcsg_status one_round(const mci_ctx *ctx, const mcsg_mesh *from,
                              const mcsg_provenance *from_source, bool want_source,
                              round_state *to, mcsg_eval_stats *st, mcsg_error *err)
