@@ -272,14 +272,14 @@ typedef struct mcsg_check_report {
      * boundary and inconsistent edges above never are. */
     size_t unbalanced_edges;      /* more than two triangles, unequal directions */
     uint32_t example_unbalanced_edge[2];
-    /* Shells (what `components` counts): triangles joined across edges. At an edge of
-     * more than two triangles, each is joined with the one it bounds a wedge of solid
-     * with, by angle about the edge, where directions alternate around it (triangles in
-     * one half-plane, such as a face listed twice, taken in an order that makes them
-     * alternate); where they cannot, the k-th use in one direction is joined with the
-     * k-th in the other (in triangle order). An edge where they cannot and one shell has
-     * more than two triangles (surfaces crossing at the edge) is counted here: mcsg_eval
-     * does not take such a primitive. */
+    /* Shells (what `components` counts): triangles joined across edges, where at an edge
+     * of more than two triangles the k-th use in one direction is joined with the k-th
+     * in the other (in triangle order). Where one shell then has more than two
+     * triangles at an edge (it meets itself there), they are paired by angle about the
+     * edge, each with the one it bounds a wedge of solid with (triangles in one
+     * half-plane, such as a sliver folded flat, taken in an order that makes directions
+     * alternate). An edge where directions cannot alternate (surfaces of one shell
+     * crossing at the edge) is counted here: mcsg_eval does not take such a primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;

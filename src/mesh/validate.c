@@ -397,20 +397,13 @@ static bool pair_by_angle(const check_state *s, const edge_use *group, size_t n,
 }
 
 /* Joins the triangles of one edge into shells: both of a manifold edge; at a balanced
- * edge of more than two, the pairs by angle (pair_by_angle), else (coincident faces,
- * surfaces crossing at the edge) the k-th use each way (any pairing closes every shell
- * up as a chain; this one keeps a file's parts, listed one after another, apart); all of
- * an unbalanced one. */
+ * edge of more than two, the k-th use each way (any pairing closes every shell up as a
+ * chain; this one keeps a file's parts, listed one after another, apart); all of an
+ * unbalanced one. */
 static void join_shells(check_state *s, const edge_use *group, size_t n, size_t forward)
 {
-    uint8_t mate[ANGLE_PAIRING_MAX];
     if (n == 2) { /* nearly every edge */
         unite(s->parent, group[0].tri, group[1].tri);
-        return;
-    }
-    if (pair_by_angle(s, group, n, mate)) {
-        for (size_t i = 0; i < n; i++)
-            unite(s->parent, group[i].tri, group[mate[i]].tri);
         return;
     }
     for (size_t i = 1; i < n && 2 * forward != n; i++)
@@ -453,22 +446,47 @@ static bool add_mates(check_state *s, const edge_use *group, size_t n, const uin
     return true;
 }
 
-/* After the shells are joined: a balanced edge of more than two triangles where one
- * shell has two uses. Where pair_by_angle pairs the edge, the shell's pairs there are
- * listed (s->mates); elsewhere such an edge is counted as not supported. */
+/* The uses of the edge in the shell of group[i] (more than two: it meets itself). */
+static size_t uses_in_shell(const check_state *s, const edge_use *group, size_t n, size_t i,
+                            edge_use *out)
+{
+    uint32_t root = mci_find_root(s->parent, group[i].tri);
+    size_t m = 0;
+    for (size_t j = 0; j < n && m < ANGLE_PAIRING_MAX; j++)
+        if (mci_find_root(s->parent, group[j].tri) == root)
+            out[m++] = group[j];
+    return m;
+}
+
+/* After the shells are joined: a balanced edge of more than two triangles where a shell
+ * has more than two uses. That shell's uses are paired by angle (pair_by_angle, the
+ * other shells' left out) and listed in s->mates; where they cannot be, the edge is
+ * counted as not supported. */
 static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
 {
+    edge_use mine[ANGLE_PAIRING_MAX];
     uint8_t mate[ANGLE_PAIRING_MAX];
-    for (size_t i = 0; n > 2 && i < n; i++)
-        for (size_t j = i + 1; j < n; j++)
-            if (mci_find_root(s->parent, group[i].tri) == mci_find_root(s->parent, group[j].tri) &&
-                group[i].forward == group[j].forward) {
-                if (pair_by_angle(s, group, n, mate))
-                    return !s->mates || add_mates(s, group, n, mate);
-                note_edge(s->report->example_self_touching_edge,
-                          &s->report->self_touching_edges, group[0].key);
-                return true;
-            }
+    bool done[ANGLE_PAIRING_MAX] = {false};
+    if (n <= 2)
+        return true;
+    for (size_t i = 0; i < n; i++) {
+        size_t m;
+        if (i < ANGLE_PAIRING_MAX && done[i])
+            continue;
+        m = uses_in_shell(s, group, n, i, mine);
+        for (size_t j = i; j < n && j < ANGLE_PAIRING_MAX; j++)
+            done[j] |= mci_find_root(s->parent, group[j].tri) ==
+                       mci_find_root(s->parent, group[i].tri);
+        if (m <= 2)
+            continue;
+        if (n > ANGLE_PAIRING_MAX || !pair_by_angle(s, mine, m, mate)) {
+            note_edge(s->report->example_self_touching_edge, &s->report->self_touching_edges,
+                      group[0].key);
+            return true;
+        }
+        if (s->mates && !add_mates(s, mine, m, mate))
+            return false;
+    }
     return true;
 }
 

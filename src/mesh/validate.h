@@ -46,10 +46,9 @@ bool mci_edge_mates_has(const mci_edge_mates *mates, uint32_t t, uint32_t u);
  * several components, each triangle's component over shared edges, numbered
  * 0 .. report->components - 1 in the order of their first triangles (valid triangles
  * only; others get UINT32_MAX). With one component `shell` is left as it is. At edges
- * of more than two triangles the shells are joined by angle where the triangles' angles
- * about the edge alternate in direction, else the k-th use each way. `mates` (optional)
- * receives the angle pairs where a shell meets itself (allocated with ctx: free with
- * mci_edge_mates_free; empty on error). */
+ * of more than two triangles the shells are joined by the k-th use each way. `mates`
+ * (optional) receives the angle pairs where a shell meets itself (allocated with ctx:
+ * free with mci_edge_mates_free; empty on error). */
 mcsg_status mci_mesh_check_shells(const mci_ctx *ctx, const mcsg_mesh *mesh,
                                   mcsg_check_report *report, uint32_t *shell,
                                   mci_edge_mates *mates, mcsg_error *err);
