@@ -97,7 +97,8 @@ typedef void (*mcsg_log_fn)(void *user, mcsg_log_level level, const char *messag
  * one step). The steps, in order:
  *   mcsg_eval:      "check" (the input contract), "intersect" (octree, pair tests,
  *                   per-face arrangements, point numbering), "triangulate", "classify",
- *                   "assemble" (rounding and the output mesh)
+ *                   "assemble" (rounding and the output mesh), and only when rounding
+ *                   broke a guarantee "evaluate rounded result again" (mcsg_eval)
  *   mcsg_intersect: "intersect"
  * `step` is a static string. */
 typedef int (*mcsg_progress_fn)(void *user, const char *step, int done);
