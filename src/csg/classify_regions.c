@@ -311,9 +311,10 @@ static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool she
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
     bool shells = leaf_has_shells(w);
+    bool mates = w->cl->tree->leaf_mates[w->leaf].count > 0;
     side_pass pass = n > 2 ? SAME_FACE : ANY_FACE;
     for (; pass <= ANY_FACE; pass++)
-        for (size_t a = 0; a < n; a++) {
+        for (size_t a = 0; a < n && (pass != ANGLE_MATES || mates); a++) {
             uint32_t k = run[a].ref;
             size_t b = a + 1;
             if (w->mate[k] != MCI_NONE)
