@@ -259,7 +259,7 @@ static void run_case(face_case *f)
     mci_cdt_output out;
     uint32_t *insert = malloc(f->count * sizeof *insert);
     mci_cdt_input in = {point_refs(f), f->count, f->axis, f->sign, insert, f->count - 3,
-                        f->edges, f->edge_count, NULL, NULL};
+                        f->edges, f->edge_count, NULL, NULL, NULL, NULL};
     mci_ctx_init(&ctx, NULL);
     for (size_t i = 3; i < f->count; i++)
         insert[i - 3] = (uint32_t)i;
@@ -333,7 +333,7 @@ TEST(contract_violations_are_reported)
     mci_cdt_input in;
     lattice_face(&f, 3);
     mci_ctx_init(&ctx, NULL);
-    in = (mci_cdt_input){point_refs(&f), f.count, f.axis, f.sign, insert, 2, NULL, 0, NULL, NULL};
+    in = (mci_cdt_input){point_refs(&f), f.count, f.axis, f.sign, insert, 2, NULL, 0, NULL, NULL, NULL, NULL};
     CHECK(mci_triangulate(&ctx, &in, &out, &err) == MCSG_ERR_INTERNAL);
     CHECK(out.tris == NULL && out.adj == NULL);
 }
@@ -346,7 +346,7 @@ TEST(allocation_failures)
     {
         uint32_t insert[MAX_POINTS];
         mci_cdt_input in = {point_refs(&f), f.count, f.axis, f.sign, insert, f.count - 3,
-                            f.edges, f.edge_count, NULL, NULL};
+                            f.edges, f.edge_count, NULL, NULL, NULL, NULL};
         for (size_t i = 3; i < f.count; i++)
             insert[i - 3] = (uint32_t)i;
         for (int fail_at = 1; fail_at < 64; fail_at++) {

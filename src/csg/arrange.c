@@ -1140,7 +1140,7 @@ mcsg_status mci_arr_triangulate(const mci_ctx *ctx, mci_face_arr *arr, const boo
         st = mci_fail_nomem(err, "triangulating a face");
     } else if (st == MCSG_OK) {
         mci_cdt_input in = {arr->points, arr->point_count, arr->axis, arr->sign, insert, 0,
-                            pairs, 0, known_collinear, arr};
+                            pairs, 0, known_collinear, arr, arr->gid, arr->values};
         mci_cdt_output out;
         in.insert_count = chosen_points(arr, use, mark, insert);
         in.edge_count = chosen_edges(arr, use, pairs);

@@ -75,6 +75,10 @@ typedef struct mci_face_arr {
                             when no coplanar face is expected (mci_arr_init) */
     uint32_t *tris;      /* after mci_arr_triangulate: 3 point ids per triangle */
     uint32_t *adj;       /* ... and the side across each side (mci_cdt_output.adj) */
+    /* Once the scene's points are numbered: each point's number and the scene's table
+     * of point values, which triangulation shares (NULL before, and outside scenes). */
+    const uint32_t *gid;
+    struct mci_point_values *values;
     uint32_t face;       /* global face id */
     int axis, sign;      /* projection (mci_plane_projection_axis) */
     /* Counts in 32 bits (point ids are 32-bit anyway): one header per touched face

@@ -100,6 +100,7 @@ void mci_scene_free_geometry(const mci_ctx *ctx, mci_scene *scene)
     mci_free(ctx, scene->gid_start);
     mci_free(ctx, scene->gid);
     mci_free(ctx, scene->explicit_slot);
+    mci_point_values_free(&scene->values);
     mci_free(ctx, scene->touch_start);
     mci_free(ctx, scene->touch_leaf);
     mci_free(ctx, scene->arr_dropped);

@@ -9,6 +9,7 @@
 
 #include "csg/arrange.h"
 #include "csg/octree.h"
+#include "csg/point_values.h"
 
 typedef struct mci_scene {
     mci_octree octree;        /* faces have global ids; octree.face_leaf / face_base */
@@ -29,6 +30,9 @@ typedef struct mci_scene {
     /* Global identity (mci_scene_number_points): gid[gid_start[k] + i] numbers point
      * i of arrs[k]; equal points have equal numbers, across all faces. */
     uint32_t *gid_start, *gid;
+    /* Double-word values of the numbered points, as predicates need them (each
+     * arrangement's `gid` and `values` point here once the points are numbered). */
+    mci_point_values values;
     uint8_t *explicit_slot; /* per gid slot: 1 when the point is an input vertex (kept so
                                that later passes need not read every point again) */
     size_t point_count;

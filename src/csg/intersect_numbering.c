@@ -372,6 +372,12 @@ mcsg_status mci_scene_number_points(const mci_ctx *ctx, mci_scene *s, mcsg_error
     s->point_count = st == MCSG_OK ? id : 0;
     mci_free(ctx, nb.table);
     mci_free(ctx, nb.parent);
+    if (st == MCSG_OK)
+        st = mci_point_values_init(ctx, &s->values, s->point_count, err);
+    for (size_t k = 0; st == MCSG_OK && k < s->arr_count; k++) {
+        s->arrs[k].gid = s->gid + s->gid_start[k];
+        s->arrs[k].values = &s->values;
+    }
     s->stats.seconds_merge = mci_seconds_now() - t0;
     return st;
 }

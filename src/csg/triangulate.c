@@ -27,6 +27,7 @@
  */
 #include "csg/triangulate.h"
 #include "base/sort.h"
+#include "csg/point_values.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -59,6 +60,7 @@ typedef struct cdt {
     bool block_on_heap, queue_on_heap;
 } cdt;
 
+
 /* Most faces have a handful of points: their scratch lives on mci_triangulate's stack
  * (4 KiB and 1.5 KiB), which saves two allocations and frees per face. */
 enum { STACK_BLOCK_WORDS = 512, STACK_QUEUE_EDGES = 128 };
@@ -73,17 +75,65 @@ static int prev3(int i)
     return i == 0 ? 2 : i - 1;
 }
 
+/* orient2d on the points' double-word values from the caller's table (see
+ * csg/point_values.h), MCI_UNCERTAIN without a table or where they do not decide;
+ * values not yet in the table are computed only when `compute`. */
+static int orient_dd(const cdt *c, uint32_t a, uint32_t b, uint32_t p, bool compute)
+{
+    const mci_cdt_input *in = c->in;
+    const uint32_t id[3] = {in->ids[a], in->ids[b], in->ids[p]};
+    const mci_point *pt[3] = {in->points[a], in->points[b], in->points[p]};
+    double scratch[3][3][3];
+    const double *v[3];
+    for (int k = 0; k < 3; k++) {
+        v[k] = compute ? mci_point_values_get(in->values, id[k], pt[k], scratch[k])
+                       : mci_point_values_known(in->values, id[k]);
+        if (!v[k])
+            return MCI_UNCERTAIN;
+    }
+    return mci_orient2d_dd_values(v[0], v[1], v[2], in->axis);
+}
+
+/* Whether values are worth computing for an orientation of a, b and p that the cheap
+ * stages left open: as for the thread's table of exact points (FILL_NEAR_TROUBLE in
+ * exact/kernel.c), only near crowds of nearly coincident points, where one of them is
+ * ill-conditioned or has its values already. Elsewhere the double-double stage on the
+ * points' definitions decides at a fraction of the cost of computing three points. */
+static bool near_trouble(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
+{
+    const mci_cdt_input *in = c->in;
+    const uint32_t v[3] = {a, b, p};
+    for (int k = 0; k < 3; k++)
+        if (in->points[v[k]]->ill_conditioned ||
+            mci_point_values_known(in->values, in->ids[v[k]]))
+            return true;
+    return false;
+}
+
 /* The quick filter first: it decides most calls, and never where the points are known
- * to be collinear (it does not return 0). */
+ * to be collinear (it does not return 0). With a table of point values, values known
+ * already decide next (crowds of nearly coincident points meet the same orientations
+ * again and again, where the double filter fails), then the stages that compute no
+ * exact point, then the values computed near trouble. */
 static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
-    const mci_point *const *pts = c->in->points;
+    const mci_cdt_input *in = c->in;
+    const mci_point *const *pts = in->points;
     int s = mci_orient2d_boxes(c->box[a], c->box[b], c->box[p]);
     if (s != MCI_UNCERTAIN)
-        return c->in->sign * s;
-    if (c->in->known_collinear && c->in->known_collinear(c->in->user, a, b, p))
+        return in->sign * s;
+    if (in->known_collinear && in->known_collinear(in->user, a, b, p))
         return 0;
-    return c->in->sign * mci_orient2d_projected_rest(pts[a], pts[b], pts[p], c->in->axis);
+    if (in->values) {
+        s = orient_dd(c, a, b, p, false);
+        if (s == MCI_UNCERTAIN)
+            s = mci_orient2d_projected_cheap(pts[a], pts[b], pts[p], in->axis);
+        if (s == MCI_UNCERTAIN && near_trouble(c, a, b, p))
+            s = orient_dd(c, a, b, p, true);
+        if (s != MCI_UNCERTAIN)
+            return in->sign * s;
+    }
+    return in->sign * mci_orient2d_projected_rest(pts[a], pts[b], pts[p], in->axis);
 }
 
 static int vertex_index(const tri *t, uint32_t v)

@@ -30,6 +30,10 @@ typedef struct mci_cdt_input {
      * a predicate, whose exact stage is slow on the exact zeros they produce. */
     bool (*known_collinear)(const void *user, uint32_t a, uint32_t b, uint32_t c);
     const void *user;
+    /* Optional (NULL: none): the points' numbers in a table of point values, which
+     * decides orientations the boxes leave open before the general predicate. */
+    const uint32_t *ids;
+    struct mci_point_values *values;
 } mci_cdt_input;
 
 /* The triangles (point ids, counter-clockwise in the face's orientation) tile the face

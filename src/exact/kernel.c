@@ -1087,10 +1087,15 @@ static bool fill_entry(mci_exact_point *e, const mci_point *p)
 
 bool mci_point_dd_values(const mci_point *p, double approx[3][3])
 {
-    mci_exact_point e;
-    if (!compute_entry(&e, p) || !e.has_approx)
+    bool held = false;
+    mci_exact_point fresh, *e = mci_exact_cache_find(p, &held);
+    /* Computed into the thread's table, where the exact stage finds the point when
+     * these values leave a predicate undecided. */
+    if (!held && !(e ? fill_entry(e, p) : compute_entry(e = &fresh, p)))
         return false;
-    memcpy(approx, e.approx, sizeof e.approx);
+    if (!e->has_approx)
+        return false;
+    memcpy(approx, e->approx, sizeof e->approx);
     return true;
 }
 
@@ -1364,6 +1369,22 @@ static bool short_base(const mci_point *p)
     return true;
 }
 
+/* Inputs that fit 128-bit integers (short coordinates: CAD grids) skip the double-double
+ * stage: the exact one is cheaper there, and only it decides the exact zeros such inputs
+ * are full of. The scale is worth computing for that only when the points' base
+ * vertices have short coordinates. MCI_UNCERTAIN for other inputs. */
+static int orient2d_short(const mci_point *p, const mci_point *q, const mci_point *r,
+                          int axis)
+{
+    if (short_base(p) && short_base(q) && short_base(r)) {
+        const mci_point *points[3] = {p, q, r};
+        input_scale sc = scale_of(points, 3, NULL, 0);
+        if (fits_i128(sc, x_degree(p) + x_degree(q) + x_degree(r)))
+            return i128_orient2d(points, axis, sc.e0);
+    }
+    return MCI_UNCERTAIN;
+}
+
 /* The stages after the box filter. */
 static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const mci_point *r,
                                  int axis)
@@ -1387,16 +1408,9 @@ static int orient2d_beyond_boxes(const mci_point *p, const mci_point *q, const m
     s = mci_orient2d_projected_filtered(p, q, r, axis);
     if (s != MCI_UNCERTAIN)
         return s;
-    /* Inputs that fit 128-bit integers (short coordinates: CAD grids) skip the
-     * double-double stage: the exact one is cheaper there, and only it decides the exact
-     * zeros such inputs are full of. The scale is worth computing for that only when
-     * the points' base vertices have short coordinates. */
-    if (short_base(p) && short_base(q) && short_base(r)) {
-        const mci_point *points[3] = {p, q, r};
-        input_scale sc = scale_of(points, 3, NULL, 0);
-        if (fits_i128(sc, x_degree(p) + x_degree(q) + x_degree(r)))
-            return i128_orient2d(points, axis, sc.e0);
-    }
+    s = orient2d_short(p, q, r, axis);
+    if (s != MCI_UNCERTAIN)
+        return s;
     /* Points that needed the exact stage before are in the thread's cache, with their
      * coordinates to 106 bits: that decides before the double-double stage on their
      * definitions, which left them undecided once already (nearly collinear points
@@ -1421,6 +1435,19 @@ int mci_orient2d_projected(const mci_point *p, const mci_point *q, const mci_poi
         return 0;
     s = mci_orient2d_projected_quick(p, q, r, axis);
     return s != MCI_UNCERTAIN ? s : orient2d_beyond_boxes(p, q, r, axis);
+}
+
+int mci_orient2d_projected_cheap(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis)
+{
+    int s;
+    if (collinear_by_definition(p, q, r))
+        return 0;
+    if (exact_in_projection(p, axis) && exact_in_projection(q, axis) &&
+        exact_in_projection(r, axis))
+        return orient2d_exact_centres(p, q, r, axis);
+    s = mci_orient2d_projected_filtered(p, q, r, axis);
+    return s != MCI_UNCERTAIN ? s : orient2d_short(p, q, r, axis);
 }
 
 /* After mci_orient2d_projected_quick: its box filter never returns 0 (the error bound is

@@ -253,6 +253,12 @@ static inline int mci_orient2d_projected_quick(const mci_point *p, const mci_poi
 }
 int mci_orient2d_projected_rest(const mci_point *p, const mci_point *q, const mci_point *r,
                                 int axis);
+/* The stages of mci_orient2d_projected_rest that compute no exact point (definitional
+ * zeros, exact centres, the double filter, 128-bit integers for short coordinates):
+ * the sign, or MCI_UNCERTAIN. Callers that keep points' double-word values try this
+ * before computing those. */
+int mci_orient2d_projected_cheap(const mci_point *p, const mci_point *q, const mci_point *r,
+                                 int axis);
 
 /* Order of two points lying on the line of intersection of two planes, along the
  * direction n1 x n2 (paper Eq. 1): sign((a - b) . (n1 x n2)). +1: a is ahead of b. The
