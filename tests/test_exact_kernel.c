@@ -604,6 +604,21 @@ static void check_orient2d_boxes(const scenario *s, const query *q, int ref)
     box_filter_decided += got != MCI_UNCERTAIN;
 }
 
+/* The stages that compute no implicit point (mci_orient2d_projected_cheap): a sign
+ * they give, 0 included, must be the reference's. */
+static long cheap_cases, cheap_decided;
+
+static void check_orient2d_cheap(const scenario *s, const query *q, int ref)
+{
+    const mci_point *a = &ws.kpt[q->pt[0]], *b = &ws.kpt[q->pt[1]], *c = &ws.kpt[q->pt[2]];
+    int got = mci_orient2d_projected_cheap(a, b, c, q->axis);
+    CHECK_MSG(got == MCI_UNCERTAIN || got == ref,
+              "mci_orient2d_projected_cheap (%s): %d, reference %d", class_names[s->cls], got,
+              ref);
+    cheap_cases++;
+    cheap_decided += got != MCI_UNCERTAIN;
+}
+
 static void check_orient2d_dd(const scenario *s, const query *q, int filtered, int ref)
 {
     const mci_point *a = &ws.kpt[q->pt[0]], *b = &ws.kpt[q->pt[1]], *c = &ws.kpt[q->pt[2]];
@@ -666,6 +681,7 @@ static void run_query(const scenario *s, const query *q)
     check_case(s, q, got, ref);
     if (q->pred == PR_ORIENT2D) {
         check_orient2d_boxes(s, q, ref);
+        check_orient2d_cheap(s, q, ref);
         check_orient2d_dd(s, q, got[2], ref);
     }
     if (q->pred == PR_ORIENT3D)
@@ -1003,6 +1019,8 @@ static void print_predicate_table(void)
            dd_round_tries);
     printf("orient2d box filter: %ld cases, %ld decided\n", box_filter_cases,
            box_filter_decided);
+    printf("orient2d stages without implicit points: %ld cases, %ld decided\n", cheap_cases,
+           cheap_decided);
     printf("orient2d cases the first filter left: %ld, double-double stage decided %ld\n",
            dd_after_filter, dd_decided);
     printf("orient3d of input vertices: %ld filter cases, %ld decided by the filter\n",
@@ -1199,6 +1217,7 @@ int main(void)
     print_predicate_table();
     /* The box filter's check was not vacuous: it decided some cases and left others. */
     CHECK(box_filter_decided > 0 && box_filter_decided < box_filter_cases);
+    CHECK(cheap_decided > 0 && cheap_decided < cheap_cases);
     printf("points kept by the exact cache: %ld; approximations checked %ld, coordinates "
            "within 2^-100: %ld\n", cached_points_seen, approx_points, approx_tight);
     CHECK(approx_points > 0 && approx_tight > 0);

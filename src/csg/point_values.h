@@ -20,7 +20,7 @@ typedef struct mci_point_values {
     const mci_ctx *ctx;
     size_t count;
     atomic_uchar *state;      /* per point: unknown, being computed, known or none */
-    _Atomic(void *) *blocks;  /* values in blocks of MCI_POINT_VALUE_BLOCK, on demand */
+    _Atomic(void *) *blocks;  /* values in blocks of 512 points, allocated on demand */
 } mci_point_values;
 
 /* A table for points 0..count-1; fails only with MCSG_ERR_NOMEM. */

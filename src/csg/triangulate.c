@@ -60,7 +60,6 @@ typedef struct cdt {
     bool block_on_heap, queue_on_heap;
 } cdt;
 
-
 /* Most faces have a handful of points: their scratch lives on mci_triangulate's stack
  * (4 KiB and 1.5 KiB), which saves two allocations and frees per face. */
 enum { STACK_BLOCK_WORDS = 512, STACK_QUEUE_EDGES = 128 };

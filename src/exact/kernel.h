@@ -365,8 +365,9 @@ unsigned mci_point_round_dd(const mci_point *p, unsigned pending, const double g
 bool mci_dd_from_chunks(const uint32_t *chunk, int n, int exponent, int sign, double out[3]);
 int mci_orient2d_dd_values(const double *p, const double *q, const double *r, int axis);
 int mci_compare_dd_values(const double a[3], const double b[3]);
-/* p's coordinates as such values, from its exact ones (what exact/exact_cache.c keeps);
- * false when they are not kept (a number too large, or scaling out of range). */
+/* p's coordinates as such values, from its exact ones (what exact/exact_cache.c keeps:
+ * taken from the thread's table, or computed into it); false when they are not kept
+ * (a number too large, or scaling out of range). */
 bool mci_point_dd_values(const mci_point *p, double approx[3][3]);
 /* Sign of component `axis` of n1 x n2 (the direction of a plane-plane line). */
 int mci_line_direction_sign_filtered(const mci_plane *p1, const mci_plane *p2, int axis);
