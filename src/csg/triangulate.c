@@ -74,39 +74,41 @@ static int prev3(int i)
     return i == 0 ? 2 : i - 1;
 }
 
-/* orient2d on the points' double-word values from the caller's table (see
- * csg/point_values.h), MCI_UNCERTAIN without a table or where they do not decide;
- * values not yet in the table are computed only when `compute`. */
-static int orient_dd(const cdt *c, uint32_t a, uint32_t b, uint32_t p, bool compute)
+/* orient2d on the values the caller's table (see csg/point_values.h) holds already,
+ * MCI_UNCERTAIN where one is missing or they do not decide. *near_trouble tells whether
+ * values are worth computing should the cheap stages fail too: as for the thread's table
+ * of exact points (FILL_NEAR_TROUBLE in exact/kernel.c), only near crowds of nearly
+ * coincident points, where one of the three is ill-conditioned or has its values
+ * already. Elsewhere the double-double stage on the points' definitions decides at a
+ * fraction of the cost of computing three points. */
+static int orient_known_dd(const cdt *c, uint32_t a, uint32_t b, uint32_t p,
+                           bool *near_trouble)
 {
     const mci_cdt_input *in = c->in;
-    const uint32_t id[3] = {in->ids[a], in->ids[b], in->ids[p]};
-    const mci_point *pt[3] = {in->points[a], in->points[b], in->points[p]};
-    double scratch[3][3][3];
+    const uint32_t at[3] = {a, b, p};
     const double *v[3];
+    bool all = true;
+    *near_trouble = false;
     for (int k = 0; k < 3; k++) {
-        v[k] = compute ? mci_point_values_get(in->values, id[k], pt[k], scratch[k])
-                       : mci_point_values_known(in->values, id[k]);
-        if (!v[k])
-            return MCI_UNCERTAIN;
+        v[k] = mci_point_values_known(in->values, in->ids[at[k]]);
+        all &= v[k] != NULL;
+        *near_trouble |= v[k] != NULL || in->points[at[k]]->ill_conditioned;
     }
-    return mci_orient2d_dd_values(v[0], v[1], v[2], in->axis);
+    return all ? mci_orient2d_dd_values(v[0], v[1], v[2], in->axis) : MCI_UNCERTAIN;
 }
 
-/* Whether values are worth computing for an orientation of a, b and p that the cheap
- * stages left open: as for the thread's table of exact points (FILL_NEAR_TROUBLE in
- * exact/kernel.c), only near crowds of nearly coincident points, where one of them is
- * ill-conditioned or has its values already. Elsewhere the double-double stage on the
- * points' definitions decides at a fraction of the cost of computing three points. */
-static bool near_trouble(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
+/* The same on values computed where the table lacks them. */
+static int orient_computed_dd(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
 {
     const mci_cdt_input *in = c->in;
-    const uint32_t v[3] = {a, b, p};
+    const uint32_t at[3] = {a, b, p};
+    double scratch[3][3][3];
+    const double *v[3];
     for (int k = 0; k < 3; k++)
-        if (in->points[v[k]]->ill_conditioned ||
-            mci_point_values_known(in->values, in->ids[v[k]]))
-            return true;
-    return false;
+        if (!(v[k] = mci_point_values_get(in->values, in->ids[at[k]], in->points[at[k]],
+                                          scratch[k])))
+            return MCI_UNCERTAIN;
+    return mci_orient2d_dd_values(v[0], v[1], v[2], in->axis);
 }
 
 /* The quick filter first: it decides most calls, and never where the points are known
@@ -119,16 +121,17 @@ static int orient(const cdt *c, uint32_t a, uint32_t b, uint32_t p)
     const mci_cdt_input *in = c->in;
     const mci_point *const *pts = in->points;
     int s = mci_orient2d_boxes(c->box[a], c->box[b], c->box[p]);
+    bool near_trouble;
     if (s != MCI_UNCERTAIN)
         return in->sign * s;
     if (in->known_collinear && in->known_collinear(in->user, a, b, p))
         return 0;
     if (in->values) {
-        s = orient_dd(c, a, b, p, false);
+        s = orient_known_dd(c, a, b, p, &near_trouble);
         if (s == MCI_UNCERTAIN)
             s = mci_orient2d_projected_cheap(pts[a], pts[b], pts[p], in->axis);
-        if (s == MCI_UNCERTAIN && near_trouble(c, a, b, p))
-            s = orient_dd(c, a, b, p, true);
+        if (s == MCI_UNCERTAIN && near_trouble)
+            s = orient_computed_dd(c, a, b, p);
         if (s != MCI_UNCERTAIN)
             return in->sign * s;
     }
