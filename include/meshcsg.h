@@ -530,6 +530,9 @@ typedef struct mcsg_eval_stats {
     size_t rounding_split_triangles; /* rounded to three collinear corners and removed by
                                         splitting the neighbour at the middle corner */
     size_t rounding_flat_triangles;  /* rounded flat and left (neighbour flat as well) */
+    size_t rounding_turned_triangles; /* thin triangles that rounding turned over (a
+                                         corner moved across the opposite edge), removed
+                                         by splitting the neighbour at that corner */
     size_t rounding_dropped_shells;  /* closed parts of the result thinner than the
                                         spacing of doubles, which rounding made flat
                                         (volume 0) or inside out where no outer part's

@@ -1150,7 +1150,8 @@ static bool output_check_agrees(const mcsg_mesh *out, const mcsg_eval_stats *sta
 static bool rounding_acted(const mcsg_eval_stats *stats)
 {
     return stats->rounding_joined_vertices > 0 || stats->rounding_dropped_triangles > 0 ||
-           stats->rounding_split_triangles > 0 || stats->rounding_flat_triangles > 0;
+           stats->rounding_split_triangles > 0 || stats->rounding_flat_triangles > 0 ||
+           stats->rounding_turned_triangles > 0;
 }
 
 static bool check_mesh(const mcsg_mesh *out, const mcsg_eval_stats *stats,
@@ -1322,6 +1323,16 @@ static bool check_points(const tree_facts *f, const tree_facts *claim, uint64_t 
 
 bool csg_self_check;
 
+/* Keeps the reason a round of evaluating the rounded result again failed. */
+static void keep_reevaluation_failure(void *user, mcsg_log_level level, const char *message)
+{
+    static const char prefix[] = "evaluating the rounded result again failed: ";
+    csg_result *r = user;
+    (void)level;
+    if (strncmp(message, prefix, sizeof prefix - 1) == 0)
+        snprintf(r->reevaluation, sizeof r->reevaluation, "%s", message + sizeof prefix - 1);
+}
+
 bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed,
                     bool with_provenance, bool allow_touching, bool check_inputs,
                     csg_result *r)
@@ -1356,6 +1367,8 @@ bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed
         mcsg_options opts = {0};
         opts.check_output_crossings = csg_self_check;
         opts.check_self_intersections = check_inputs;
+        opts.log = keep_reevaluation_failure;
+        opts.log_user = r;
         st = mcsg_eval(tree, &opts, &out, with_provenance ? &prov : NULL, &stats, &err);
     }
     if (st != MCSG_OK) {
@@ -1364,6 +1377,7 @@ bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed
         r->triangles = out.triangle_count;
         r->dropped = stats.rounding_dropped_triangles;
         r->eval_seconds = stats.seconds_total;
+        r->check = stats.output_check;
         ok = check_mesh(&out, &stats, allow_touching, &scene, scale, r);
         if (ok && test_signed_volume(&out) < -1e-9 * scale * scale * scale)
             ok = fail(r, "negative output volume %g", test_signed_volume(&out));

@@ -100,6 +100,9 @@ typedef struct csg_result {
     bool rounding_reported;     /* the result's check reported a guarantee broken by
                                    rounding (accepted: what snap rounding will fix), and
                                    agreed with the independent checks */
+    mcsg_output_check check;    /* the result's own check, as returned */
+    char reevaluation[160];     /* why evaluating the rounded result again failed, from
+                                   the log; empty when it did not fail */
 } csg_result;
 
 /* When set, every output is also tested for self-intersections (counted, not failed:

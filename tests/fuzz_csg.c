@@ -42,12 +42,63 @@ static void save_case(const char *dir, csg_tree_spec *t, bool with_provenance)
     printf("  saved %s (%d leaves): %s\n", path, csg_reachable_leaves(t), r.why);
 }
 
+/* What the outputs reported broken by rounding break, and why evaluating them again did
+ * not mend them: the counts that tell where snap rounding stands. */
+typedef struct broken_tally {
+    long welded, crossing, degenerate, open, index_nonmanifold;
+    char reason[12][48];
+    long reason_count[12];
+    int reasons;
+} broken_tally;
+
+/* A reason without its numbers and example coordinates: its kind. */
+static void reason_kind(const char *why, char *kind, size_t size)
+{
+    const char *p = strstr(why, "rounded result: ");
+    size_t n = 0;
+    p = p ? p + strlen("rounded result: ") : why;
+    for (; *p && *p != '(' && *p != ',' && n + 1 < size; p++)
+        if (*p < '0' || *p > '9')
+            kind[n++] = *p;
+    kind[n] = '\0';
+}
+
+static void tally_broken(broken_tally *b, const csg_result *r)
+{
+    char kind[48];
+    int k;
+    b->welded += r->check.welded_nonmanifold_edges > 0;
+    b->crossing += r->check.crossing_pairs > 0;
+    b->degenerate += r->check.degenerate_triangles > 0;
+    b->open += r->check.open_edges + r->check.misoriented_edges > 0;
+    b->index_nonmanifold += r->check.index_nonmanifold_edges > 0;
+    reason_kind(r->reevaluation[0] ? r->reevaluation : "every round failed its check", kind,
+                sizeof kind);
+    for (k = 0; k < b->reasons && strcmp(b->reason[k], kind) != 0; k++)
+        ;
+    if (k == b->reasons && b->reasons == 12)
+        k = 11;
+    else if (k == b->reasons)
+        snprintf(b->reason[b->reasons++], sizeof b->reason[0], "%s", kind);
+    b->reason_count[k]++;
+}
+
+static void print_broken(const broken_tally *b)
+{
+    printf("broken by rounding: %ld non-manifold once welded, %ld crossing, %ld zero-area, "
+           "%ld open or misoriented, %ld not manifold by index; evaluating again failed by:\n",
+           b->welded, b->crossing, b->degenerate, b->open, b->index_nonmanifold);
+    for (int k = 0; k < b->reasons; k++)
+        printf("  %6ld %s\n", b->reason_count[k], b->reason[k]);
+}
+
 int main(int argc, char **argv)
 {
     double seconds = argc > 1 ? atof(argv[1]) : 60, start = csg_now();
     const char *dir = argc > 2 ? argv[2] : MCSG_REGRESSION_DIR;
     uint64_t first = argc > 3 ? strtoull(argv[3], NULL, 0) : (uint64_t)(start * 1e6);
     static csg_tree_spec t;
+    static broken_tally broken;
     if (argc == 3 && strcmp(argv[1], "print") == 0) {
         csg_load_models();
         csg_random_tree(&t, strtoull(argv[2], NULL, 0));
@@ -75,6 +126,8 @@ int main(int argc, char **argv)
         if (csg_run_case(&t, NULL, with_provenance, &r)) {
             self_intersecting[t.family] += r.self_intersecting;
             reported += r.rounding_reported;
+            if (r.rounding_reported)
+                tally_broken(&broken, &r);
             continue;
         }
         failures++;
@@ -90,6 +143,7 @@ int main(int argc, char **argv)
     for (int k = 0; k < CSG_FAMILIES; k++)
         printf("%s%ld %s", k ? ", " : "", self_intersecting[k], csg_family_names[k]);
     printf("; %ld reported broken by rounding\n", reported);
+    print_broken(&broken);
     csg_free_models();
     return failures ? 1 : 0;
 }

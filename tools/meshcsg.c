@@ -31,11 +31,14 @@
 #define EXIT_BROKEN_GUARANTEE CLI_EXIT_BROKEN_GUARANTEE
 #define DEMO_SPHERES 200
 
+/* user: the lowest level printed, or NULL for warnings only. */
 static void log_to_stderr(void *user, mcsg_log_level level, const char *message)
 {
-    (void)user;
+    const mcsg_log_level *lowest = user;
     if (level >= MCSG_LOG_WARNING)
         fprintf(stderr, "meshcsg: warning: %s\n", message);
+    else if (lowest && level >= *lowest)
+        fprintf(stderr, "meshcsg: %s\n", message);
 }
 
 static mcsg_options cli_options(void)
@@ -588,11 +591,12 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  assemble         %8.3f s  (%zu vertices, %zu triangles)\n", s->seconds_assemble,
            s->output_vertices, s->output_triangles);
     if (s->rounding_joined_vertices + s->rounding_dropped_triangles +
-        s->rounding_split_triangles + s->rounding_flat_triangles)
+        s->rounding_split_triangles + s->rounding_flat_triangles + s->rounding_turned_triangles)
         printf("  rounding to doubles: %zu vertices joined, %zu triangles collapsed or folded "
-               "and dropped, %zu flat ones split away, %zu flat left\n",
-               s->rounding_joined_vertices, s->rounding_dropped_triangles,
-               s->rounding_split_triangles, s->rounding_flat_triangles);
+               "and dropped, %zu flat ones split away, %zu flat left, %zu turned over and "
+               "split away\n", s->rounding_joined_vertices, s->rounding_dropped_triangles,
+               s->rounding_split_triangles, s->rounding_flat_triangles,
+               s->rounding_turned_triangles);
     if (s->rounding_dropped_shells)
         printf("  rounding to doubles: %zu flat or inside-out shells removed\n",
                s->rounding_dropped_shells);
@@ -660,6 +664,10 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
     opts.threads = (int)v->threads;
     opts.check_self_intersections = v->check_inputs;
     opts.check_output_crossings = v->check_crossings;
+    if (v->verbose) {
+        static const mcsg_log_level info = MCSG_LOG_INFO;
+        opts.log_user = (void *)&info;
+    }
     /* One set of workers for reading, evaluating and writing: each call would start its
      * own, and a new thread took up to milliseconds to get going. Without the pool (no
      * threads to spare) every call runs as before. */
@@ -863,6 +871,9 @@ static const cli_option eval_options[] = {
      "first test every shell of every leaf for self-intersections, exactly, and evaluate "
      "one that crosses itself by its winding number (about the cost of an evaluation; "
      "off by default)"},
+    {"verbose", 'v', CLI_FLAG, NULL, 0, 0, VALUE(verbose),
+     "also print the library's informational messages (what rounding did, why a step "
+     "was retried)"},
     END_OF_OPTIONS};
 static const cli_option repair_options[] = {
     OUTPUT("write the repaired mesh to FILE, format from its extension (default: none, "

@@ -46,6 +46,9 @@ typedef struct mci_ctx {
     void *progress_user;
     int check_self_intersections;
     int check_output_crossings;
+    /* An evaluation of a rounded result again (csg/reevaluate.c): its rounding repair
+     * looks for opposite twins after every change, which folds there need. */
+    bool reevaluation_round;
     mci_pool *pool; /* worker threads: the options' (borrowed) or the call's own */
     bool owns_pool; /* started by mci_pool_start, stopped by mci_pool_stop */
 } mci_ctx;

@@ -25,6 +25,126 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The search for a point inside a sliver (point_inside_sliver). */
+typedef struct sliver_search {
+    const mci_point *a, *b, *c; /* corners: a-b the long edge */
+    const mci_plane *plane;
+    int axis, turn;             /* projection, and the triangle's turn in it */
+    double (*ends)[3];          /* the line's ends: ends[0] fixed, ends[1] moved */
+    double far[3], across[3];   /* ends[1] = far + mu * across */
+    mci_point *out;
+} sliver_search;
+
+/* Where the line's point for mu lies: -1 beyond the long edge, 0 strictly inside the
+ * triangle, +1 beyond one of the other edges (or no point). */
+static int sliver_side(sliver_search *q, double mu)
+{
+    for (int k = 0; k < 3; k++)
+        q->ends[1][k] = q->far[k] + mu * q->across[k];
+    if (mci_orient3d_vertex(q->ends[1], q->plane) * mci_orient3d_vertex(q->ends[0], q->plane) >=
+            0 ||
+        !mci_point_lpi(q->out, q->ends[0], q->ends[1], q->plane))
+        return 1;
+    if (mci_orient2d_projected(q->a, q->b, q->out, q->axis) != q->turn)
+        return -1;
+    return mci_orient2d_projected(q->b, q->c, q->out, q->axis) == q->turn &&
+                   mci_orient2d_projected(q->c, q->a, q->out, q->axis) == q->turn
+               ? 0
+               : 1;
+}
+
+/* Bisection on mu between a point beyond the long edge and one beyond the others. */
+static bool sliver_bisect(sliver_search *q, double lo, double hi)
+{
+    int at_lo = sliver_side(q, lo), at_hi = sliver_side(q, hi);
+    if (at_lo == 0 || at_hi == 0)
+        return sliver_side(q, at_lo == 0 ? lo : hi) == 0;
+    if (at_lo == at_hi)
+        return false;
+    if (at_lo > 0) {
+        double t = lo;
+        lo = hi, hi = t;
+    }
+    for (int step = 0; step < 200; step++) {
+        double mid = 0.5 * (lo + hi);
+        int side;
+        if (mid == lo || mid == hi)
+            return false;
+        side = sliver_side(q, mid);
+        if (side == 0)
+            return true;
+        if (side < 0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return false;
+}
+
+/* The squared length of edge i (from corner i to the next) of doubles x, roughly. */
+static double edge_length2(double x[3][3], int i)
+{
+    double sum = 0;
+    for (int k = 0; k < 3; k++)
+        sum += (x[(i + 1) % 3][k] - x[i][k]) * (x[(i + 1) % 3][k] - x[i][k]);
+    return sum;
+}
+
+/* A point strictly inside a triangle narrower than the spacing of doubles, where no
+ * line through doubles near its centroid pierces it: the line runs from ends[0], a
+ * double next to the plane at the long edge's middle, to ends[1], far on the other
+ * side, so that moving ends[1] by a whole unit moves the point by a tiny fraction of
+ * one across the triangle; bisection over that offset, every step decided exactly,
+ * finds the strip between the long edge and the others. x: the corners' doubles. */
+static bool point_inside_sliver(const mci_point c[3], double x[3][3],
+                                const mci_plane *plane, double ends[2][3], mci_point *out)
+{
+    sliver_search q = {NULL, NULL, NULL, plane, 0, 0, ends, {0}, {0}, out};
+    double n[3], u[3], across[3], len = 0, nlen = 0, big = 0, mid[3], d0, d1, t0;
+    int sign, longest = 0, s0;
+    for (int i = 1; i < 3; i++)
+        if (edge_length2(x, i) > edge_length2(x, longest))
+            longest = i;
+    q.a = &c[longest], q.b = &c[(longest + 1) % 3], q.c = &c[(longest + 2) % 3];
+    q.axis = mci_plane_projection_axis(plane, &sign);
+    q.turn = q.axis < 0 ? 0 : mci_orient2d_projected(q.a, q.b, q.c, q.axis);
+    if (q.turn == 0)
+        return false;
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        n[k] = (plane->b[i] - plane->a[i]) * (plane->c[j] - plane->a[j]) -
+               (plane->b[j] - plane->a[j]) * (plane->c[i] - plane->a[i]);
+        u[k] = x[(longest + 1) % 3][k] - x[longest][k];
+        mid[k] = 0.5 * (x[longest][k] + x[(longest + 1) % 3][k]);
+        big = fmax(big, fabs(mid[k]));
+    }
+    for (int k = 0; k < 3; k++) {
+        across[k] = n[(k + 1) % 3] * u[(k + 2) % 3] - n[(k + 2) % 3] * u[(k + 1) % 3];
+        nlen = fmax(nlen, fabs(n[k]));
+        len = fmax(len, fabs(across[k]));
+    }
+    if (!(len > 0) || !(nlen > 0) || !isfinite(len) || !isfinite(big) || big == 0)
+        return false;
+    /* ends[0]: the long edge's middle, moved off the plane along the projection axis by
+     * the fewest units that leave it. */
+    memcpy(ends[0], mid, sizeof mid);
+    for (int step = 0; (s0 = mci_orient3d_vertex(ends[0], plane)) == 0; step++) {
+        if (step == 64)
+            return false;
+        ends[0][q.axis] = nextafter(ends[0][q.axis], INFINITY);
+    }
+    /* far: as far again as the point is from the origin, on the other side. */
+    memcpy(q.far, ends[0], sizeof q.far);
+    q.far[q.axis] -= s0 * (n[q.axis] > 0 ? 1 : -1) * 4 * (big + 1);
+    d0 = fabs(ends[0][q.axis] - mid[q.axis]) + 4 * big * 0x1p-52;
+    d1 = fabs(q.far[q.axis] - ends[0][q.axis]);
+    t0 = d0 / (d0 + d1); /* roughly how far along the line the plane is */
+    for (int k = 0; k < 3; k++)
+        q.across[k] = across[k] / len / t0;
+    /* The triangle lies within some units of the doubles of its corners. */
+    return sliver_bisect(&q, -64 * big * 0x1p-52, 64 * big * 0x1p-52);
+}
+
 /* A point strictly inside the triangle with corners c[0..2] in plane `plane` (input
  * vertices; the corners may be implicit points): where a line through the corners'
  * approximate centroid, along the plane's approximate normal, pierces the plane (an LPI
@@ -65,7 +185,9 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, int attem
         return false;
     for (int i = 0; i < 3; i++)
         turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
-    return turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2];
+    if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
+        return true;
+    return attempt == MCI_INSIDE_ATTEMPTS - 1 && point_inside_sliver(c, x, plane, ends, out);
 }
 
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],

@@ -81,7 +81,9 @@
 #include "csg/rounding_repair.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
+#include "exact/predicates.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -351,6 +353,29 @@ static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
     m->vertex_count = nv;
 }
 
+/* How the exact result's kept triangle `tag` turns (mci_turn_fn): it lies in its face's
+ * plane and faces as the face does, or the other way where the face's leaf is
+ * complemented. The axis is the one the face's normal is largest along (in doubles: any
+ * axis with a nonzero exact turn would do). */
+static int kept_turn(const void *user, uint32_t tag, int *axis)
+{
+    const eval_state *e = user;
+    const mci_octree *o = &e->scene.octree;
+    uint32_t f = e->kept.faces[tag], leaf = o->face_leaf[f];
+    const double *a = mci_octree_face_vertex(o, f, 0), *b = mci_octree_face_vertex(o, f, 1),
+                 *c = mci_octree_face_vertex(o, f, 2);
+    double n[3];
+    int i, j, sign;
+    for (int k = 0; k < 3; k++) {
+        i = (k + 1) % 3, j = (k + 2) % 3;
+        n[k] = fabs((b[i] - a[i]) * (c[j] - a[j]) - (b[j] - a[j]) * (c[i] - a[i]));
+    }
+    *axis = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
+    i = (*axis + 1) % 3, j = (*axis + 2) % 3;
+    sign = mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
+    return e->tree.nodes[e->tree.leaf_node[leaf]].complement ? -sign : sign;
+}
+
 /* See rounding_repair.h. Opposite twins only appear where rounding joined vertices
  * (`joined`) or a flat triangle was split; splitting can fold a sliver next to it and
  * cancelling twins can expose flat triangles, so repeat while either changes something.
@@ -358,25 +383,32 @@ static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
 static mcsg_status repair_rounding(eval_state *e, mcsg_mesh *out, uint32_t *which,
                                    uint32_t *map, bool joined, mcsg_error *err)
 {
-    mci_flat_repair repair = {0, 0};
-    size_t split = 0, total_cancelled = 0;
+    mci_flat_repair repair = {0, 0, 0, false};
+    mci_expected_turns turns = {kept_turn, e};
+    size_t split = 0, turned = 0, total_cancelled = 0;
     for (int round = 0; round < 8; round++) {
         size_t cancelled = 0;
         if ((joined && !mci_cancel_opposite_triangles(&e->ctx, out->triangles, which,
                                                       &out->triangle_count, &cancelled)) ||
             !mci_split_flat_triangles(&e->ctx, out->vertices, out->triangles, which,
-                                      out->triangle_count, &repair))
+                                      out->triangle_count, &turns, &repair))
             return mci_fail_nomem(err, "assembling the result");
         total_cancelled += cancelled;
         split += repair.split;
-        if (cancelled == 0 && repair.split == 0)
+        turned += repair.turned;
+        if (cancelled == 0 && repair.split == 0 && repair.turned == 0)
             break;
-        joined = true;
+        /* Twins need joined vertices, a flat triangle split or a fold closing up (in
+         * rounds of evaluating again, where folds abound): only then is the sort of every
+         * triangle worth it. */
+        joined = joined || cancelled > 0 || repair.split > 0 || repair.twins ||
+                 e->ctx.reevaluation_round;
     }
     if (total_cancelled > 0)
         drop_unused_vertices(out, map);
     e->stats.rounding_dropped_triangles += total_cancelled;
     e->stats.rounding_split_triangles = split;
+    e->stats.rounding_turned_triangles = turned;
     e->stats.rounding_flat_triangles = repair.remaining;
     return MCSG_OK;
 }

@@ -31,6 +31,7 @@ static mci_ctx round_context(const mci_ctx *ctx)
     inner.progress = NULL;
     inner.check_self_intersections = 1;
     inner.check_output_crossings = 0; /* the round is checked once, by the caller's rules */
+    inner.reevaluation_round = true;
     inner.owns_pool = false;
     return inner;
 }

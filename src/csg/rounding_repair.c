@@ -1,18 +1,33 @@
 /*
- * Repair of triangles that rounding flattened. The exact result has no zero-area
- * triangle, but a thin one (a vertex within an ulp of the opposite edge) can round to
- * three collinear points. Its middle vertex m then lies, exactly in doubles, on the
- * segment p-q of its long edge; the triangle on the other side of that edge, (p, q, X),
- * is split at m into (p, m, X) and (m, q, X), which replace the flat triangle and that
- * neighbour. The mesh stays closed and consistently oriented, the triangle count does not
- * change, and both new triangles lie in the neighbour's plane with the neighbour's
- * orientation, so they are not flat unless the neighbour was (then the flat triangle is
- * left as it is and counted).
+ * Repair of triangles that rounding flattened, turned over or folded. The exact result
+ * has no zero-area triangle, but a thin one (a vertex within an ulp of the opposite edge)
+ * can round to three collinear points. Its middle vertex m then lies, exactly in doubles,
+ * on the segment p-q of its long edge; the triangle on the other side of that edge,
+ * (p, q, X), is split at m into (p, m, X) and (m, q, X), which replace the flat triangle
+ * and that neighbour. The mesh stays closed and consistently oriented, the triangle count
+ * does not change, and both new triangles lie in the neighbour's plane with the
+ * neighbour's orientation, so they are not flat unless the neighbour was (then the flat
+ * triangle is left as it is and counted).
+ *
+ * The same split mends a thin triangle whose corner m rounding moved across the opposite
+ * edge p-q: the triangle then turns the other way than its exact original (seen along
+ * its face's normal; "turned"), or lies in its neighbour's plane on the neighbour's side
+ * of the edge, covering part of it twice ("folded", found without the exact result).
+ * This is what snap rounding does to an edge that passes within the rounding distance
+ * of a vertex: the edge p-q is routed through m, the thin triangle collapses, and the
+ * neighbour is split at m. The split is made only where m lies strictly inside the
+ * neighbour (both halves turn as it does), so the halves cover exactly the neighbour
+ * less the thin triangle's part of it. Every test is an exact predicate on the rounded
+ * doubles; only the choice of which triangles to test (thin ones: a corner within 64
+ * units of the opposite edge, where rounding moves each by half a unit) is a
+ * floating-point bound.
  */
 #include "csg/rounding_repair.h"
 #include "base/sort.h"
+#include "exact/kernel.h"
 #include "exact/predicates.h"
 
+#include <math.h>
 
 #include <stdlib.h>
 #include <string.h>
@@ -48,34 +63,101 @@ static int middle_corner(const double *xyz, const uint32_t *t)
     return 0; /* unreachable for three distinct collinear points */
 }
 
+/* A triangle's mark: FOLDED + i for a fold at corner i (folded_at). */
+enum { GOOD = 0, FLAT = 1, TURNED = 2, FOLDED = 3 };
+
 static uint64_t directed_key(uint32_t u, uint32_t v)
 {
     return (uint64_t)u << 32 | v;
 }
 
-static bool index_directed_edges(const mci_ctx *ctx, const uint32_t *tris, size_t nt,
-                                 mci_keyed **out)
+/* Where the neighbours of the suspect triangles are: every triangle holding a directed
+ * edge opposite to one of theirs, as (edge key, triangle), sorted by key. The wanted
+ * keys are few, so each edge of the mesh is tested against a bitmap of them first: no
+ * sort of the whole mesh's edges. */
+typedef struct edge_index {
+    mci_keyed *edges;
+    size_t count, room;
+} edge_index;
+
+enum { WANTED_BITS = 16 };
+
+static uint32_t wanted_bit(uint64_t key)
 {
-    mci_keyed *edges = mci_malloc_array(ctx, 3 * nt + 1, sizeof *edges);
-    if (!edges)
+    return (uint32_t)((key * 0x9E3779B97F4A7C15u) >> (64 - WANTED_BITS));
+}
+
+static bool is_wanted(const uint64_t *wanted, size_t n, const uint64_t *bits, uint64_t key)
+{
+    uint32_t b = wanted_bit(key);
+    size_t lo = 0, hi = n;
+    if (!(bits[b / 64] >> (b % 64) & 1))
         return false;
-    for (size_t t = 0; t < nt; t++)
-        for (int i = 0; i < 3; i++) {
-            edges[3 * t + i].key = directed_key(tris[3 * t + i], tris[3 * t + (i + 1) % 3]);
-            edges[3 * t + i].ref = (uint32_t)t;
-        }
-    mci_sort_keyed(edges, 3 * nt);
-    *out = edges;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (wanted[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && wanted[lo] == key;
+}
+
+static bool push_edge(const mci_ctx *ctx, edge_index *x, uint64_t key, uint32_t t)
+{
+    if (x->count == x->room) {
+        size_t room = 2 * x->room + 16;
+        mci_keyed *grown = mci_realloc_array(ctx, x->edges, room, sizeof *grown);
+        if (!grown)
+            return false;
+        x->edges = grown;
+        x->room = room;
+    }
+    x->edges[x->count++] = (mci_keyed){key, t};
     return true;
 }
 
-/* The untouched, non-flat triangle holding directed edge u->v, or MCI_NONE. */
+static bool index_neighbour_edges(const mci_ctx *ctx, const uint32_t *tris, size_t nt,
+                                  const uint32_t *suspect, size_t ns, edge_index *out)
+{
+    uint64_t *wanted = mci_malloc_array(ctx, 3 * ns + 1, sizeof *wanted);
+    uint64_t *bits = mci_calloc_array(ctx, ((size_t)1 << WANTED_BITS) / 64, sizeof *bits);
+    size_t nw = 0;
+    bool ok = wanted && bits;
+    memset(out, 0, sizeof *out);
+    for (size_t k = 0; ok && k < ns; k++)
+        for (int i = 0; i < 3; i++) {
+            const uint32_t *T = tris + 3 * (size_t)suspect[k];
+            uint64_t key = directed_key(T[(i + 1) % 3], T[i]);
+            uint32_t b = wanted_bit(key);
+            wanted[nw++] = key;
+            bits[b / 64] |= (uint64_t)1 << (b % 64);
+        }
+    if (ok) {
+        mci_sort_u64(wanted, nw);
+        nw = mci_unique_u64(wanted, nw);
+    }
+    for (size_t t = 0; ok && t < nt; t++)
+        for (int i = 0; ok && i < 3; i++) {
+            uint64_t key = directed_key(tris[3 * t + i], tris[3 * t + (i + 1) % 3]);
+            if (is_wanted(wanted, nw, bits, key))
+                ok = push_edge(ctx, out, key, (uint32_t)t);
+        }
+    if (ok)
+        mci_sort_keyed(out->edges, out->count);
+    mci_free(ctx, wanted);
+    mci_free(ctx, bits);
+    return ok;
+}
+
+/* The untouched triangle holding directed edge u->v, not flat, or MCI_NONE. (A turned
+ * one may take a flat neighbour's middle corner: it may not be mended itself.) */
 static uint32_t neighbour_with_edge(const mci_keyed *edges, size_t n, uint32_t u, uint32_t v,
-                                    const unsigned char *touched, const unsigned char *flat)
+                                    const unsigned char *touched, const unsigned char *mark)
 {
     uint64_t key = directed_key(u, v);
     for (size_t i = mci_find_key(edges, n, key); i < n && edges[i].key == key; i++)
-        if (!touched[edges[i].ref] && !flat[edges[i].ref])
+        if (!touched[edges[i].ref] && mark[edges[i].ref] != FLAT)
             return edges[i].ref;
     return MCI_NONE;
 }
@@ -88,76 +170,277 @@ static uint32_t third_corner(const uint32_t *t, uint32_t u, uint32_t v)
     return t[0];
 }
 
-/* One pass: split the neighbours of flat triangles whose neighbour is not flat and not
- * already changed in this pass. Returns how many flat triangles were removed. */
-static size_t split_pass(const double *xyz, uint32_t *tris, uint32_t *source, size_t nt,
-                         const mci_keyed *edges, unsigned char *touched,
-                         const unsigned char *flat)
+/* The rounded triangle's turn projected along axis (+1 counter-clockwise). */
+static int projected_turn(const double *xyz, const uint32_t *t, int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    const double *a = at(xyz, t[0]), *b = at(xyz, t[1]), *c = at(xyz, t[2]);
+    return mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
+}
+
+/* Whether the triangle turns the other way than its exact original. */
+static bool is_turned(const double *xyz, const uint32_t *t, uint32_t tag,
+                      const mci_expected_turns *turns)
+{
+    int axis, sign = turns->turn(turns->user, tag, &axis);
+    return sign != 0 && projected_turn(xyz, t, axis) == -sign;
+}
+
+/* Sign of (p - m) . (q - m) in the projection along axis, exactly: with R the quarter
+ * turn (x, y) -> (-y, x), it is the cross product (q - m) x (R p - R m). */
+static int projected_dot_sign(const double *m, const double *p, const double *q, int axis)
+{
+    int i = (axis + 1) % 3, j = (axis + 2) % 3;
+    double m2[2] = {m[i], m[j]}, q2[2] = {q[i], q[j]};
+    double rm[2] = {-m[j], m[i]}, rp[2] = {-p[j], p[i]};
+    return mci_cross2_diff_sign(m2, q2, rm, rp);
+}
+
+/* The corner of a turned-over triangle whose angle is obtuse (the corner that rounding
+ * moved across the opposite edge), or -1 when none is (not a thin triangle). */
+static int obtuse_corner(const double *xyz, const uint32_t *t, int axis)
+{
+    for (int i = 0; i < 3; i++)
+        if (projected_dot_sign(at(xyz, t[i]), at(xyz, t[(i + 2) % 3]), at(xyz, t[(i + 1) % 3]),
+                               axis) < 0)
+            return i;
+    return -1;
+}
+
+/* Whether some corner of the triangle lies within 64 units in the last place (of its
+ * largest coordinate, bounded above by the corners' length) of the line through the
+ * other two: only such a triangle can be flat, or turned over or folded by rounding,
+ * which moves each coordinate by half a unit at most. A generous floating-point bound
+ * that only selects which triangles the exact tests look at. */
+static bool is_thin(const double *xyz, const uint32_t *t)
+{
+    const double *a = at(xyz, t[0]), *b = at(xyz, t[1]), *c = at(xyz, t[2]);
+    double u[3], v[3], cross2 = 0, lu = 0, lv = 0, lw = 0, size2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double w = c[k] - b[k];
+        u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+        lu += u[k] * u[k], lv += v[k] * v[k], lw += w * w;
+        size2 += a[k] * a[k] + b[k] * b[k] + c[k] * c[k];
+    }
+    for (int k = 0; k < 3; k++) {
+        double n = u[(k + 1) % 3] * v[(k + 2) % 3] - u[(k + 2) % 3] * v[(k + 1) % 3];
+        cross2 += n * n;
+    }
+    /* The lowest corner is the one across the longest edge: height |u x v| / length;
+     * (64 units)^2 = 2^-92 size^2. */
+    return cross2 <= 0x1p-92 * size2 * fmax(lu, fmax(lv, lw));
+}
+
+/* The axis along which triangle t's rounded normal is largest, and its turn there. */
+static int own_turn(const double *xyz, const uint32_t *t, int *axis)
+{
+    const double *a = at(xyz, t[0]), *b = at(xyz, t[1]), *c = at(xyz, t[2]);
+    double n[3];
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        n[k] = fabs((b[i] - a[i]) * (c[j] - a[j]) - (b[j] - a[j]) * (c[i] - a[i]));
+    }
+    *axis = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
+    return projected_turn(xyz, t, *axis);
+}
+
+/* The first triangle holding directed edge u->v, or MCI_NONE. */
+static uint32_t triangle_with_edge(const mci_keyed *edges, size_t n, uint32_t u, uint32_t v)
+{
+    uint64_t key = directed_key(u, v);
+    size_t i = mci_find_key(edges, n, key);
+    return i < n && edges[i].key == key ? edges[i].ref : MCI_NONE;
+}
+
+/* Whether corner i of triangle T and the neighbour N across the edge opposite it are
+ * folded onto each other: the same plane, and N's third corner on the same side of the
+ * shared edge as T's corner i (so that the two turn opposite ways). */
+static bool folded_at(const double *xyz, const uint32_t *tris, const edge_index *x,
+                      const uint32_t *T, int i)
+{
+    uint32_t m = T[i], q = T[(i + 1) % 3], p = T[(i + 2) % 3];
+    uint32_t n = triangle_with_edge(x->edges, x->count, p, q);
+    const uint32_t *N;
+    mci_plane plane;
+    int turn, axis;
+    if (n == MCI_NONE)
+        return false;
+    N = tris + 3 * (size_t)n;
+    mci_plane_init(&plane, at(xyz, N[0]), at(xyz, N[1]), at(xyz, N[2]));
+    if (mci_orient3d_vertex(at(xyz, m), &plane) != 0)
+        return false;
+    turn = own_turn(xyz, N, &axis);
+    return turn != 0 && projected_turn(xyz, T, axis) == -turn;
+}
+
+/* What is wrong with suspect triangle t (flat or thin), if anything: GOOD, FLAT, TURNED
+ * or FOLDED + corner. */
+static unsigned char triangle_mark(const double *xyz, const uint32_t *tris,
+                                   const uint32_t *source, const edge_index *x, size_t t,
+                                   const mci_expected_turns *turns)
+{
+    const uint32_t *T = tris + 3 * t;
+    if (is_flat(xyz, T))
+        return FLAT;
+    if (turns && is_turned(xyz, T, source[t], turns))
+        return TURNED;
+    for (int i = 0; i < 3; i++)
+        if (folded_at(xyz, tris, x, T, i))
+            return (unsigned char)(FOLDED + i);
+    return GOOD;
+}
+
+/* The corner to split the neighbour at, for a marked triangle; -1 for none. */
+static int split_corner(const double *xyz, const uint32_t *t, unsigned char mark, uint32_t tag,
+                        const mci_expected_turns *turns)
+{
+    int axis;
+    if (mark == FLAT)
+        return middle_corner(xyz, t);
+    if (mark >= FOLDED)
+        return mark - FOLDED;
+    return turns->turn(turns->user, tag, &axis) != 0 ? obtuse_corner(xyz, t, axis) : -1;
+}
+
+/* Whether both halves a and b of neighbour N, split for a turned or folded triangle,
+ * turn as N should: as in the exact result (turned), or as N itself does (folded). Then
+ * the moved corner lies inside N. */
+static bool halves_turn_right(const double *xyz, const uint32_t *a, const uint32_t *b,
+                              const uint32_t *N, uint32_t tag, unsigned char mark,
+                              const mci_expected_turns *turns)
+{
+    int axis;
+    int sign = mark == TURNED ? turns->turn(turns->user, tag, &axis) : own_turn(xyz, N, &axis);
+    return sign != 0 && projected_turn(xyz, a, axis) == sign &&
+           projected_turn(xyz, b, axis) == sign;
+}
+
+/* Whether a triangle holds directed edge u->v and has `third` as its third corner: the
+ * opposite twin of a new half with edge v->u (a fold can close up that way). */
+static bool has_twin(const uint32_t *tris, const edge_index *x, uint32_t u, uint32_t v,
+                     uint32_t third)
+{
+    uint64_t key = directed_key(u, v);
+    for (size_t i = mci_find_key(x->edges, x->count, key); i < x->count && x->edges[i].key == key;
+         i++)
+        if (third_corner(tris + 3 * (size_t)x->edges[i].ref, u, v) == third)
+            return true;
+    return false;
+}
+
+/* One pass over the suspects: split the neighbours of marked triangles whose neighbour
+ * is not flat and not already changed in this pass. Returns how many were removed (the
+ * neighbours split in split[]), the turned or folded ones among them in *turned, and
+ * sets *twins when a new half has an opposite twin. */
+static size_t split_pass(const double *xyz, uint32_t *tris, uint32_t *source,
+                         const uint32_t *suspect, size_t ns, const edge_index *x,
+                         unsigned char *touched, const unsigned char *mark,
+                         const mci_expected_turns *turns, uint32_t *split, size_t *turned,
+                         bool *twins)
 {
     size_t fixed = 0;
-    for (size_t t = 0; t < nt; t++) {
-        uint32_t *T = tris + 3 * t, p, q, m, n, x;
+    for (size_t k = 0; k < ns; k++) {
+        size_t t = suspect[k];
+        uint32_t *T = tris + 3 * t, *N, p, q, m, n, third, a[3], b[3];
         int i;
-        if (!flat[t] || touched[t])
+        if (mark[t] == GOOD || touched[t])
             continue;
-        i = middle_corner(xyz, T);
+        i = split_corner(xyz, T, mark[t], source ? source[t] : 0, turns);
+        if (i < 0)
+            continue;
         m = T[i];
         q = T[(i + 1) % 3];
         p = T[(i + 2) % 3];
-        n = neighbour_with_edge(edges, 3 * nt, p, q, touched, flat);
+        n = neighbour_with_edge(x->edges, x->count, p, q, touched, mark);
         if (n == MCI_NONE)
             continue;
-        x = third_corner(tris + 3 * (size_t)n, p, q);
-        T[0] = p, T[1] = m, T[2] = x;
-        tris[3 * (size_t)n] = m, tris[3 * (size_t)n + 1] = q, tris[3 * (size_t)n + 2] = x;
+        N = tris + 3 * (size_t)n;
+        third = third_corner(N, p, q);
+        a[0] = p, a[1] = m, a[2] = third;
+        b[0] = m, b[1] = q, b[2] = third;
+        if (mark[t] != FLAT &&
+            !halves_turn_right(xyz, a, b, N, source ? source[n] : 0, mark[t], turns))
+            continue;
+        *twins = *twins || has_twin(tris, x, m, p, third) || has_twin(tris, x, q, m, third);
+        memcpy(T, a, sizeof a);
+        memcpy(N, b, sizeof b);
         if (source)
             source[t] = source[n];
         touched[t] = touched[n] = 1;
-        fixed++;
+        split[fixed++] = n;
+        *turned += mark[t] != FLAT;
     }
     return fixed;
 }
 
-static size_t mark_flat(const double *xyz, const uint32_t *tris, size_t nt, unsigned char *flat)
+/* The suspects of the next pass: only the triangles a pass changed can have become thin
+ * (this one's suspects and the neighbours split), so *ns shrinks to those still thin. */
+static void next_suspects(const double *xyz, const uint32_t *tris, uint32_t *suspect,
+                          size_t *ns, const uint32_t *split, size_t nsplit, unsigned char *seen)
 {
-    size_t count = 0;
-    for (size_t t = 0; t < nt; t++) {
-        flat[t] = is_flat(xyz, tris + 3 * t);
-        count += flat[t];
+    size_t kept = 0;
+    for (size_t k = 0; k < *ns; k++)
+        seen[suspect[k]] = 1;
+    for (size_t k = 0; k < *ns; k++)
+        if (is_thin(xyz, tris + 3 * (size_t)suspect[k]))
+            suspect[kept++] = suspect[k];
+    for (size_t k = 0; k < nsplit; k++)
+        if (!seen[split[k]] && is_thin(xyz, tris + 3 * (size_t)split[k])) {
+            seen[split[k]] = 1;
+            suspect[kept++] = split[k];
+        }
+    *ns = kept;
+}
+
+/* One pass over the suspects: their neighbours' edges, marks, splits; then the next
+ * pass's suspects. *fixed: how many triangles were removed. */
+static bool one_pass(const mci_ctx *ctx, const double *xyz, uint32_t *tris, uint32_t *source,
+                     size_t nt, const mci_expected_turns *turns, unsigned char *marks,
+                     uint32_t *suspect, size_t *ns, mci_flat_repair *result, size_t *fixed)
+{
+    unsigned char *mark = marks, *touched = marks + nt;
+    uint32_t *split = mci_malloc_array(ctx, *ns + 1, sizeof *split);
+    edge_index x = {NULL, 0, 0};
+    bool ok = split && index_neighbour_edges(ctx, tris, nt, suspect, *ns, &x);
+    *fixed = 0;
+    if (ok) {
+        memset(marks, GOOD, 2 * nt);
+        for (size_t k = 0; k < *ns; k++)
+            mark[suspect[k]] = triangle_mark(xyz, tris, source, &x, suspect[k], turns);
+        *fixed = split_pass(xyz, tris, source, suspect, *ns, &x, touched, mark, turns, split,
+                            &result->turned, &result->twins);
+        result->split += *fixed;
+        memset(touched, 0, nt);
+        next_suspects(xyz, tris, suspect, ns, split, *fixed, touched);
     }
-    return count;
+    mci_free(ctx, x.edges);
+    mci_free(ctx, split);
+    return ok;
 }
 
 bool mci_split_flat_triangles(const mci_ctx *ctx, const double *xyz, uint32_t *tris,
-                              uint32_t *source, size_t nt, mci_flat_repair *result)
+                              uint32_t *source, size_t nt, const mci_expected_turns *turns,
+                              mci_flat_repair *result)
 {
-    unsigned char *marks = mci_malloc_array(ctx, 2 * nt + 1, 1), *flat, *touched;
-    size_t count;
-    bool ok = marks != NULL;
+    unsigned char *marks = mci_malloc_array(ctx, 2 * nt + 1, 1);
+    uint32_t *suspect = mci_malloc_array(ctx, nt + 1, sizeof *suspect);
+    bool ok = marks && suspect;
+    size_t fixed = 1, ns = 0;
     memset(result, 0, sizeof *result);
-    if (!ok)
-        return false;
-    flat = marks;
-    touched = marks + nt;
-    count = mark_flat(xyz, tris, nt, flat);
-    /* Each pass fixes every flat triangle whose neighbour is free; chains of flat
+    if (!source)
+        turns = NULL;
+    for (size_t t = 0; ok && t < nt; t++)
+        if (is_thin(xyz, tris + 3 * t))
+            suspect[ns++] = (uint32_t)t;
+    /* Each pass fixes every marked triangle whose neighbour is free; chains of flat
      * triangles along one line need a few passes. */
-    for (int pass = 0; ok && count > 0 && pass < 16; pass++) {
-        mci_keyed *edges = NULL;
-        size_t fixed;
-        ok = index_directed_edges(ctx, tris, nt, &edges);
-        if (!ok)
-            break;
-        memset(touched, 0, nt);
-        fixed = split_pass(xyz, tris, source, nt, edges, touched, flat);
-        mci_free(ctx, edges);
-        result->split += fixed;
-        count = mark_flat(xyz, tris, nt, flat);
-        if (fixed == 0)
-            break;
-    }
-    result->remaining = count;
+    for (int pass = 0; ok && ns > 0 && fixed > 0 && pass < 16; pass++)
+        ok = one_pass(ctx, xyz, tris, source, nt, turns, marks, suspect, &ns, result, &fixed);
+    for (size_t k = 0; ok && k < ns; k++)
+        result->remaining += is_flat(xyz, tris + 3 * (size_t)suspect[k]);
+    result->split -= result->turned;
     mci_free(ctx, marks);
+    mci_free(ctx, suspect);
     return ok;
 }
 
