@@ -81,9 +81,6 @@
 #include "csg/rounding_repair.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
-#include "exact/predicates.h"
-
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -355,24 +352,14 @@ static void drop_unused_vertices(mcsg_mesh *m, uint32_t *map)
 
 /* How the exact result's kept triangle `tag` turns (mci_turn_fn): it lies in its face's
  * plane and faces as the face does, or the other way where the face's leaf is
- * complemented. The axis is the one the face's normal is largest along (in doubles: any
- * axis with a nonzero exact turn would do). */
+ * complemented. */
 static int kept_turn(const void *user, uint32_t tag, int *axis)
 {
     const eval_state *e = user;
     const mci_octree *o = &e->scene.octree;
     uint32_t f = e->kept.faces[tag], leaf = o->face_leaf[f];
-    const double *a = mci_octree_face_vertex(o, f, 0), *b = mci_octree_face_vertex(o, f, 1),
-                 *c = mci_octree_face_vertex(o, f, 2);
-    double n[3];
-    int i, j, sign;
-    for (int k = 0; k < 3; k++) {
-        i = (k + 1) % 3, j = (k + 2) % 3;
-        n[k] = fabs((b[i] - a[i]) * (c[j] - a[j]) - (b[j] - a[j]) * (c[i] - a[i]));
-    }
-    *axis = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
-    i = (*axis + 1) % 3, j = (*axis + 2) % 3;
-    sign = mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
+    int sign = mci_triangle_turn(mci_octree_face_vertex(o, f, 0), mci_octree_face_vertex(o, f, 1),
+                                 mci_octree_face_vertex(o, f, 2), axis);
     return e->tree.nodes[e->tree.leaf_node[leaf]].complement ? -sign : sign;
 }
 

@@ -87,20 +87,14 @@ static uint32_t wanted_bit(uint64_t key)
     return (uint32_t)((key * 0x9E3779B97F4A7C15u) >> (64 - WANTED_BITS));
 }
 
-static bool is_wanted(const uint64_t *wanted, size_t n, const uint64_t *bits, uint64_t key)
+static bool is_wanted(const mci_keyed *wanted, size_t n, const uint64_t *bits, uint64_t key)
 {
     uint32_t b = wanted_bit(key);
-    size_t lo = 0, hi = n;
+    size_t i;
     if (!(bits[b / 64] >> (b % 64) & 1))
         return false;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (wanted[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < n && wanted[lo] == key;
+    i = mci_find_key(wanted, n, key);
+    return i < n && wanted[i].key == key;
 }
 
 static bool push_edge(const mci_ctx *ctx, edge_index *x, uint64_t key, uint32_t t)
@@ -120,7 +114,7 @@ static bool push_edge(const mci_ctx *ctx, edge_index *x, uint64_t key, uint32_t 
 static bool index_neighbour_edges(const mci_ctx *ctx, const uint32_t *tris, size_t nt,
                                   const uint32_t *suspect, size_t ns, edge_index *out)
 {
-    uint64_t *wanted = mci_malloc_array(ctx, 3 * ns + 1, sizeof *wanted);
+    mci_keyed *wanted = mci_malloc_array(ctx, 3 * ns + 1, sizeof *wanted);
     uint64_t *bits = mci_calloc_array(ctx, ((size_t)1 << WANTED_BITS) / 64, sizeof *bits);
     size_t nw = 0;
     bool ok = wanted && bits;
@@ -130,13 +124,11 @@ static bool index_neighbour_edges(const mci_ctx *ctx, const uint32_t *tris, size
             const uint32_t *T = tris + 3 * (size_t)suspect[k];
             uint64_t key = directed_key(T[(i + 1) % 3], T[i]);
             uint32_t b = wanted_bit(key);
-            wanted[nw++] = key;
+            wanted[nw++] = (mci_keyed){key, 0};
             bits[b / 64] |= (uint64_t)1 << (b % 64);
         }
-    if (ok) {
-        mci_sort_u64(wanted, nw);
-        nw = mci_unique_u64(wanted, nw);
-    }
+    if (ok)
+        mci_sort_keyed(wanted, nw);
     for (size_t t = 0; ok && t < nt; t++)
         for (int i = 0; ok && i < 3; i++) {
             uint64_t key = directed_key(tris[3 * t + i], tris[3 * t + (i + 1) % 3]);
@@ -231,17 +223,23 @@ static bool is_thin(const double *xyz, const uint32_t *t)
     return cross2 <= 0x1p-92 * size2 * fmax(lu, fmax(lv, lw));
 }
 
-/* The axis along which triangle t's rounded normal is largest, and its turn there. */
-static int own_turn(const double *xyz, const uint32_t *t, int *axis)
+int mci_triangle_turn(const double *a, const double *b, const double *c, int *axis)
 {
-    const double *a = at(xyz, t[0]), *b = at(xyz, t[1]), *c = at(xyz, t[2]);
     double n[3];
+    int i, j;
     for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
+        i = (k + 1) % 3, j = (k + 2) % 3;
         n[k] = fabs((b[i] - a[i]) * (c[j] - a[j]) - (b[j] - a[j]) * (c[i] - a[i]));
     }
     *axis = n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
-    return projected_turn(xyz, t, *axis);
+    i = (*axis + 1) % 3, j = (*axis + 2) % 3;
+    return mci_orient2d(a[i], a[j], b[i], b[j], c[i], c[j]);
+}
+
+/* Triangle t's rounded turn along the axis its normal is largest on. */
+static int own_turn(const double *xyz, const uint32_t *t, int *axis)
+{
+    return mci_triangle_turn(at(xyz, t[0]), at(xyz, t[1]), at(xyz, t[2]), axis);
 }
 
 /* The first triangle holding directed edge u->v, or MCI_NONE. */

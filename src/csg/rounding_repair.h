@@ -23,6 +23,11 @@ typedef struct mci_flat_repair {
  * clockwise, 0 when not known. */
 typedef int (*mci_turn_fn)(const void *user, uint32_t tag, int *axis);
 
+/* The turn of triangle a, b, c (+1 counter-clockwise, -1 clockwise, 0 flat), exactly,
+ * projected along *axis: the axis its normal is largest along, in doubles (any axis with
+ * a nonzero exact turn would do). */
+int mci_triangle_turn(const double *a, const double *b, const double *c, int *axis);
+
 typedef struct mci_expected_turns {
     mci_turn_fn turn;
     const void *user;
