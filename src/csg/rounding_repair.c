@@ -80,21 +80,48 @@ typedef struct edge_index {
     size_t count, room;
 } edge_index;
 
-enum { WANTED_BITS = 16 };
+/* The wanted keys, sorted, and a bitmap of their hashes with about 16 bits per key, so
+ * that few of the mesh's other edges reach the binary search however many are wanted. */
+typedef struct wanted_keys {
+    mci_keyed *keys;
+    size_t count;
+    uint64_t *bits;
+    int log_bits;
+} wanted_keys;
 
-static uint32_t wanted_bit(uint64_t key)
+enum { MIN_WANTED_LOG_BITS = 12 };
+
+static uint32_t wanted_bit(const wanted_keys *w, uint64_t key)
 {
-    return (uint32_t)((key * 0x9E3779B97F4A7C15u) >> (64 - WANTED_BITS));
+    return (uint32_t)((key * 0x9E3779B97F4A7C15u) >> (64 - w->log_bits));
 }
 
-static bool is_wanted(const mci_keyed *wanted, size_t n, const uint64_t *bits, uint64_t key)
+static void want(wanted_keys *w, uint64_t key)
 {
-    uint32_t b = wanted_bit(key);
+    uint32_t b = wanted_bit(w, key);
+    w->keys[w->count++] = (mci_keyed){key, 0};
+    w->bits[b / 64] |= (uint64_t)1 << (b % 64);
+}
+
+static bool is_wanted(const wanted_keys *w, uint64_t key)
+{
+    uint32_t b = wanted_bit(w, key);
     size_t i;
-    if (!(bits[b / 64] >> (b % 64) & 1))
+    if (!(w->bits[b / 64] >> (b % 64) & 1))
         return false;
-    i = mci_find_key(wanted, n, key);
-    return i < n && wanted[i].key == key;
+    i = mci_find_key(w->keys, w->count, key);
+    return i < w->count && w->keys[i].key == key;
+}
+
+static bool wanted_init(const mci_ctx *ctx, size_t room, wanted_keys *w)
+{
+    w->count = 0;
+    w->log_bits = MIN_WANTED_LOG_BITS;
+    while (w->log_bits < 31 && ((size_t)1 << w->log_bits) < 16 * room)
+        w->log_bits++;
+    w->keys = mci_malloc_array(ctx, room + 1, sizeof *w->keys);
+    w->bits = mci_calloc_array(ctx, ((size_t)1 << w->log_bits) / 64, sizeof *w->bits);
+    return w->keys && w->bits;
 }
 
 static bool push_edge(const mci_ctx *ctx, edge_index *x, uint64_t key, uint32_t t)
@@ -114,31 +141,26 @@ static bool push_edge(const mci_ctx *ctx, edge_index *x, uint64_t key, uint32_t 
 static bool index_neighbour_edges(const mci_ctx *ctx, const uint32_t *tris, size_t nt,
                                   const uint32_t *suspect, size_t ns, edge_index *out)
 {
-    mci_keyed *wanted = mci_malloc_array(ctx, 3 * ns + 1, sizeof *wanted);
-    uint64_t *bits = mci_calloc_array(ctx, ((size_t)1 << WANTED_BITS) / 64, sizeof *bits);
-    size_t nw = 0;
-    bool ok = wanted && bits;
+    wanted_keys w;
+    bool ok = wanted_init(ctx, 3 * ns, &w);
     memset(out, 0, sizeof *out);
     for (size_t k = 0; ok && k < ns; k++)
         for (int i = 0; i < 3; i++) {
             const uint32_t *T = tris + 3 * (size_t)suspect[k];
-            uint64_t key = directed_key(T[(i + 1) % 3], T[i]);
-            uint32_t b = wanted_bit(key);
-            wanted[nw++] = (mci_keyed){key, 0};
-            bits[b / 64] |= (uint64_t)1 << (b % 64);
+            want(&w, directed_key(T[(i + 1) % 3], T[i]));
         }
     if (ok)
-        mci_sort_keyed(wanted, nw);
+        mci_sort_keyed(w.keys, w.count);
     for (size_t t = 0; ok && t < nt; t++)
         for (int i = 0; ok && i < 3; i++) {
             uint64_t key = directed_key(tris[3 * t + i], tris[3 * t + (i + 1) % 3]);
-            if (is_wanted(wanted, nw, bits, key))
+            if (is_wanted(&w, key))
                 ok = push_edge(ctx, out, key, (uint32_t)t);
         }
     if (ok)
         mci_sort_keyed(out->edges, out->count);
-    mci_free(ctx, wanted);
-    mci_free(ctx, bits);
+    mci_free(ctx, w.keys);
+    mci_free(ctx, w.bits);
     return ok;
 }
 
@@ -327,13 +349,14 @@ static bool has_twin(const uint32_t *tris, const edge_index *x, uint32_t u, uint
 }
 
 /* One pass over the suspects: split the neighbours of marked triangles whose neighbour
- * is not flat and not already changed in this pass. Returns how many were removed (the
- * neighbours split in split[]), the turned or folded ones among them in *turned, and
+ * is not flat and not already changed in this pass. Returns how many were removed (each
+ * mended triangle and its split neighbour in changed[]), the turned or folded ones among
+ * them in *turned, and
  * sets *twins when a new half has an opposite twin. */
 static size_t split_pass(const double *xyz, uint32_t *tris, uint32_t *source,
                          const uint32_t *suspect, size_t ns, const edge_index *x,
                          unsigned char *touched, const unsigned char *mark,
-                         const mci_expected_turns *turns, uint32_t *split, size_t *turned,
+                         const mci_expected_turns *turns, uint32_t *changed, size_t *turned,
                          bool *twins)
 {
     size_t fixed = 0;
@@ -365,80 +388,140 @@ static size_t split_pass(const double *xyz, uint32_t *tris, uint32_t *source,
         if (source)
             source[t] = source[n];
         touched[t] = touched[n] = 1;
-        split[fixed++] = n;
+        changed[2 * fixed] = (uint32_t)t;
+        changed[2 * fixed++ + 1] = n;
         *turned += mark[t] != FLAT;
     }
     return fixed;
 }
 
-/* The suspects of the next pass: only the triangles a pass changed can have become thin
- * (this one's suspects and the neighbours split), so *ns shrinks to those still thin. */
-static void next_suspects(const double *xyz, const uint32_t *tris, uint32_t *suspect,
-                          size_t *ns, const uint32_t *split, size_t nsplit, unsigned char *seen)
+/* The triangles under watch: every thin one, and among those the suspects, which the
+ * next pass marks. A mark depends only on the triangle and the triangles holding its
+ * edges, so it can change only where a triangle changed: the suspects are the thin
+ * triangles that share a corner with a changed one, or whose mark was not GOOD but
+ * could not be mended. Marking only those keeps the passes' cost with the changes, not
+ * with the number of thin triangles, which is large on meshes full of slivers. */
+typedef struct watch {
+    uint32_t *thin, *suspect, *changed;
+    size_t nthin, nsuspect, nchanged;
+    unsigned char *dirty; /* per vertex: a corner of a changed triangle */
+} watch;
+
+static void set_corners(const uint32_t *tris, const uint32_t *list, size_t n,
+                        unsigned char *flags, unsigned char value)
 {
-    size_t kept = 0;
-    for (size_t k = 0; k < *ns; k++)
-        seen[suspect[k]] = 1;
-    for (size_t k = 0; k < *ns; k++)
-        if (is_thin(xyz, tris + 3 * (size_t)suspect[k]))
-            suspect[kept++] = suspect[k];
-    for (size_t k = 0; k < nsplit; k++)
-        if (!seen[split[k]] && is_thin(xyz, tris + 3 * (size_t)split[k])) {
-            seen[split[k]] = 1;
-            suspect[kept++] = split[k];
-        }
-    *ns = kept;
+    for (size_t k = 0; k < n; k++)
+        for (int i = 0; i < 3; i++)
+            flags[tris[3 * (size_t)list[k] + i]] = value;
 }
 
-/* One pass over the suspects: their neighbours' edges, marks, splits; then the next
- * pass's suspects. *fixed: how many triangles were removed. */
+static bool near_change(const uint32_t *t, const unsigned char *dirty)
+{
+    return dirty[t[0]] || dirty[t[1]] || dirty[t[2]];
+}
+
+/* After a pass that changed w->changed: the triangles still thin, the changed ones that
+ * became thin, and the next suspects: those near a change, and those to retry (marked
+ * but not mended). listed[] and retry[] are zero on return. */
+static void next_suspects(const double *xyz, const uint32_t *tris, watch *w,
+                          unsigned char *retry, unsigned char *listed)
+{
+    size_t kept = 0;
+    for (size_t k = 0; k < w->nthin; k++)
+        if (is_thin(xyz, tris + 3 * (size_t)w->thin[k])) {
+            listed[w->thin[k]] = 1;
+            w->thin[kept++] = w->thin[k];
+        }
+    w->nthin = kept;
+    for (size_t k = 0; k < w->nchanged; k++)
+        if (!listed[w->changed[k]] && is_thin(xyz, tris + 3 * (size_t)w->changed[k])) {
+            listed[w->changed[k]] = 1;
+            w->thin[w->nthin++] = w->changed[k];
+        }
+    set_corners(tris, w->changed, w->nchanged, w->dirty, 1);
+    w->nsuspect = 0;
+    for (size_t k = 0; k < w->nthin; k++) {
+        uint32_t t = w->thin[k];
+        if (retry[t] || near_change(tris + 3 * (size_t)t, w->dirty))
+            w->suspect[w->nsuspect++] = t;
+        listed[t] = retry[t] = 0;
+    }
+    set_corners(tris, w->changed, w->nchanged, w->dirty, 0);
+}
+
+/* One pass: the suspects' neighbour edges, marks, splits; then the next suspects.
+ * *fixed: how many triangles were removed. marks: three zeroed arrays of nt flags. */
 static bool one_pass(const mci_ctx *ctx, const double *xyz, uint32_t *tris, uint32_t *source,
                      size_t nt, const mci_expected_turns *turns, unsigned char *marks,
-                     uint32_t *suspect, size_t *ns, mci_flat_repair *result, size_t *fixed)
+                     watch *w, mci_flat_repair *result, size_t *fixed)
 {
-    unsigned char *mark = marks, *touched = marks + nt;
-    uint32_t *split = mci_malloc_array(ctx, *ns + 1, sizeof *split);
+    unsigned char *mark = marks, *touched = marks + nt, *retry = marks + 2 * nt;
     edge_index x = {NULL, 0, 0};
-    bool ok = split && index_neighbour_edges(ctx, tris, nt, suspect, *ns, &x);
+    bool ok = index_neighbour_edges(ctx, tris, nt, w->suspect, w->nsuspect, &x);
     *fixed = 0;
     if (ok) {
-        memset(marks, GOOD, 2 * nt);
-        for (size_t k = 0; k < *ns; k++)
-            mark[suspect[k]] = triangle_mark(xyz, tris, source, &x, suspect[k], turns);
-        *fixed = split_pass(xyz, tris, source, suspect, *ns, &x, touched, mark, turns, split,
-                            &result->turned, &result->twins);
+        for (size_t k = 0; k < w->nsuspect; k++)
+            mark[w->suspect[k]] = triangle_mark(xyz, tris, source, &x, w->suspect[k], turns);
+        *fixed = split_pass(xyz, tris, source, w->suspect, w->nsuspect, &x, touched, mark,
+                            turns, w->changed, &result->turned, &result->twins);
+        w->nchanged = 2 * *fixed;
         result->split += *fixed;
-        memset(touched, 0, nt);
-        next_suspects(xyz, tris, suspect, ns, split, *fixed, touched);
+        for (size_t k = 0; k < w->nsuspect; k++) {
+            uint32_t t = w->suspect[k];
+            retry[t] = mark[t] != GOOD && !touched[t];
+            mark[t] = GOOD;
+        }
+        for (size_t k = 0; k < w->nchanged; k++)
+            touched[w->changed[k]] = 0;
+        next_suspects(xyz, tris, w, retry, touched);
     }
     mci_free(ctx, x.edges);
-    mci_free(ctx, split);
     return ok;
+}
+
+static uint32_t vertex_count(const uint32_t *tris, size_t nt)
+{
+    uint32_t n = 0;
+    for (size_t k = 0; k < 3 * nt; k++)
+        n = tris[k] >= n ? tris[k] + 1 : n;
+    return n;
+}
+
+static void free_watch(const mci_ctx *ctx, watch *w)
+{
+    mci_free(ctx, w->thin);
+    mci_free(ctx, w->suspect);
+    mci_free(ctx, w->changed);
+    mci_free(ctx, w->dirty);
 }
 
 bool mci_split_flat_triangles(const mci_ctx *ctx, const double *xyz, uint32_t *tris,
                               uint32_t *source, size_t nt, const mci_expected_turns *turns,
                               mci_flat_repair *result)
 {
-    unsigned char *marks = mci_malloc_array(ctx, 2 * nt + 1, 1);
-    uint32_t *suspect = mci_malloc_array(ctx, nt + 1, sizeof *suspect);
-    bool ok = marks && suspect;
-    size_t fixed = 1, ns = 0;
+    unsigned char *marks = mci_calloc_array(ctx, 3 * nt + 1, 1);
+    watch w = {mci_malloc_array(ctx, nt + 1, sizeof(uint32_t)),
+               mci_malloc_array(ctx, nt + 1, sizeof(uint32_t)),
+               mci_malloc_array(ctx, nt + 1, sizeof(uint32_t)),
+               0, 0, 0,
+               mci_calloc_array(ctx, (size_t)vertex_count(tris, nt) + 1, 1)};
+    bool ok = marks && w.thin && w.suspect && w.changed && w.dirty;
+    size_t fixed = 1;
     memset(result, 0, sizeof *result);
     if (!source)
         turns = NULL;
     for (size_t t = 0; ok && t < nt; t++)
         if (is_thin(xyz, tris + 3 * t))
-            suspect[ns++] = (uint32_t)t;
+            w.thin[w.nthin++] = w.suspect[w.nsuspect++] = (uint32_t)t;
     /* Each pass fixes every marked triangle whose neighbour is free; chains of flat
      * triangles along one line need a few passes. */
-    for (int pass = 0; ok && ns > 0 && fixed > 0 && pass < 16; pass++)
-        ok = one_pass(ctx, xyz, tris, source, nt, turns, marks, suspect, &ns, result, &fixed);
-    for (size_t k = 0; ok && k < ns; k++)
-        result->remaining += is_flat(xyz, tris + 3 * (size_t)suspect[k]);
+    for (int pass = 0; ok && w.nsuspect > 0 && fixed > 0 && pass < 16; pass++)
+        ok = one_pass(ctx, xyz, tris, source, nt, turns, marks, &w, result, &fixed);
+    for (size_t k = 0; ok && k < w.nthin; k++)
+        result->remaining += is_flat(xyz, tris + 3 * (size_t)w.thin[k]);
     result->split -= result->turned;
     mci_free(ctx, marks);
-    mci_free(ctx, suspect);
+    free_watch(ctx, &w);
     return ok;
 }
 
