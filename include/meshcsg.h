@@ -540,6 +540,9 @@ typedef struct mcsg_eval_stats {
     size_t touching_vertices_split;  /* vertex copies added where parts of the result
                                         touch along an edge or at a point, so that the
                                         output is edge- and vertex-manifold */
+    size_t rounding_separated_vertices; /* vertex copies moved by one unit in the last
+                                           place where rounding made parts touch along an
+                                           edge that the exact result keeps apart */
     mcsg_output_check output_check; /* the result against its guarantees; a failure is
                                        also logged as a warning */
     size_t rounding_reevaluations;  /* rounds of evaluating the rounded result again, alone

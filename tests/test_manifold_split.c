@@ -29,29 +29,6 @@ static void put_points(double *xyz, const int *degrees, int rim_count)
     }
 }
 
-static double orient(const double *a, const double *b, const double *c, const double *d)
-{
-    double ab[3], ac[3], ad[3];
-    for (int k = 0; k < 3; k++)
-        ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ad[k] = d[k] - a[k];
-    return ab[0] * (ac[1] * ad[2] - ac[2] * ad[1]) - ab[1] * (ac[0] * ad[2] - ac[2] * ad[0]) +
-           ab[2] * (ac[0] * ad[1] - ac[1] * ad[0]);
-}
-
-/* The four faces of tetrahedron q, each turned so that the fourth corner is behind it. */
-static void put_tetrahedron(const double *xyz, const uint32_t q[4], uint32_t *tris)
-{
-    static const int faces[4][4] = {{0, 1, 2, 3}, {0, 3, 1, 2}, {0, 2, 3, 1}, {1, 3, 2, 0}};
-    for (int f = 0; f < 4; f++) {
-        uint32_t a = q[faces[f][0]], b = q[faces[f][1]], c = q[faces[f][2]];
-        uint32_t d = q[faces[f][3]];
-        bool flip = orient(xyz + 3 * a, xyz + 3 * b, xyz + 3 * c, xyz + 3 * d) > 0;
-        tris[3 * f] = a;
-        tris[3 * f + 1] = flip ? c : b;
-        tris[3 * f + 2] = flip ? b : c;
-    }
-}
-
 /* Two tetrahedra u v r0 r1 and u v r2 r3 (rim angles in degrees), split. */
 static void split_two_tetrahedra(const int degrees[4], size_t reordered)
 {
@@ -67,8 +44,8 @@ static void split_two_tetrahedra(const int degrees[4], size_t reordered)
         return;
     }
     put_points(m.vertices, degrees, 4);
-    put_tetrahedron(m.vertices, first, m.triangles);
-    put_tetrahedron(m.vertices, second, m.triangles + 12);
+    test_put_tetrahedron(m.vertices, first, m.triangles);
+    test_put_tetrahedron(m.vertices, second, m.triangles + 12);
     CHECK(test_index_manifold_defects(&m) > 0);
     CHECK(mci_split_touching(&ctx, &m, &split));
     CHECK_EQ_SIZE(split.new_vertices, 2);

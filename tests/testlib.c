@@ -140,6 +140,28 @@ static const directed_edge *find_directed(const directed_edge *e, size_t n, uint
     return bsearch(&key, e, n, sizeof *e, compare_directed);
 }
 
+static double orient_of(const double *a, const double *b, const double *c, const double *d)
+{
+    double ab[3], ac[3], ad[3];
+    for (int k = 0; k < 3; k++)
+        ab[k] = b[k] - a[k], ac[k] = c[k] - a[k], ad[k] = d[k] - a[k];
+    return ab[0] * (ac[1] * ad[2] - ac[2] * ad[1]) - ab[1] * (ac[0] * ad[2] - ac[2] * ad[0]) +
+           ab[2] * (ac[0] * ad[1] - ac[1] * ad[0]);
+}
+
+void test_put_tetrahedron(const double *xyz, const uint32_t q[4], uint32_t *tris)
+{
+    static const int faces[4][4] = {{0, 1, 2, 3}, {0, 3, 1, 2}, {0, 2, 3, 1}, {1, 3, 2, 0}};
+    for (int f = 0; f < 4; f++) {
+        uint32_t a = q[faces[f][0]], b = q[faces[f][1]], c = q[faces[f][2]];
+        uint32_t d = q[faces[f][3]];
+        bool flip = orient_of(xyz + 3 * a, xyz + 3 * b, xyz + 3 * c, xyz + 3 * d) > 0;
+        tris[3 * f] = a;
+        tris[3 * f + 1] = flip ? c : b;
+        tris[3 * f + 2] = flip ? b : c;
+    }
+}
+
 size_t test_index_manifold_defects(const mcsg_mesh *m)
 {
     size_t n = 3 * m->triangle_count, defects = 0, *seen_at;

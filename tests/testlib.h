@@ -121,6 +121,9 @@ mcsg_status test_eval_scad(const char *text, const mcsg_options *opts, mcsg_mesh
  * not used exactly once in each direction, plus vertices whose triangles do not form a
  * single umbrella: 0 for an index-manifold closed oriented mesh. */
 size_t test_index_manifold_defects(const mcsg_mesh *m);
+/* The four faces of tetrahedron q (vertex ids into xyz) as triangles tris[0 .. 12),
+ * each turned so that the fourth corner is behind it (faces outward). */
+void test_put_tetrahedron(const double *xyz, const uint32_t q[4], uint32_t *tris);
 /* Equal bit for bit, except that any NaN equals any NaN. */
 bool test_same_double(double a, double b);
 /* Same counts, vertices (test_same_double) and triangles; false if either is NULL. */

@@ -42,6 +42,8 @@
  *                             mci_split_flat_triangles    rounding_repair.c  -
  *     touching parts          mci_split_touching          manifold_split.c   -
  *     void shells             mci_drop_void_shells        void_shells.c      -
+ *     copies rounding made    mci_separate_welded_copies  separate_copies.c  -
+ *       touch, moved apart
  *     guarantees checked      mci_check_output            output_check.c     -
  *   rounding broke them       mci_reevaluate_rounded      reevaluate.c       -
  *
@@ -79,6 +81,7 @@
 #include "csg/output_check.h"
 #include "csg/reevaluate.h"
 #include "csg/rounding_repair.h"
+#include "csg/separate_copies.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
 #include <stdlib.h>
@@ -487,14 +490,42 @@ static mcsg_status drop_void_shells(eval_state *e, mcsg_mesh *out, uint32_t *kep
     return MCSG_OK;
 }
 
-/* The result against its guarantees, as the next program sees it (output_check.h). */
-static mcsg_status check_output(eval_state *e, const mcsg_mesh *out, const rounded *r,
-                                mcsg_error *err)
+/* Where the exact result touches itself (e->touching: edges allowed more than two
+ * triangles once welded). */
+static mcsg_status list_touching(eval_state *e, const rounded *r, mcsg_error *err)
 {
     mci_exact_result exact = {e->kept.tris, e->kept.count, r->dense, r->xyz, NULL, 0};
     if (!mci_list_touching_edges(&e->ctx, &exact, &e->touching, &e->touching_count))
         return mci_fail_nomem(err, "checking the result");
-    exact = (mci_exact_result){NULL, 0, NULL, NULL, e->touching, e->touching_count};
+    return MCSG_OK;
+}
+
+static mci_exact_result touching_of(const eval_state *e)
+{
+    return (mci_exact_result){NULL, 0, NULL, NULL, e->touching, e->touching_count};
+}
+
+/* Parts that rounding made touch along an edge are moved apart (separate_copies.c). */
+static mcsg_status separate_copies(eval_state *e, mcsg_mesh *out, mcsg_error *err)
+{
+    mci_exact_result exact = touching_of(e);
+    mci_copy_separation sep;
+    if (e->stats.touching_vertices_split == 0) /* no two vertices share coordinates */
+        return MCSG_OK;
+    if (!mci_separate_welded_copies(&e->ctx, out, &exact, &sep))
+        return mci_fail_nomem(err, "assembling the result");
+    e->stats.rounding_separated_vertices = sep.moved;
+    if (sep.moved > 0)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "%zu vertices moved by one unit in the last place to "
+                "separate parts that rounding made touch along %zu edges", sep.moved,
+                sep.edges);
+    return MCSG_OK;
+}
+
+/* The result against its guarantees, as the next program sees it (output_check.h). */
+static mcsg_status check_output(eval_state *e, const mcsg_mesh *out, mcsg_error *err)
+{
+    mci_exact_result exact = touching_of(e);
     return mci_check_output(&e->ctx, out, &exact, &e->stats.output_check, err);
 }
 
@@ -533,7 +564,11 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
     if (st == MCSG_OK)
         st = drop_void_shells(e, out, kept_tri, err);
     if (st == MCSG_OK)
-        st = check_output(e, out, &r, err);
+        st = list_touching(e, &r, err);
+    if (st == MCSG_OK)
+        st = separate_copies(e, out, err);
+    if (st == MCSG_OK)
+        st = check_output(e, out, err);
     if (st == MCSG_OK && provenance)
         st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
     if (st != MCSG_OK)

@@ -196,6 +196,35 @@ static bool check_welded(const mci_ctx *ctx, const mcsg_mesh *m, const mci_exact
     return ok;
 }
 
+bool mci_welded_overfull_edges(const mci_ctx *ctx, const mcsg_mesh *m,
+                               const mci_exact_result *x, uint32_t *canon, uint64_t **edges,
+                               size_t *n)
+{
+    size_t count = 0, touching_count = 0;
+    edge_counts c = {0, 0, 0};
+    edge_ends *touching = NULL;
+    uint64_t *keys = NULL;
+    bool ok = m->vertex_count < MAX_PACKED_ID &&
+              mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, canon) &&
+              (keys = sorted_edges(ctx, m->triangles, m->triangle_count, canon,
+                                   m->vertex_count, &count)) != NULL &&
+              (touching = exact_touching_edges(ctx, x, &touching_count)) != NULL;
+    *n = 0;
+    if (ok)
+        count_edges(keys, count, m->vertex_count, &c);
+    for (size_t i = 0; ok && i < c.overfull; i++) {
+        uint32_t u = (uint32_t)(keys[i] >> 32), v = (uint32_t)keys[i];
+        edge_ends key = ends_of(m->vertices + 3 * (size_t)u, m->vertices + 3 * (size_t)v);
+        if (!bsearch(&key, touching, touching_count, sizeof key, compare_ends))
+            keys[(*n)++] = keys[i];
+    }
+    mci_free(ctx, touching);
+    if (!ok)
+        mci_free(ctx, keys);
+    *edges = ok ? keys : NULL;
+    return ok;
+}
+
 /* The indexed view: every edge used once in each direction. */
 static bool check_indexed(const mci_ctx *ctx, const mcsg_mesh *m, mcsg_output_check *check)
 {

@@ -30,6 +30,16 @@ typedef struct mci_exact_result {
 bool mci_list_touching_edges(const mci_ctx *ctx, const mci_exact_result *exact, double **ends,
                              size_t *n);
 
+/* The edges of m with more than two triangles once its vertices are welded by
+ * coordinates, where the exact result does not touch itself (what the check counts in
+ * welded_nonmanifold_edges): keys u << 32 | v of welded ids u < v, sorted, in *edges
+ * (allocated with ctx; *n of them), where canon[i] (room for m's vertices) is set to the
+ * welded id of vertex i: the first vertex with its coordinates. False when out of memory
+ * or with 2^31 vertices or more. */
+bool mci_welded_overfull_edges(const mci_ctx *ctx, const mcsg_mesh *m,
+                               const mci_exact_result *x, uint32_t *canon, uint64_t **edges,
+                               size_t *n);
+
 /* Fills *check for mesh m (see mcsg_output_check); crossings only when
  * ctx->check_output_crossings. Fails only when out of memory. */
 mcsg_status mci_check_output(const mci_ctx *ctx, const mcsg_mesh *m,

@@ -17,6 +17,7 @@
  * Not detected: coplanar triangles with one common vertex whose edges overlap along a
  * segment while their interiors stay apart.
  */
+#include "csg/self_intersect.h"
 #include "csg/octree.h"
 #include "exact/predicates.h"
 #include "exact/tri_tri.h"
@@ -83,7 +84,7 @@ static bool coplanar_boundaries_meet(const double *const a[3], const double *con
     return false;
 }
 
-static bool pair_intersects(const mcsg_mesh *m, uint32_t s, uint32_t t)
+bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t)
 {
     const double *a[3] = {vertex(m, s, 0), vertex(m, s, 1), vertex(m, s, 2)};
     const double *b[3] = {vertex(m, t, 0), vertex(m, t, 1), vertex(m, t, 2)};
@@ -147,7 +148,7 @@ mcsg_status mcsg_mesh_self_intersections(const mcsg_mesh *mesh, const mcsg_optio
     for (size_t i = 0; st == MCSG_OK && i < n; i++) {
         uint32_t s = (uint32_t)(candidates[i] >> 32);
         uint32_t t = (uint32_t)candidates[i] - (uint32_t)mesh->triangle_count;
-        if (s >= t || !pair_intersects(mesh, s, t))
+        if (s >= t || !mci_triangles_cross(mesh, s, t))
             continue;
         if (count++ == 0 && example)
             example[0] = s, example[1] = t;

@@ -1,0 +1,15 @@
+/*
+ * The exact test of mcsg_mesh_self_intersections for one pair of a mesh's triangles
+ * (csg/self_intersect.c), for callers that test a few pairs of their own.
+ */
+#ifndef MESHCSG_CSG_SELF_INTERSECT_H
+#define MESHCSG_CSG_SELF_INTERSECT_H
+
+#include "base/core.h"
+
+/* Whether triangles s and t of m meet anywhere other than in the vertices and the edge
+ * they share, vertices identified by coordinates (the rules of self_intersect.c); false
+ * when either has zero area. */
+bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t);
+
+#endif
