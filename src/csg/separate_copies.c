@@ -336,11 +336,19 @@ static bool move_is_valid(const separator *s, size_t first, size_t end, const in
         if (turn_along(s->m, t, before[i - first][1]) != before[i - first][0])
             return false;
     }
-    for (size_t i = first; i < end; i++)
-        for (size_t j = near_first; j < s->nnear && s->near[j].key == c; j++)
-            if (s->near[j].ref != s->incident[i].ref &&
-                mci_triangles_cross(s->m, s->incident[i].ref, s->near[j].ref))
+    for (size_t i = first; i < end; i++) {
+        uint32_t t = s->incident[i].ref;
+        double box[6], other[6];
+        triangle_box(s->m, t, box);
+        for (size_t j = near_first; j < s->nnear && s->near[j].key == c; j++) {
+            uint32_t u = s->near[j].ref;
+            if (u == t)
+                continue;
+            triangle_box(s->m, u, other); /* closed triangles meet only if their boxes do */
+            if (boxes_meet(box, other) && mci_triangles_cross(s->m, t, u))
                 return false;
+        }
+    }
     return true;
 }
 
