@@ -528,8 +528,10 @@ typedef struct mcsg_eval_stats {
                                           opposite twin when distinct exact vertices that
                                           round to the same doubles were joined */
     size_t rounding_split_triangles; /* rounded to three collinear corners and removed by
-                                        splitting the neighbour at the middle corner */
-    size_t rounding_flat_triangles;  /* rounded flat and left (neighbour flat as well) */
+                                        splitting the neighbour at the middle corner (two
+                                        back to back: their sides zipped) */
+    size_t rounding_flat_triangles;  /* rounded flat and left (a neighbour flat as well,
+                                        not back to back along one segment) */
     size_t rounding_turned_triangles; /* thin triangles that rounding turned over (a
                                          corner moved across the opposite edge), removed
                                          by splitting the neighbour at that corner */

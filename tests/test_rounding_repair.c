@@ -1,7 +1,8 @@
 /*
  * What rounding to doubles breaks, mended on hand-built meshes:
  *   - a flat triangle (three collinear corners) and a thin one folded onto its
- *     neighbour (rounding_repair.c: the neighbour is split at the middle corner);
+ *     neighbour (rounding_repair.c: the neighbour is split at the middle corner), and two
+ *     flat triangles back to back (zipped);
  *   - two parts touching along an edge that the exact result keeps apart
  *     (separate_copies.c: vertex copies moved apart by one unit in the last place).
  */
@@ -84,6 +85,36 @@ TEST(flat_triangle_is_removed_by_splitting_its_neighbour)
 TEST(folded_triangle_is_removed_by_splitting_its_neighbour)
 {
     repair_dent(0x1p-50, 0, 1);
+}
+
+/* The tetrahedron's edge a-b opened into a sliver of zero width: face (a, b, c) split at
+ * m, face (b, a, d) at x, both on segment a-b, closed by the flat triangles (b, m, a) and
+ * (a, x, b) back to back. Neither flat triangle's neighbour across a-b can be split (it
+ * is the other); the pair goes, and the sides are zipped by splitting (a, m, c) at x and
+ * (b, x, d) at m. */
+TEST(back_to_back_flat_triangles_are_zipped)
+{
+    enum { ZA, ZB, ZC, ZD, ZM, ZX, ZIP_POINTS };
+    const double corners[ZIP_POINTS][3] = {{1, 0, 0}, {3, 0, 0}, {2, 1, 2},
+                                           {2, 2, 0}, {2, 0, 0}, {1.5, 0, 0}};
+    uint32_t tris[] = {ZA, ZM, ZC, ZM, ZB, ZC, ZB, ZX, ZD, ZX, ZA, ZD,
+                       ZB, ZD, ZC, ZA, ZC, ZD, ZB, ZM, ZA, ZA, ZX, ZB};
+    double xyz[3 * ZIP_POINTS];
+    mcsg_mesh m = {.vertices = xyz, .vertex_count = ZIP_POINTS, .triangles = tris,
+                   .triangle_count = 8};
+    mci_ctx ctx;
+    mci_flat_repair r;
+    mci_ctx_init(&ctx, NULL);
+    memcpy(xyz, corners, sizeof corners);
+    CHECK_EQ_SIZE(test_index_manifold_defects(&m), 0);
+    CHECK_EQ_SIZE(degenerate_triangles(xyz, tris, 8), 2);
+    CHECK(mci_split_flat_triangles(&ctx, xyz, tris, NULL, 8, NULL, &r));
+    CHECK_EQ_SIZE(r.split, 2);
+    CHECK_EQ_SIZE(r.remaining, 0);
+    CHECK_EQ_SIZE(degenerate_triangles(xyz, tris, 8), 0);
+    CHECK_EQ_SIZE(test_index_manifold_defects(&m), 0);
+    CHECK_MSG(fabs(test_signed_volume(&m) - 4.0 / 3) < 1e-12, "volume %.17g",
+              test_signed_volume(&m));
 }
 
 TEST(opposite_twins_cancel)
@@ -205,6 +236,7 @@ int main(void)
 {
     RUN(flat_triangle_is_removed_by_splitting_its_neighbour);
     RUN(folded_triangle_is_removed_by_splitting_its_neighbour);
+    RUN(back_to_back_flat_triangles_are_zipped);
     RUN(opposite_twins_cancel);
     RUN(copies_that_rounding_made_touch_are_moved_apart);
     RUN(copies_where_the_exact_result_touches_stay);

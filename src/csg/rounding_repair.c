@@ -6,8 +6,11 @@
  * (p, q, X), is split at m into (p, m, X) and (m, q, X), which replace the flat triangle
  * and that neighbour. The mesh stays closed and consistently oriented, the triangle count
  * does not change, and both new triangles lie in the neighbour's plane with the
- * neighbour's orientation, so they are not flat unless the neighbour was (then the flat
- * triangle is left as it is and counted).
+ * neighbour's orientation, so they are not flat unless the neighbour was. Where the
+ * neighbour is flat as well, with its middle corner X also on p-q (a sliver of zero
+ * width), both go and the two sides are zipped: the triangle next to each across the
+ * segment that holds the other's middle corner is split there, the halves taking the
+ * two flat triangles' slots. Other flat triangles are left as they are and counted.
  *
  * The same split mends a thin triangle whose corner m rounding moved across the opposite
  * edge p-q: the triangle then turns the other way than its exact original (seen along
@@ -348,51 +351,120 @@ static bool has_twin(const uint32_t *tris, const edge_index *x, uint32_t u, uint
     return false;
 }
 
-/* One pass over the suspects: split the neighbours of marked triangles whose neighbour
- * is not flat and not already changed in this pass. Returns how many were removed (each
- * mended triangle and its split neighbour in changed[]), the turned or folded ones among
- * them in *turned, and
- * sets *twins when a new half has an opposite twin. */
-static size_t split_pass(const double *xyz, uint32_t *tris, uint32_t *source,
-                         const uint32_t *suspect, size_t ns, const edge_index *x,
-                         unsigned char *touched, const unsigned char *mark,
-                         const mci_expected_turns *turns, uint32_t *changed, size_t *turned,
-                         bool *twins)
+/* What a pass reads and writes. */
+typedef struct pass_state {
+    const double *xyz;
+    uint32_t *tris, *source;
+    const edge_index *x;
+    unsigned char *touched;
+    const unsigned char *mark;
+    const mci_expected_turns *turns;
+    uint32_t *changed; /* the triangles changed, *nchanged of them */
+    size_t nchanged, turned;
+    bool twins;
+} pass_state;
+
+static void note_changed(pass_state *ps, uint32_t t)
 {
-    size_t fixed = 0;
-    for (size_t k = 0; k < ns; k++) {
-        size_t t = suspect[k];
-        uint32_t *T = tris + 3 * t, *N, p, q, m, n, third, a[3], b[3];
-        int i;
-        if (mark[t] == GOOD || touched[t])
-            continue;
-        i = split_corner(xyz, T, mark[t], source ? source[t] : 0, turns);
-        if (i < 0)
-            continue;
-        m = T[i];
-        q = T[(i + 1) % 3];
-        p = T[(i + 2) % 3];
-        n = neighbour_with_edge(x->edges, x->count, p, q, touched, mark);
-        if (n == MCI_NONE)
-            continue;
-        N = tris + 3 * (size_t)n;
-        third = third_corner(N, p, q);
-        a[0] = p, a[1] = m, a[2] = third;
-        b[0] = m, b[1] = q, b[2] = third;
-        if (mark[t] != FLAT &&
-            !halves_turn_right(xyz, a, b, N, source ? source[n] : 0, mark[t], turns))
-            continue;
-        *twins = *twins || has_twin(tris, x, m, p, third) || has_twin(tris, x, q, m, third);
-        memcpy(T, a, sizeof a);
-        memcpy(N, b, sizeof b);
-        if (source)
-            source[t] = source[n];
-        touched[t] = touched[n] = 1;
-        changed[2 * fixed] = (uint32_t)t;
-        changed[2 * fixed++ + 1] = n;
-        *turned += mark[t] != FLAT;
+    ps->touched[t] = 1;
+    ps->changed[ps->nchanged++] = t;
+}
+
+/* The untouched, not flat triangle holding directed edge u->v, with its third corner
+ * strictly off the line (it splits into two triangles of nonzero area), or MCI_NONE. */
+static uint32_t splittable_with_edge(const pass_state *ps, uint32_t u, uint32_t v)
+{
+    return neighbour_with_edge(ps->x->edges, ps->x->count, u, v, ps->touched, ps->mark);
+}
+
+/* Split triangle n, which holds directed edge u->w, at z (strictly inside segment u-w)
+ * into (u, z, Y) in place and (z, w, Y) in slot `into`. */
+static void split_at(pass_state *ps, uint32_t n, uint32_t u, uint32_t w, uint32_t z, uint32_t into)
+{
+    uint32_t *N = ps->tris + 3 * (size_t)n, Y = third_corner(N, u, w);
+    const uint32_t a[3] = {u, z, Y}, b[3] = {z, w, Y};
+    ps->twins = ps->twins || has_twin(ps->tris, ps->x, z, u, Y) ||
+                has_twin(ps->tris, ps->x, w, z, Y);
+    memcpy(N, a, sizeof a);
+    memcpy(ps->tris + 3 * (size_t)into, b, sizeof b);
+    if (ps->source)
+        ps->source[into] = ps->source[n];
+}
+
+/* Flat triangle t = (p, m, q) order-free, with middle corner m, whose neighbour n across
+ * its long edge (holding p->q) is flat too, with middle corner X: the two are a sliver
+ * of zero width along p-q. Both go, and the two sides are zipped: where m and X lie in
+ * the order p, m, X, q, t's neighbour across m->q is split at X and n's across X->p at
+ * m (p, X, m, q: t's across p->m at X, n's across q->X at m), the new halves taking t's
+ * and n's slots. Returns 2 when done, 0 when a triangle to split is flat or taken. */
+static size_t zip_flat_pair(pass_state *ps, uint32_t t, uint32_t p, uint32_t q, uint32_t m)
+{
+    const double *P = at(ps->xyz, p), *Q = at(ps->xyz, q);
+    uint32_t n = MCI_NONE, X, s1, s2;
+    bool m_first;
+    for (size_t i = mci_find_key(ps->x->edges, ps->x->count, directed_key(p, q));
+         n == MCI_NONE && i < ps->x->count && ps->x->edges[i].key == directed_key(p, q); i++)
+        if (!ps->touched[ps->x->edges[i].ref] && ps->mark[ps->x->edges[i].ref] == FLAT)
+            n = ps->x->edges[i].ref;
+    if (n == MCI_NONE)
+        return 0;
+    X = third_corner(ps->tris + 3 * (size_t)n, p, q);
+    if (X == m || ps->tris[3 * (size_t)n + middle_corner(ps->xyz, ps->tris + 3 * (size_t)n)] != X)
+        return 0;
+    m_first = lex_less(at(ps->xyz, m), at(ps->xyz, X)) == lex_less(P, Q);
+    s1 = m_first ? splittable_with_edge(ps, q, m) : splittable_with_edge(ps, m, p);
+    s2 = m_first ? splittable_with_edge(ps, p, X) : splittable_with_edge(ps, X, q);
+    if (s1 == MCI_NONE || s2 == MCI_NONE || s1 == s2)
+        return 0;
+    if (m_first) {
+        split_at(ps, s1, q, m, X, t);
+        split_at(ps, s2, p, X, m, n);
+    } else {
+        split_at(ps, s1, m, p, X, t);
+        split_at(ps, s2, X, q, m, n);
     }
-    return fixed;
+    note_changed(ps, t);
+    note_changed(ps, n);
+    note_changed(ps, s1);
+    note_changed(ps, s2);
+    return 2;
+}
+
+/* Mend suspect t if it is marked: split its neighbour at the moved corner (or zip it with
+ * a flat neighbour). Returns how many triangles went. */
+static size_t mend_one(pass_state *ps, uint32_t t)
+{
+    uint32_t *T = ps->tris + 3 * (size_t)t, *N, p, q, m, n, third, a[3], b[3];
+    unsigned char mark = ps->mark[t];
+    int i;
+    if (mark == GOOD || ps->touched[t])
+        return 0;
+    i = split_corner(ps->xyz, T, mark, ps->source ? ps->source[t] : 0, ps->turns);
+    if (i < 0)
+        return 0;
+    m = T[i];
+    q = T[(i + 1) % 3];
+    p = T[(i + 2) % 3];
+    n = splittable_with_edge(ps, p, q);
+    if (n == MCI_NONE)
+        return mark == FLAT ? zip_flat_pair(ps, t, p, q, m) : 0;
+    N = ps->tris + 3 * (size_t)n;
+    third = third_corner(N, p, q);
+    a[0] = p, a[1] = m, a[2] = third;
+    b[0] = m, b[1] = q, b[2] = third;
+    if (mark != FLAT && !halves_turn_right(ps->xyz, a, b, N, ps->source ? ps->source[n] : 0,
+                                           mark, ps->turns))
+        return 0;
+    ps->twins = ps->twins || has_twin(ps->tris, ps->x, m, p, third) ||
+                has_twin(ps->tris, ps->x, q, m, third);
+    memcpy(T, a, sizeof a);
+    memcpy(N, b, sizeof b);
+    if (ps->source)
+        ps->source[t] = ps->source[n];
+    note_changed(ps, t);
+    note_changed(ps, n);
+    ps->turned += mark != FLAT;
+    return 1;
 }
 
 /* The triangles under watch: every thin one, and among those the suspects, which the
@@ -458,13 +530,16 @@ static bool one_pass(const mci_ctx *ctx, const double *xyz, uint32_t *tris, uint
     unsigned char *mark = marks, *touched = marks + nt, *retry = marks + 2 * nt;
     edge_index x = {NULL, 0, 0};
     bool ok = index_neighbour_edges(ctx, tris, nt, w->suspect, w->nsuspect, &x);
+    pass_state ps = {xyz, tris, source, &x, touched, mark, turns, w->changed, 0, 0, false};
     *fixed = 0;
     if (ok) {
         for (size_t k = 0; k < w->nsuspect; k++)
             mark[w->suspect[k]] = triangle_mark(xyz, tris, source, &x, w->suspect[k], turns);
-        *fixed = split_pass(xyz, tris, source, w->suspect, w->nsuspect, &x, touched, mark,
-                            turns, w->changed, &result->turned, &result->twins);
-        w->nchanged = 2 * *fixed;
+        for (size_t k = 0; k < w->nsuspect; k++)
+            *fixed += mend_one(&ps, w->suspect[k]);
+        w->nchanged = ps.nchanged;
+        result->turned += ps.turned;
+        result->twins = result->twins || ps.twins;
         result->split += *fixed;
         for (size_t k = 0; k < w->nsuspect; k++) {
             uint32_t t = w->suspect[k];

@@ -3,7 +3,8 @@
  * because they round to the same doubles: pairs of opposite triangles on the same
  * corners cancel, and triangles that rounding made exactly flat (three collinear
  * corners), turned over or folded onto their neighbour are removed by splitting that
- * neighbour across the long edge at the third corner. See rounding_repair.c.
+ * neighbour across the long edge at the third corner (two flat triangles back to back
+ * are zipped). See rounding_repair.c.
  */
 #ifndef MESHCSG_CSG_ROUNDING_REPAIR_H
 #define MESHCSG_CSG_ROUNDING_REPAIR_H
@@ -11,9 +12,10 @@
 #include "base/core.h"
 
 typedef struct mci_flat_repair {
-    size_t split;     /* flat triangles removed (each by splitting a neighbour) */
+    size_t split;     /* flat triangles removed (each by splitting a neighbour, or two
+                         back to back by zipping their sides) */
     size_t turned;    /* triangles turned over, removed the same way */
-    size_t remaining; /* flat triangles left (their neighbour was flat as well) */
+    size_t remaining; /* flat triangles left (a neighbour flat as well, not zippable) */
     bool twins;       /* a new triangle has an opposite twin (mci_cancel_opposite_triangles
                          has work) */
 } mci_flat_repair;
