@@ -92,7 +92,8 @@ typedef struct wanted_keys {
     int log_bits;
 } wanted_keys;
 
-enum { MIN_WANTED_LOG_BITS = 12 };
+/* From 512 bytes to 8 MiB: beyond that, more keys only mean more false hits. */
+enum { MIN_WANTED_LOG_BITS = 12, MAX_WANTED_LOG_BITS = 26 };
 
 static uint32_t wanted_bit(const wanted_keys *w, uint64_t key)
 {
@@ -120,7 +121,7 @@ static bool wanted_init(const mci_ctx *ctx, size_t room, wanted_keys *w)
 {
     w->count = 0;
     w->log_bits = MIN_WANTED_LOG_BITS;
-    while (w->log_bits < 31 && ((size_t)1 << w->log_bits) < 16 * room)
+    while (w->log_bits < MAX_WANTED_LOG_BITS && ((size_t)1 << w->log_bits) < 16 * room)
         w->log_bits++;
     w->keys = mci_malloc_array(ctx, room + 1, sizeof *w->keys);
     w->bits = mci_calloc_array(ctx, ((size_t)1 << w->log_bits) / 64, sizeof *w->bits);
@@ -359,7 +360,7 @@ typedef struct pass_state {
     unsigned char *touched;
     const unsigned char *mark;
     const mci_expected_turns *turns;
-    uint32_t *changed; /* the triangles changed, *nchanged of them */
+    uint32_t *changed; /* the triangles changed, nchanged of them */
     size_t nchanged, turned;
     bool twins;
 } pass_state;
@@ -391,7 +392,7 @@ static void split_at(pass_state *ps, uint32_t n, uint32_t u, uint32_t w, uint32_
         ps->source[into] = ps->source[n];
 }
 
-/* Flat triangle t = (p, m, q) order-free, with middle corner m, whose neighbour n across
+/* Flat triangle t, with middle corner m between p and q, whose neighbour n across
  * its long edge (holding p->q) is flat too, with middle corner X: the two are a sliver
  * of zero width along p-q. Both go, and the two sides are zipped: where m and X lie in
  * the order p, m, X, q, t's neighbour across m->q is split at X and n's across X->p at
