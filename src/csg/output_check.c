@@ -148,26 +148,43 @@ bool mci_list_touching_edges(const mci_ctx *ctx, const mci_exact_result *exact, 
     return list != NULL;
 }
 
-/* The welded overfull edges (keys of welded ids) split into those
- * where the exact result touches itself and the others. False when out of memory. */
-static bool classify_overfull(const mci_ctx *ctx, const mcsg_mesh *m, const uint64_t *over,
-                              size_t overfull, const mci_exact_result *x,
-                              mcsg_output_check *check)
+/* Of the welded overfull edges (keys of welded ids), those where the exact result does
+ * not touch itself are moved to the front of over[], in order; *apart says how many.
+ * False when out of memory. */
+static bool split_overfull(const mci_ctx *ctx, const mcsg_mesh *m, uint64_t *over,
+                           size_t overfull, const mci_exact_result *x, size_t *apart)
 {
     size_t touching_count = 0;
     edge_ends *touching = exact_touching_edges(ctx, x, &touching_count);
+    *apart = 0;
     if (!touching)
         return false;
     for (size_t i = 0; i < overfull; i++) {
         uint32_t u = (uint32_t)(over[i] >> 32), v = (uint32_t)over[i];
         edge_ends key = ends_of(m->vertices + 3 * (size_t)u, m->vertices + 3 * (size_t)v);
-        if (bsearch(&key, touching, touching_count, sizeof key, compare_ends))
-            check->touching_edges++;
-        else
-            check->welded_nonmanifold_edges++;
+        if (!bsearch(&key, touching, touching_count, sizeof key, compare_ends))
+            over[(*apart)++] = over[i];
     }
     mci_free(ctx, touching);
     return true;
+}
+
+/* The welded view: canon[] (welded id per vertex), the edge counts, and the overfull
+ * edges where the exact result does not touch at the front of *keys (*apart of them;
+ * c->overfull in all). False when out of memory or with 2^31 vertices or more. */
+static bool welded_edges(const mci_ctx *ctx, const mcsg_mesh *m, const mci_exact_result *x,
+                         uint32_t *canon, uint64_t **keys, edge_counts *c, size_t *apart)
+{
+    size_t n = 0;
+    bool ok = m->vertex_count < MAX_PACKED_ID &&
+              mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, canon) &&
+              (*keys = sorted_edges(ctx, m->triangles, m->triangle_count, canon,
+                                    m->vertex_count, &n)) != NULL;
+    memset(c, 0, sizeof *c);
+    *apart = 0;
+    if (ok)
+        count_edges(*keys, n, m->vertex_count, c);
+    return ok && (c->overfull == 0 || split_overfull(ctx, m, *keys, c->overfull, x, apart));
 }
 
 /* The welded view: open, misoriented and overfull edges. *copies says whether some
@@ -177,20 +194,16 @@ static bool check_welded(const mci_ctx *ctx, const mcsg_mesh *m, const mci_exact
 {
     uint32_t *canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *canon);
     uint64_t *keys = NULL;
-    size_t n = 0;
-    edge_counts c = {0, 0, 0};
-    bool ok = canon && mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, canon);
+    size_t apart = 0;
+    edge_counts c;
+    bool ok = canon && welded_edges(ctx, m, x, canon, &keys, &c, &apart);
     *copies = false;
     for (size_t v = 0; ok && v < m->vertex_count; v++)
         *copies |= canon[v] != v;
-    ok = ok && (keys = sorted_edges(ctx, m->triangles, m->triangle_count, canon,
-                                    m->vertex_count, &n)) != NULL;
-    if (ok)
-        count_edges(keys, n, m->vertex_count, &c);
     check->open_edges = c.open;
     check->misoriented_edges = c.misoriented;
-    if (ok && c.overfull > 0)
-        ok = classify_overfull(ctx, m, keys, c.overfull, x, check);
+    check->welded_nonmanifold_edges = apart;
+    check->touching_edges = c.overfull - apart;
     mci_free(ctx, canon);
     mci_free(ctx, keys);
     return ok;
@@ -200,28 +213,15 @@ bool mci_welded_overfull_edges(const mci_ctx *ctx, const mcsg_mesh *m,
                                const mci_exact_result *x, uint32_t *canon, uint64_t **edges,
                                size_t *n)
 {
-    size_t count = 0, touching_count = 0;
-    edge_counts c = {0, 0, 0};
-    edge_ends *touching = NULL;
+    edge_counts c;
     uint64_t *keys = NULL;
-    bool ok = m->vertex_count < MAX_PACKED_ID &&
-              mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, canon) &&
-              (keys = sorted_edges(ctx, m->triangles, m->triangle_count, canon,
-                                   m->vertex_count, &count)) != NULL &&
-              (touching = exact_touching_edges(ctx, x, &touching_count)) != NULL;
-    *n = 0;
-    if (ok)
-        count_edges(keys, count, m->vertex_count, &c);
-    for (size_t i = 0; ok && i < c.overfull; i++) {
-        uint32_t u = (uint32_t)(keys[i] >> 32), v = (uint32_t)keys[i];
-        edge_ends key = ends_of(m->vertices + 3 * (size_t)u, m->vertices + 3 * (size_t)v);
-        if (!bsearch(&key, touching, touching_count, sizeof key, compare_ends))
-            keys[(*n)++] = keys[i];
-    }
-    mci_free(ctx, touching);
-    if (!ok)
+    bool ok = welded_edges(ctx, m, x, canon, &keys, &c, n);
+    if (!ok) {
         mci_free(ctx, keys);
-    *edges = ok ? keys : NULL;
+        keys = NULL;
+        *n = 0;
+    }
+    *edges = keys;
     return ok;
 }
 
