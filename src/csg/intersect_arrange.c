@@ -44,17 +44,25 @@ static void free_adjacency(const mci_ctx *ctx, leaf_adjacency *a)
     mci_free(ctx, a->faces);
 }
 
-/* The face having the directed edge w -> u (canonical vertices), or MCI_NONE. */
-static uint32_t face_with_edge(const mcsg_mesh *m, const leaf_adjacency *a, uint32_t w,
-                               uint32_t u)
+/* The face having the directed edge w -> u (canonical vertices), or MCI_NONE; at an edge
+ * of more than two faces (shells of one leaf sharing it), one of the shell of global
+ * face f first: the other half of f's surface there. */
+static uint32_t face_with_edge(const mci_scene *s, const mcsg_mesh *m, const leaf_adjacency *a,
+                               uint32_t w, uint32_t u, uint32_t base, uint32_t f)
 {
+    uint32_t first = MCI_NONE, shell = mci_octree_face_shell(&s->octree, base + f);
     for (uint32_t k = a->start[w]; k < a->start[w + 1]; k++) {
         const uint32_t *t = m->triangles + 3 * (size_t)a->faces[k];
-        for (int i = 0; i < 3; i++)
-            if (a->canon[t[i]] == w && a->canon[t[(i + 1) % 3]] == u)
+        for (int i = 0; i < 3; i++) {
+            if (a->canon[t[i]] != w || a->canon[t[(i + 1) % 3]] != u)
+                continue;
+            if (mci_octree_face_shell(&s->octree, base + a->faces[k]) == shell)
                 return a->faces[k];
+            if (first == MCI_NONE)
+                first = a->faces[k];
+        }
     }
-    return MCI_NONE;
+    return first;
 }
 
 static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const bool *wanted)
@@ -73,7 +81,7 @@ static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const
         if (!wanted[base + f])
             continue;
         for (int i = 0; i < 3; i++) {
-            uint32_t nb = face_with_edge(m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]]);
+            uint32_t nb = face_with_edge(s, m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]], base, f);
             s->neighbour[3 * (size_t)(base + f) + i] = nb == MCI_NONE ? MCI_NONE : base + nb;
         }
     }
