@@ -261,34 +261,46 @@ static void slot_points(const mci_leaf_work *w, size_t k, mci_point *x, mci_poin
     mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, far);
 }
 
+static bool group_seen(const uint32_t *seen, size_t nseen, uint32_t g)
+{
+    for (size_t i = 0; i < nseen; i++)
+        if (seen[i] == g)
+            return true;
+    return false;
+}
+
 /* The winding numbers across separator slot k of region r from region `from` (across
  * the slot's mate), for the leaf whose faces hold it in sep[begin .. end): one step per
- * shell (faces of one group at the separator are one sheet of it). */
+ * sheet. Faces of one group at the separator are one sheet of it, and so is the face
+ * the local test took as the other half of a wedge: in a leaf whose faces are groups
+ * of their own (one that crosses itself), a separator along the edge between two faces
+ * is held by both, and counting each would cross the sheet twice. */
 static mci_wind_sum wind_steps(mci_leaf_work *w, size_t k, size_t begin, size_t end)
 {
     const mci_scene *s = w->s;
     mci_wind_sum sum = {0, 0, false, false};
-    uint32_t seen[8];
+    uint32_t seen[16];
     size_t nseen = 0, k1 = w->mate[k];
     mci_point x, y, far, x1, y1, far1;
     slot_points(w, k, &x, &y, &far);
     slot_points(w, k1, &x1, &y1, &far1);
     for (size_t e = begin; e < end; e++) {
-        uint32_t h = w->sep[e].ref, g = mci_scene_face_group(s, h);
+        uint32_t h = w->sep[e].ref, g = mci_scene_face_group(s, h), partner;
         mci_label to, from;
-        bool repeated = false;
-        for (size_t i = 0; i < nseen; i++)
-            repeated |= seen[i] == g;
-        if (repeated)
+        if (group_seen(seen, nseen, g))
             continue;
-        if (nseen == sizeof seen / sizeof seen[0]) {
+        if (nseen + 2 > sizeof seen / sizeof seen[0]) {
             sum.unknown = true; /* more shells through one curve than looked at */
             break;
         }
         seen[nseen++] = g;
         w->stats->local_tests += 2;
-        to = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h);
-        from = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x1, &y1, &far1, h);
+        to = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h,
+                             &partner);
+        from = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x1, &y1, &far1, h,
+                               NULL);
+        if (partner != MCI_NONE && mci_scene_face_group(s, partner) != g)
+            seen[nseen++] = mci_scene_face_group(s, partner);
         mci_wind_sheet(&sum, from, to);
     }
     return sum;
@@ -362,7 +374,7 @@ static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_un
         for (size_t i = e; i < end && !(only_unknown && to[c] != MCI_LABEL_UNKNOWN); i++) {
             w->stats->local_tests++;
             to[c] = (uint8_t)mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x,
-                                             &y, &far, w->sep[i].ref);
+                                             &y, &far, w->sep[i].ref, NULL);
         }
     }
 }

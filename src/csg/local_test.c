@@ -68,9 +68,10 @@ static mci_label wedge_label(int convex, int s1, int s2, const mci_face_arr *fa,
 /* Label of a piece of face arrangement fa with respect to the leaf of face h, where the
  * piece's edge x-y lies in the closed face h and w is the piece's third vertex. The
  * piece's interior does not meet that leaf's surface (or lies in it), so the side of w
- * near the edge decides. */
+ * near the edge decides. *partner (if not NULL): the face across the edge of h that the
+ * test took as the other half of the wedge, or MCI_NONE. */
 mci_label mci_local_label(const mci_scene *s, const mci_face_arr *fa, const mci_point *x,
-                             const mci_point *y, const mci_point *w, uint32_t h)
+                          const mci_point *y, const mci_point *w, uint32_t h, uint32_t *partner)
 {
     mci_plane p1, p2;
     int wx, wy, common, side1, c;
@@ -79,11 +80,15 @@ mci_label mci_local_label(const mci_scene *s, const mci_face_arr *fa, const mci_
     mci_scene_face_plane(s, h, &p1);
     cx = mci_point_in_triangle(x, &p1, &wx);
     cy = mci_point_in_triangle(y, &p1, &wy);
+    if (partner)
+        *partner = MCI_NONE;
     if (cx == MCI_OUTSIDE || cy == MCI_OUTSIDE)
         return MCI_LABEL_UNKNOWN;
     common = edges_through(cx, wx) & edges_through(cy, wy);
     if (common)
         h2 = s->neighbour[3 * (size_t)h + (common & 1 ? 0 : common & 2 ? 1 : 2)];
+    if (partner)
+        *partner = h2;
     side1 = mci_orient3d(w, &p1);
     if (h2 == MCI_NONE || (c = bend(s, h2, &p1)) == 0)
         return one_face_label(side1, fa, &p1);
