@@ -1317,13 +1317,61 @@ TEST(input_contract_is_checked)
     expect_contract_error(&m, "NaN or infinite coordinates, e.g. vertex 6");
     v[3 * 6] = 1;
     {
-        /* A tetrahedron whose bottom edge 0-1 has its midpoint 4 as a vertex, the gap
-         * closed by the zero-area triangle (0, 4, 1): closed and manifold, but flat. */
-        static const double tv[] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 2, 1, 0, 0};
-        static const uint32_t tt[] = {0, 2, 4, 4, 2, 1, 0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
-        mcsg_mesh sliver = {(double *)tv, (uint32_t *)tt, 5, 6};
+        /* Zero-area triangles that cannot go: edge 0-1 of a tetrahedron has vertex 4 on
+         * one side and 5 on the other, and the two zero-area triangles (0, 4, 1) and
+         * (0, 1, 5) close the gaps back to back: neither has a neighbour to split. */
+        static const double tv[] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 2, 1, 0, 0, 0.5, 0, 0};
+        static const uint32_t tt[] = {0, 2, 4, 4, 2, 1, 0, 4, 1, 0, 5, 3,
+                                      5, 1, 3, 0, 1, 5, 0, 3, 2, 1, 2, 3};
+        mcsg_mesh sliver = {(double *)tv, (uint32_t *)tt, 6, 8};
         expect_contract_error(&sliver, "triangles of zero area (no plane), e.g. triangle 2");
     }
+}
+
+/* Zero-area triangles bound nothing (no solid angle from any point off them) and are
+ * removed before evaluation; one with three distinct corners takes a split of its
+ * neighbour across its long edge with it, so the leaf stays closed. Provenance names
+ * the leaf's own triangles. */
+TEST(zero_area_triangles_are_removed)
+{
+    /* A tetrahedron whose bottom edge 0-1 has its midpoint 4 as a vertex, the gap
+     * closed by the zero-area triangle (0, 4, 1); the triangle (0, 1, 3) across that
+     * edge is split at 4. And a repeated corner: triangle (2, 2, 3) goes alone. */
+    static const double tv[] = {0, 0, 0, 2, 0, 0, 0, 2, 0, 0, 0, 2, 1, 0, 0};
+    static const uint32_t tt[] = {0, 2, 4, 4, 2, 1, 0, 4, 1, 0, 1, 3,
+                                  0, 3, 2, 1, 2, 3, 2, 2, 3};
+    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    double size[3] = {2, 2, 2};
+    mcsg_mesh sliver = {(double *)tv, (uint32_t *)tt, 5, 7}, cube, out;
+    mcsg_tree *tree;
+    mcsg_node_id ids[2], root;
+    mcsg_provenance *prov = NULL;
+    mcsg_check_report r;
+    mcsg_error err;
+    bool named[7] = {false};
+    CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
+    CHECK_OK(mcsg_make_cube(size, 1, NULL, &cube, &err), &err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, &cube, identity, "cube", &ids[0], &err), &err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, &sliver, identity, "sliver", &ids[1], &err), &err);
+    CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, &root, &err), &err);
+    CHECK_OK(mcsg_tree_set_root(tree, root, &err), &err);
+    CHECK_OK(mcsg_eval(tree, NULL, &out, &prov, NULL, &err), &err);
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
+    /* [-1,1]^3 and the tetrahedron x, y, z >= 0, x + y + z <= 2 (4/3) meet in 5/6. */
+    CHECK(mcsg_check_report_is_valid(&r));
+    CHECK_MSG(fabs(r.volume - 8.5) < 1e-12, "volume %.17g", r.volume);
+    for (size_t t = 0; prov && t < out.triangle_count; t++)
+        if (prov[t].leaf == ids[1] && prov[t].face < 7)
+            named[prov[t].face] = true;
+    /* Every face has a part outside the cube (the side (0, 1, 3) as its two halves);
+     * no output triangle comes from a removed one. */
+    CHECK(named[0] && named[1] && named[3] && named[4] && named[5] && !named[2] && !named[6]);
+    CHECK(test_allocation_failures("mcsg_eval, zero-area triangles", eval_under, tree, false) >
+          50);
+    mcsg_free(prov, NULL);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_mesh_free(&cube, NULL);
+    mcsg_tree_free(tree);
 }
 
 /* A leaf whose one shell crosses itself: the unit cube with its corner (1, 1, 1) pushed
@@ -1383,6 +1431,7 @@ int main(void)
     RUN(intersect_reports_progress_and_can_cancel);
     RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
+    RUN(zero_area_triangles_are_removed);
     RUN(leaves_with_several_shells);
     RUN(leaves_with_crossing_shells);
     RUN(leaves_closed_as_chains);

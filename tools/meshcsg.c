@@ -905,8 +905,10 @@ static const cli_command commands[] = {
     {"intersect", "FILE", "intersection curves between the leaves of a CSG file: counts, "
      "per-step times", NULL, intersect_options, 1, 1, cmd_intersect},
     {"eval", "FILE", "evaluate a CSG file (.scad .csg) exactly and write the result",
-     "Every leaf must be closed, oriented and manifold (checked, with a message naming\n"
-     "the leaf). The result is checked too: when rounding to doubles broke a guarantee\n"
+     "Every leaf must be closed: each edge used as often one way as the other (checked,\n"
+     "with a message naming the leaf). A leaf is where its winding number is positive:\n"
+     "several shells, overlapping or nested, are fine; zero-area triangles are removed\n"
+     "with a warning. The result is checked too: when rounding to doubles broke a guarantee\n"
      "(closed, oriented, manifold once vertices are welded by coordinates, no zero-area\n"
      "triangles; no crossing triangles with --check-crossings), a warning says what,\n"
      "the mesh is written all the same, and the exit status is 3.",

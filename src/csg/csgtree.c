@@ -160,11 +160,14 @@ mcsg_status mci_ptree_build(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree
     out->leaf_shells = mci_calloc_array(ctx, n, sizeof *out->leaf_shells);
     out->leaf_crossing = mci_calloc_array(ctx, n, 1);
     out->leaf_mates = mci_calloc_array(ctx, n, sizeof *out->leaf_mates);
+    out->leaf_cleaned = mci_calloc_array(ctx, n, sizeof *out->leaf_cleaned);
+    out->leaf_face_of = mci_calloc_array(ctx, n, sizeof *out->leaf_face_of);
     b.stack = mci_malloc_array(ctx, n, sizeof *b.stack);
     b.done = mci_malloc_array(ctx, n, sizeof *b.done);
     if (!out->nodes || !out->child || !out->leaf_node || !out->leaf_mesh ||
         !out->leaf_source || !out->leaf_winding || !out->leaf_shell || !out->leaf_shells ||
-        !out->leaf_crossing || !out->leaf_mates || !b.stack || !b.done) {
+        !out->leaf_crossing || !out->leaf_mates || !out->leaf_cleaned ||
+        !out->leaf_face_of || !b.stack || !b.done) {
         mci_free(ctx, b.stack);
         mci_free(ctx, b.done);
         mci_ptree_free(ctx, out);
@@ -192,6 +195,14 @@ void mci_ptree_free(const mci_ctx *ctx, mci_ptree *t)
     for (size_t l = 0; t->leaf_mates && l < t->leaf_count; l++)
         mci_edge_mates_free(ctx, &t->leaf_mates[l]);
     mci_free(ctx, t->leaf_mates);
+    for (size_t l = 0; t->leaf_cleaned && l < t->leaf_count; l++) {
+        if (t->leaf_cleaned[l])
+            mci_mesh_free(ctx, t->leaf_cleaned[l]);
+        mci_free(ctx, t->leaf_cleaned[l]);
+        mci_free(ctx, t->leaf_face_of[l]);
+    }
+    mci_free(ctx, t->leaf_cleaned);
+    mci_free(ctx, t->leaf_face_of);
     memset(t, 0, sizeof *t);
 }
 

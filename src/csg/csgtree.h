@@ -74,6 +74,12 @@ typedef struct mci_ptree {
      * ask, mci_check_leaves): its faces are then intersected with each other one by one
      * (see mci_octree_params.face_shell). Such a primitive is a winding one. */
     uint8_t *leaf_crossing;
+    /* Per primitive whose mesh had zero-area triangles: the copy without them that
+     * leaf_mesh then points to (mesh/zero_area.h; owned), and per triangle of the copy,
+     * the triangle of the leaf's own mesh it is part of (for provenance). NULL for the
+     * others. */
+    mcsg_mesh **leaf_cleaned;
+    uint32_t **leaf_face_of;
     size_t leaf_count;
 } mci_ptree;
 

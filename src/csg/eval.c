@@ -538,8 +538,9 @@ static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size
         return mci_fail_nomem(err, "assembling the result");
     for (size_t t = 0; t < n; t++) {
         uint32_t f = e->kept.faces[kept_tri[t]], leaf = o->face_leaf[f];
+        const uint32_t *face_of = e->tree.leaf_face_of[leaf]; /* zero-area ones removed */
         p[t].leaf = e->tree.leaf_source[leaf];
-        p[t].face = f - o->face_base[leaf];
+        p[t].face = face_of ? face_of[f - o->face_base[leaf]] : f - o->face_base[leaf];
     }
     *provenance = p;
     return MCSG_OK;

@@ -1,8 +1,9 @@
 /*
  * The evaluator's input contract, checked before any geometry (docs/robustness.md):
  * every primitive must be closed as a chain (each edge used as often one way as the
- * other, vertices identified by coordinates) with finite coordinates and no zero-area
- * triangles (they have no plane). It may have several shells (paired at edges of more
+ * other, vertices identified by coordinates) with finite coordinates. Zero-area
+ * triangles bound nothing and are removed (mesh/zero_area.h) when they can be; the
+ * primitive is then evaluated as that copy. It may have several shells (paired at edges of more
  * than two triangles, mcsg_check_report), apart, nested, crossing or lying in each other,
  * facing out or in: the primitive's solid is where its winding number is positive.
  * Such primitives are marked for classification by winding numbers
@@ -17,6 +18,7 @@
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
 #include "mesh/validate.h"
+#include "mesh/zero_area.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -76,22 +78,85 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
     }
 }
 
+/* Whether zero-area triangles are the report's first problem (the surface closed, the
+ * coordinates finite): then removing them is worth trying. */
+static bool only_zero_area(const mcsg_check_report *r)
+{
+    return r->degenerate_triangles > 0 && r->out_of_range_indices == 0 &&
+           r->nonfinite_vertices == 0 && r->boundary_edges == 0 && r->unbalanced_edges == 0 &&
+           r->inconsistent_edges == 0;
+}
+
+/* Leaf k's mesh without its zero-area triangles (mesh/zero_area.c) in place of its own,
+ * when they can all go; *removed: how many went (0: the leaf is as it was). */
+static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t *removed,
+                                    mcsg_error *err)
+{
+    mci_ptree *t = job->ptree;
+    mcsg_mesh *copy = mci_malloc_array(job->ctx, 1, sizeof *copy);
+    mci_zero_area res;
+    uint32_t *face_of;
+    *removed = 0;
+    if (!copy || !mci_remove_zero_area(job->ctx, t->leaf_mesh[k], copy, &face_of, &res)) {
+        mci_free(job->ctx, copy);
+        return mci_fail_nomem(err, "checking the leaves");
+    }
+    if (res.left > 0) {
+        mci_free(job->ctx, copy);
+        return MCSG_OK;
+    }
+    t->leaf_cleaned[k] = copy;
+    t->leaf_face_of[k] = face_of;
+    t->leaf_mesh[k] = copy;
+    *removed = res.removed;
+    mci_log(job->ctx, MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
+            "(they bound nothing), %zu neighbour%s split at a middle corner to keep the "
+            "surface closed", t->leaf_source[k],
+            mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
+            mcsg_tree_node_label(job->tree, t->leaf_source[k]), res.removed,
+            res.removed == 1 ? "" : "s", res.split, res.split == 1 ? "" : "s");
+    return MCSG_OK;
+}
+
+/* Leaf k's report and shells (per triangle, in shell[]), after removing its zero-area
+ * triangles if they are its only problem (*mesh: the mesh checked; *shell reallocated). */
+static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_report *report,
+                                uint32_t **shell, mcsg_error *err)
+{
+    mci_edge_mates *mates = &job->ptree->leaf_mates[k];
+    size_t removed;
+    mcsg_status st = mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell,
+                                           mates, err);
+    if (st != MCSG_OK || !only_zero_area(report))
+        return st;
+    if ((st = remove_zero_area(job, k, &removed, err)) != MCSG_OK || removed == 0)
+        return st;
+    mci_free(job->ctx, *shell);
+    mci_edge_mates_free(job->ctx, mates);
+    *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
+                              sizeof **shell);
+    if (!*shell)
+        return mci_fail_nomem(err, "checking the leaves");
+    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, mates, err);
+}
+
 static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 {
     leaf_check_job *job = user;
-    const mcsg_mesh *m = job->ptree->leaf_mesh[k];
+    const mcsg_mesh *m;
     mcsg_node_id node = job->ptree->leaf_source[k];
     const char *label = mcsg_tree_node_label(job->tree, node);
     mcsg_check_report report;
     char problem[400];
-    uint32_t *shell = mci_malloc_array(job->ctx, m->triangle_count + 1, sizeof *shell);
-    mci_edge_mates *mates = &job->ptree->leaf_mates[k];
-    mcsg_status st = shell ? mci_mesh_check_shells(job->ctx, m, &report, shell, mates, err)
+    uint32_t *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
+                                       sizeof *shell);
+    mcsg_status st = shell ? check_shells(job, k, &report, &shell, err)
                            : mci_fail_nomem(err, "checking the leaves");
     if (st != MCSG_OK) {
         mci_free(job->ctx, shell);
         return st;
     }
+    m = job->ptree->leaf_mesh[k];
     describe_problem(m, &report, problem, sizeof problem);
     if (problem[0] == '\0' && report.components > 1) {
         job->ptree->leaf_shell[k] = shell;
