@@ -489,14 +489,15 @@ typedef struct mcsg_provenance {
  * are allowed (the exact result itself touches there). */
 typedef struct mcsg_output_check {
     size_t open_edges;           /* edges of one triangle (welded by coordinates) */
-    size_t misoriented_edges;    /* edges whose triangles face opposite ways */
+    size_t misoriented_edges;    /* edges of two triangles facing opposite ways */
     size_t degenerate_triangles; /* triangles of zero area */
     size_t index_nonmanifold_edges; /* vertex-index edges not used exactly once in each
                                        direction (parts that touch have vertex copies) */
     size_t welded_nonmanifold_edges; /* once vertices are welded by coordinates (as STL
                                         readers, slicers and mesh libraries do), edges of
                                         more than two triangles where the exact result
-                                        does not touch itself: rounding made them */
+                                        does not touch itself (rounding made them), or
+                                        used more often one way than the other */
     size_t touching_edges;       /* the same where the exact result touches itself (two
                                     parts sharing an edge): allowed, not a failure */
     size_t crossing_pairs;       /* pairs of triangles that cross each other, when

@@ -227,6 +227,34 @@ static mcsg_status separate_under(const void *unused, const mcsg_options *opts, 
     return st;
 }
 
+/* The result's check counts as mcsg_mesh_check does: an edge of more than two triangles
+ * used more often one way is non-manifold (never an allowed touch), and only an edge of
+ * two triangles facing the same way is misoriented. Here a tetrahedron with one face
+ * listed again: its three edges have three uses, two one way. */
+TEST(output_check_counts_like_the_mesh_check)
+{
+    static const double points[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const uint32_t corners[4] = {0, 1, 2, 3};
+    mci_exact_result exact = {NULL, 0, NULL, NULL, NULL, 0};
+    mcsg_output_check check;
+    mcsg_check_report report;
+    mcsg_mesh m;
+    mcsg_error err;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mci_mesh_alloc(&ctx, &m, 4, 5, &err), &err);
+    memcpy(m.vertices, points, sizeof points);
+    test_put_tetrahedron(m.vertices, corners, m.triangles);
+    memcpy(m.triangles + 12, m.triangles, 3 * sizeof *m.triangles);
+    CHECK_OK(mci_check_output(&ctx, &m, &exact, &check, &err), &err);
+    CHECK_OK(mcsg_mesh_check(&m, NULL, &report, &err), &err);
+    CHECK_EQ_SIZE(check.welded_nonmanifold_edges + check.touching_edges, report.nonmanifold_edges);
+    CHECK_EQ_SIZE(check.misoriented_edges, report.inconsistent_edges);
+    CHECK(check.welded_nonmanifold_edges == 3 && check.touching_edges == 0 &&
+          check.index_nonmanifold_edges == 3 && mcsg_output_check_failed(&check));
+    mci_mesh_free(&ctx, &m);
+}
+
 TEST(separation_under_failing_allocations_leaks_nothing)
 {
     CHECK(test_allocation_failures("separating copies", separate_under, NULL, false) > 10);
@@ -240,6 +268,7 @@ int main(void)
     RUN(opposite_twins_cancel);
     RUN(copies_that_rounding_made_touch_are_moved_apart);
     RUN(copies_where_the_exact_result_touches_stay);
+    RUN(output_check_counts_like_the_mesh_check);
     RUN(separation_under_failing_allocations_leaks_nothing);
     return test_summary();
 }

@@ -18,7 +18,7 @@
 #include <string.h>
 
 typedef struct edge_counts {
-    size_t open, misoriented, overfull;
+    size_t open, misoriented, unbalanced, overfull;
 } edge_counts;
 
 /* Ids below 2^31: an undirected edge and its direction fit one 64-bit key. */
@@ -51,9 +51,10 @@ static uint64_t *sorted_edges(const mci_ctx *ctx, const uint32_t *tris, size_t c
 }
 
 /* Counts the undirected edges (runs of equal keys but for the direction bit) that are
- * open (one use), misoriented (uses unbalanced between the two directions) and overfull
- * (more than two uses, balanced); the overfull ones are moved to the front of keys as
- * edge keys (smaller id << 32 | larger id). */
+ * open (one use), misoriented (two uses the same way), unbalanced (more than two uses,
+ * more one way: non-manifold, as mcsg_mesh_check counts it, and never an allowed touch)
+ * and overfull (more than two uses, balanced); the overfull ones are moved to the front
+ * of keys as edge keys (smaller id << 32 | larger id). */
 static void count_edges(uint64_t *keys, size_t n, uint64_t ids, edge_counts *c)
 {
     memset(c, 0, sizeof *c);
@@ -65,8 +66,10 @@ static void count_edges(uint64_t *keys, size_t n, uint64_t ids, edge_counts *c)
             continue;
         if (j - i == 1)
             c->open++;
-        else if (2 * backward != j - i)
+        else if (2 * backward != j - i && j - i == 2)
             c->misoriented++;
+        else if (2 * backward != j - i)
+            c->unbalanced++;
         else
             keys[c->overfull++] = (keys[i] >> 1) / ids << 32 | (keys[i] >> 1) % ids;
     }
@@ -202,7 +205,7 @@ static bool check_welded(const mci_ctx *ctx, const mcsg_mesh *m, const mci_exact
         *copies |= canon[v] != v;
     check->open_edges = c.open;
     check->misoriented_edges = c.misoriented;
-    check->welded_nonmanifold_edges = apart;
+    check->welded_nonmanifold_edges = apart + c.unbalanced;
     check->touching_edges = c.overfull - apart;
     mci_free(ctx, canon);
     mci_free(ctx, keys);
@@ -235,7 +238,7 @@ static bool check_indexed(const mci_ctx *ctx, const mcsg_mesh *m, mcsg_output_ch
     if (!keys)
         return false;
     count_edges(keys, n, m->vertex_count, &c);
-    check->index_nonmanifold_edges = c.open + c.misoriented + c.overfull;
+    check->index_nonmanifold_edges = c.open + c.misoriented + c.unbalanced + c.overfull;
     mci_free(ctx, keys);
     return true;
 }
