@@ -915,10 +915,11 @@ static const cli_command commands[] = {
      eval_options, 1, 1, cmd_eval},
     {"repair", "IN", "the solid of one mesh: overlapping shells joined into one, inner "
      "shells dropped, cavities kept",
-     "The mesh's solid is where its winding number is positive. IN must be closed,\n"
-     "oriented and manifold, with no shell crossing itself or touching another\n"
-     "(checked exactly); shells crossing each other are what it resolves. The exit\n"
-     "status is 3 when rounding to doubles broke a guarantee, as for eval.",
+     "The mesh's solid is where its winding number is positive. IN must be closed:\n"
+     "each edge used as often one way as the other. Shells crossing each other or\n"
+     "themselves (tested exactly), nested, sharing edges or faces, are what it\n"
+     "resolves; zero-area triangles are removed with a warning. The exit status is 3\n"
+     "when rounding to doubles broke a guarantee, as for eval.",
      repair_options, 1, 1, cmd_repair},
     {"demo", "", "evaluate the built-in scene (the paper's ring with spheres), print the "
      "step timings and compare with the reference volume", NULL, demo_options, 0, 0,
