@@ -279,8 +279,10 @@ typedef struct mcsg_check_report {
      * triangles at an edge (it meets itself there), they are paired by angle about the
      * edge, each with the one it bounds a wedge of solid with (triangles in one
      * half-plane, such as a sliver folded flat, taken in an order that makes directions
-     * alternate). An edge where directions cannot alternate (surfaces of one shell
-     * crossing at the edge) is counted here: mcsg_eval does not take such a primitive. */
+     * alternate), or, where directions do not alternate (one surface entering another's
+     * wedge), each with a neighbour about the edge running the other way. An edge where
+     * neither works (three or more surfaces of one shell crossing at the edge) is
+     * counted here: mcsg_eval does not take such a primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;
@@ -570,8 +572,8 @@ typedef struct mcsg_eval_stats {
  * Input contract: every non-empty leaf the root reaches must be closed as a chain (with
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
- * coordinates, no shell meeting itself at an edge with more than two triangles whose
- * directions cannot alternate around it (self_touching_edges), and a non-zero volume
+ * coordinates, no shell meeting itself at an edge with more than two triangles that
+ * cannot be paired about it (self_touching_edges), and a non-zero volume
  * when it has one shell. Zero-area triangles bound nothing and are removed first, with a
  * warning (one with three collinear corners splits a neighbour at its middle corner;
  * provenance names the leaf's own triangles); only where two of them lie back to back

@@ -261,20 +261,20 @@ static void slot_points(const mci_leaf_work *w, size_t k, mci_point *x, mci_poin
     mci_leaf_piece_point(w, p, (int)(k % 3 + 2) % 3, far);
 }
 
-static bool group_seen(const uint32_t *seen, size_t nseen, uint32_t g)
+static bool face_seen(const uint32_t *seen, size_t nseen, uint32_t h)
 {
     for (size_t i = 0; i < nseen; i++)
-        if (seen[i] == g)
+        if (seen[i] == h)
             return true;
     return false;
 }
 
 /* The winding numbers across separator slot k of region r from region `from` (across
  * the slot's mate), for the leaf whose faces hold it in sep[begin .. end): one step per
- * sheet. Faces of one group at the separator are one sheet of it, and so is the face
- * the local test took as the other half of a wedge: in a leaf whose faces are groups
- * of their own (one that crosses itself), a separator along the edge between two faces
- * is held by both, and counting each would cross the sheet twice. */
+ * sheet. A separator along an edge of the leaf is held by the faces on both sides, one
+ * sheet: the local test takes them as one wedge, and the face it took as the other
+ * half is not stepped again. Where one shell meets itself at the edge, each of its
+ * wedges is a step of its own (the faces across are mates, see mci_scene.neighbour). */
 static mci_wind_sum wind_steps(mci_leaf_work *w, size_t k, size_t begin, size_t end)
 {
     const mci_scene *s = w->s;
@@ -285,22 +285,22 @@ static mci_wind_sum wind_steps(mci_leaf_work *w, size_t k, size_t begin, size_t 
     slot_points(w, k, &x, &y, &far);
     slot_points(w, k1, &x1, &y1, &far1);
     for (size_t e = begin; e < end; e++) {
-        uint32_t h = w->sep[e].ref, g = mci_scene_face_group(s, h), partner;
+        uint32_t h = w->sep[e].ref, partner;
         mci_label to, from;
-        if (group_seen(seen, nseen, g))
+        if (face_seen(seen, nseen, h))
             continue;
         if (nseen + 2 > sizeof seen / sizeof seen[0]) {
-            sum.unknown = true; /* more shells through one curve than looked at */
+            sum.unknown = true; /* more sheets through one curve than looked at */
             break;
         }
-        seen[nseen++] = g;
+        seen[nseen++] = h;
         w->stats->local_tests += 2;
         to = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k / 3]), &x, &y, &far, h,
                              &partner);
         from = mci_local_label(s, mci_scene_arr_of_face(s, w->pface[k1 / 3]), &x1, &y1, &far1, h,
                                NULL);
-        if (partner != MCI_NONE && mci_scene_face_group(s, partner) != g)
-            seen[nseen++] = mci_scene_face_group(s, partner);
+        if (partner != MCI_NONE)
+            seen[nseen++] = partner;
         mci_wind_sheet(&sum, from, to);
     }
     return sum;

@@ -220,7 +220,7 @@ bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r)
             w->own_front[r] = got.in_front;
             w->own_coin[r] = got.behind - got.in_front;
             w->own_first[r] = got.first_same ==
-                              mci_octree_face_shell(&w->s->octree, w->pface[w->reg_pieces[k]]);
+                              mci_octree_face_group(&w->s->octree, w->pface[w->reg_pieces[k]]);
             return true;
         }
     }

@@ -743,7 +743,8 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
         st = group_shells(e, err);
     if (st == MCSG_OK)
         st = mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, e->alias,
-                                     e->face_group, e->face_shell, &e->scene, err);
+                                     e->face_group, e->face_shell, e->tree.leaf_mates,
+                                     &e->scene, err);
     if (st == MCSG_OK && e->alias)
         st = copies_meet_coplanar_faces(e, &coplanar, err);
     if (st != MCSG_OK || !coplanar)
@@ -753,7 +754,7 @@ static mcsg_status build_scene(eval_state *e, mcsg_error *err)
     e->alias = NULL;
     e->stats.copied_primitives = 0;
     return mci_scene_build_touched(&e->ctx, leaves, e->tree.leaf_count, NULL, e->face_group,
-                                   e->face_shell, &e->scene, err);
+                                   e->face_shell, e->tree.leaf_mates, &e->scene, err);
 }
 
 /* Faces that the result drops whole are found from the pair tests, before anything is

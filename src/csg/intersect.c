@@ -45,7 +45,8 @@ static mcsg_status intersect_scene(const mci_ctx *ctx, mci_scene *s, mcsg_error 
 mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                             size_t leaf_count, mci_scene *scene, mcsg_error *err)
 {
-    mcsg_status st = mci_scene_build_touched(ctx, leaves, leaf_count, NULL, NULL, NULL, scene, err);
+    mcsg_status st = mci_scene_build_touched(ctx, leaves, leaf_count, NULL, NULL, NULL, NULL,
+                                             scene, err);
     if (st != MCSG_OK)
         return st;
     st = mci_scene_arrange(ctx, scene, err);
@@ -59,7 +60,8 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
                                     const uint32_t *face_group, const uint32_t *face_shell,
-                                    mci_scene *scene, mcsg_error *err)
+                                    const mci_edge_mates *leaf_mates, mci_scene *scene,
+                                    mcsg_error *err)
 {
     double t0 = mci_seconds_now();
     mci_octree_params params = {0, 0, NULL, face_group, face_shell};
@@ -67,6 +69,7 @@ mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *
     mcsg_status st;
     memset(scene, 0, sizeof *scene);
     scene->alias = alias;
+    scene->leaf_mates = leaf_mates;
     if (alias) {
         if (!(skip = mci_malloc_array(ctx, leaf_count + 1, 1)))
             return mci_fail_nomem(err, "building the octree");

@@ -10,11 +10,14 @@
 #include "csg/arrange.h"
 #include "csg/octree.h"
 #include "csg/point_values.h"
+#include "mesh/validate.h"
 
 typedef struct mci_scene {
     mci_octree octree;        /* faces have global ids; octree.face_leaf / face_base */
     size_t face_count;
-    uint32_t *neighbour;      /* 3 per face: the face across edge i (corner i to i + 1) */
+    uint32_t *neighbour;      /* 3 per face: the face across edge i (corner i to i + 1); where
+                                 a shell meets itself at the edge, its mate there */
+    const mci_edge_mates *leaf_mates; /* per leaf (mci_ptree.leaf_mates), or NULL */
     uint32_t *arr_of;         /* per face: index in arrs, or MCI_NONE if untouched */
     mci_face_arr *arrs;       /* in increasing face order */
     /* The points the arrangements refer to, besides their own pools: the pair tests'
@@ -73,12 +76,15 @@ mcsg_status mci_scene_build(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
  * each touched face (arr_of, touch lists, neighbours, arr_contact), their records kept
  * in `pending`; alias (NULL: none) names each leaf's stand-in (see mci_scene.alias);
  * face_group and face_shell (NULL: none; see mci_octree_params) let shells of one leaf,
- * and faces of a shell that crosses itself, meet. Faces dropped whole can be decided then
- * (mci_decide_whole_faces), before anything is built for them. */
+ * and faces of a shell that crosses itself, meet; leaf_mates (NULL: none; per leaf, see
+ * mci_ptree.leaf_mates, outliving the scene) pair the faces where a shell meets itself
+ * at an edge. Faces dropped whole can be decided then (mci_decide_whole_faces), before
+ * anything is built for them. */
 mcsg_status mci_scene_build_touched(const mci_ctx *ctx, const mcsg_mesh *const *leaves,
                                     size_t leaf_count, const uint32_t *alias,
                                     const uint32_t *face_group, const uint32_t *face_shell,
-                                    mci_scene *scene, mcsg_error *err);
+                                    const mci_edge_mates *leaf_mates, mci_scene *scene,
+                                    mcsg_error *err);
 
 /* Second, the arrangements from the pending records (then freed): those flagged in
  * arr_dropped (if any) get their corners only, and neither give nor receive points on

@@ -45,24 +45,28 @@ static void free_adjacency(const mci_ctx *ctx, leaf_adjacency *a)
 }
 
 /* The face having the directed edge w -> u (canonical vertices), or MCI_NONE; at an edge
- * of more than two faces (shells of one leaf sharing it), one of the shell of global
- * face f first: the other half of f's surface there. */
+ * of more than two faces, f's mate there where its shell meets itself (`mates`, the
+ * leaf check's pairing by angle), else one of the shell of global face f first: the
+ * other half of f's surface there. */
 static uint32_t face_with_edge(const mci_scene *s, const mcsg_mesh *m, const leaf_adjacency *a,
-                               uint32_t w, uint32_t u, uint32_t base, uint32_t f)
+                               uint32_t w, uint32_t u, uint32_t base, uint32_t f,
+                               const mci_edge_mates *mates)
 {
-    uint32_t first = MCI_NONE, shell = mci_octree_face_shell(&s->octree, base + f);
+    uint32_t first = MCI_NONE, same = MCI_NONE, shell = mci_octree_face_shell(&s->octree, base + f);
     for (uint32_t k = a->start[w]; k < a->start[w + 1]; k++) {
         const uint32_t *t = m->triangles + 3 * (size_t)a->faces[k];
         for (int i = 0; i < 3; i++) {
             if (a->canon[t[i]] != w || a->canon[t[(i + 1) % 3]] != u)
                 continue;
-            if (mci_octree_face_shell(&s->octree, base + a->faces[k]) == shell)
+            if (mates && mci_edge_mates_has(mates, f, a->faces[k]))
                 return a->faces[k];
+            if (same == MCI_NONE && mci_octree_face_shell(&s->octree, base + a->faces[k]) == shell)
+                same = a->faces[k];
             if (first == MCI_NONE)
                 first = a->faces[k];
         }
     }
-    return first;
+    return same != MCI_NONE ? same : first;
 }
 
 static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const bool *wanted)
@@ -70,6 +74,8 @@ static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const
     const mcsg_mesh *m = s->octree.leaves[leaf];
     uint32_t base = s->octree.face_base[leaf];
     leaf_adjacency a = {NULL, NULL, NULL};
+    const mci_edge_mates *mates =
+        s->leaf_mates && s->leaf_mates[leaf].count > 0 ? &s->leaf_mates[leaf] : NULL;
     bool any = false, ok;
     for (uint32_t f = 0; f < m->triangle_count && !any; f++)
         any = wanted[base + f];
@@ -81,7 +87,8 @@ static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const
         if (!wanted[base + f])
             continue;
         for (int i = 0; i < 3; i++) {
-            uint32_t nb = face_with_edge(s, m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]], base, f);
+            uint32_t nb = face_with_edge(s, m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]], base, f,
+                                         mates);
             s->neighbour[3 * (size_t)(base + f) + i] = nb == MCI_NONE ? MCI_NONE : base + nb;
         }
     }

@@ -11,9 +11,10 @@
  * message (its label says which file or primitive it came from, and where in the CSG
  * text) with the first offending edge, triangle or vertex; nothing is evaluated.
  * Shells crossing themselves are looked for only when the options ask (that costs an
- * intersection pass of its own) or when evaluation stops on an internal consistency
- * check; the primitives with one are marked (mci_ptree.leaf_crossing) and evaluated
- * with their faces intersected with each other.
+ * intersection pass of its own), in primitives where a surface of one shell enters
+ * another's wedge at an edge (mci_edge_mates.entering_edges), or when evaluation stops
+ * on an internal consistency check; the primitives with one are marked
+ * (mci_ptree.leaf_crossing) and evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
@@ -69,8 +70,8 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
         format_point(a, sizeof a, m, r->example_self_touching_edge[0]);
         format_point(b, sizeof b, m, r->example_self_touching_edge[1]);
         snprintf(out, size, "not supported: %zu edges where one shell meets itself with "
-                 "more than two triangles that do not alternate in direction around the "
-                 "edge (surfaces crossing there), e.g. from %s to %s", r->self_touching_edges,
+                 "more than two triangles that cannot be paired about the edge (three or "
+                 "more surfaces crossing there), e.g. from %s to %s", r->self_touching_edges,
                  a, b);
     } else if (r->volume_sign == 0 && r->components == 1) {
         snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
@@ -165,12 +166,18 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     }
     mci_free(job->ctx, shell);
     if (problem[0] == '\0') {
-        job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0;
+        /* Where one shell meets itself at an edge, parts of it may lie inside others or
+         * face inward (pair_neighbours in validate.c): only winding numbers tell. */
+        job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0 ||
+                                      job->ptree->leaf_mates[k].count > 0;
         return MCSG_OK;
     }
     return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
                     label[0] ? ", " : "", label, problem);
 }
+
+static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
+                               bool whole, bool only_entering, size_t *count, mcsg_error *err);
 
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
@@ -180,6 +187,11 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptre
     size_t marked;
     if (st == MCSG_OK && ctx->check_self_intersections)
         st = mci_mark_crossing_leaves(ctx, tree, ptree, &marked, err);
+    /* A leaf where one surface of a shell enters another's wedge at an edge (a part
+     * nested in another and joined to it there) often overlaps itself in their common
+     * faces too: such leaves, rare in clean input, are always tested. */
+    else if (st == MCSG_OK)
+        st = scan_leaves(ctx, tree, ptree, false, true, &marked, err);
     return st;
 }
 
@@ -229,7 +241,7 @@ static mcsg_status shell_self_intersections(const mci_ctx *ctx, const mci_ptree 
  * counted in *count; with `whole`, the first leaf any two of whose triangles cross
  * (shells touching each other too) is an INVALID_MESH error instead. */
 static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
-                               bool whole, size_t *count, mcsg_error *err)
+                               bool whole, bool only_entering, size_t *count, mcsg_error *err)
 {
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
@@ -243,7 +255,10 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
         const char *label = mcsg_tree_node_label(tree, node);
         size_t pairs;
         uint32_t example[2];
-        mcsg_status st = shell_self_intersections(ctx, ptree, k, whole, &opts, &pairs, example, err);
+        mcsg_status st;
+        if (only_entering && ptree->leaf_mates[k].entering_edges == 0)
+            continue;
+        st = shell_self_intersections(ctx, ptree, k, whole, &opts, &pairs, example, err);
         if (st != MCSG_OK)
             return st;
         if (pairs > 0 && whole)
@@ -261,7 +276,7 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                      mci_ptree *ptree, size_t *marked, mcsg_error *err)
 {
-    return scan_leaves(ctx, tree, ptree, false, marked, err);
+    return scan_leaves(ctx, tree, ptree, false, false, marked, err);
 }
 
 mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
@@ -274,7 +289,7 @@ mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree
         saved = *err;
     /* Every pair that meets, shells against each other too: the leaf whose surfaces
      * cross or touch is the likeliest cause, and naming it helps more than a bug report. */
-    st = scan_leaves(ctx, tree, ptree, true, &count, &probe);
+    st = scan_leaves(ctx, tree, ptree, true, false, &count, &probe);
     if (st == MCSG_ERR_INVALID_MESH) {
         if (err)
             *err = probe;

@@ -255,8 +255,8 @@ bool mci_ray_windings_on_plane(const mci_ctx *ctx, const mci_point *p, const mci
             if (orientation == 0 || !strictly_inside(p, a, b, c))
                 return true;
             coincident += orientation;
-            if (orientation > 0 && mci_octree_face_shell(o, s->faces[i]) < out->first_same)
-                out->first_same = mci_octree_face_shell(o, s->faces[i]);
+            if (orientation > 0 && mci_octree_face_group(o, s->faces[i]) < out->first_same)
+                out->first_same = mci_octree_face_group(o, s->faces[i]);
         }
     }
     windings_beside(at, beyond, coincident, &out->behind, &out->in_front);

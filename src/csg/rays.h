@@ -31,8 +31,9 @@ bool mci_ray_winding_octree(const mci_ctx *ctx, const mci_point *p, const mci_oc
 /* What mci_ray_windings_on_plane tells. */
 typedef struct mci_plane_windings {
     int behind, in_front;
-    uint32_t first_same; /* the lowest shell (mci_octree_face_shell) among the faces
-                          * holding p that face like the plane; UINT32_MAX if none */
+    uint32_t first_same; /* the lowest group (mci_octree_face_group: a shell, or a face
+                          * of a shell crossing itself) among the faces holding p that
+                          * face like the plane; UINT32_MAX if none */
     bool decided;
 } mci_plane_windings;
 

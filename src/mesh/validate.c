@@ -365,35 +365,62 @@ static bool alternate_ties(const edge_use *group, size_t n, const bool *tie, int
     return true;
 }
 
+/* Where directions do not alternate around the edge (one surface of the shell crossing
+ * another there, or lying inside its wedge), the uses in turn order (no two in one
+ * half-plane) paired as neighbours, (0, 1), (2, 3), ... or (1, 2), ..., (n - 1, 0), each
+ * pair one way and the other: two neighbours bound a wedge no other triangle enters,
+ * with equal winding numbers on their sides facing it and on their other sides, so
+ * their pieces may be joined into one region as a solid wedge's are. False when neither
+ * pairing runs both ways in every pair (three surfaces crossing at the edge). */
+static bool pair_neighbours(const edge_use *group, size_t n, const uint8_t *order,
+                            uint8_t *mate)
+{
+    for (size_t phase = 0; phase < 2; phase++) {
+        bool ok = true;
+        for (size_t i = phase; i < n + phase && ok; i += 2)
+            ok = group[order[i % n]].forward != group[order[(i + 1) % n]].forward;
+        for (size_t i = phase; i < n + phase && ok; i += 2) {
+            uint8_t a = order[i % n], b = order[(i + 1) % n];
+            mate[a] = b, mate[b] = a;
+        }
+        if (ok)
+            return true;
+    }
+    return false;
+}
+
 /* Pairs the uses of a balanced edge of more than two triangles by angle, as
  * csg/manifold_split.c pairs the output's: each use from the smaller vertex to the
  * larger with the one just before it in the turn, which must run the other way (the two
  * triangles then bound one solid wedge). Triangles in one half-plane (a sliver folded
  * flat, a face listed twice) may be taken in any order that makes directions alternate;
- * such a pair bounds a wedge of no width. mate[i] is i's partner (positions in group).
- * False when the edge has too many uses or directions that cannot alternate (surfaces
- * crossing at the edge). */
-static bool pair_by_angle(const check_state *s, const edge_use *group, size_t n,
-                          uint8_t *mate)
+ * such a pair bounds a wedge of no width. Where directions cannot alternate and no two
+ * lie in one half-plane, pair_neighbours pairs them. mate[i] is i's partner (positions
+ * in group). 0 when the edge has too many uses or none of these pairings works, 2
+ * when pair_neighbours paired them, else 1. */
+static int pair_by_angle(const check_state *s, const edge_use *group, size_t n,
+                         uint8_t *mate)
 {
     uint8_t order[ANGLE_PAIRING_MAX];
-    bool tie[ANGLE_PAIRING_MAX];
+    bool tie[ANGLE_PAIRING_MAX], ties = false;
     size_t forward = 0;
     int phase = 0;
     for (size_t i = 0; i < n; i++)
         forward += group[i].forward;
     if (n > ANGLE_PAIRING_MAX || 2 * forward != n || !sort_by_angle(s, group, n, order, tie))
-        return false;
+        return 0;
     while (phase < 2 && !alternate_ties(group, n, tie, phase, order))
         phase++;
+    for (size_t i = 0; i < n; i++)
+        ties |= tie[i];
     if (phase == 2)
-        return false;
+        return !ties && pair_neighbours(group, n, order, mate) ? 2 : 0;
     for (size_t i = 0; i < n; i++) {
         uint8_t here = order[i], before = order[(i + n - 1) % n];
         if (group[here].forward)
             mate[here] = before, mate[before] = here;
     }
-    return true;
+    return 1;
 }
 
 /* Joins the triangles of one edge into shells: both of a manifold edge; at a balanced
@@ -467,6 +494,7 @@ static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
     edge_use mine[ANGLE_PAIRING_MAX];
     uint8_t mate[ANGLE_PAIRING_MAX];
     bool done[ANGLE_PAIRING_MAX] = {false};
+    int paired;
     if (n <= 2)
         return true;
     for (size_t i = 0; i < n; i++) {
@@ -479,13 +507,16 @@ static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
                        mci_find_root(s->parent, group[i].tri);
         if (m <= 2)
             continue;
-        if (n > ANGLE_PAIRING_MAX || !pair_by_angle(s, mine, m, mate)) {
+        paired = n > ANGLE_PAIRING_MAX ? 0 : pair_by_angle(s, mine, m, mate);
+        if (!paired) {
             note_edge(s->report->example_self_touching_edge, &s->report->self_touching_edges,
                       group[0].key);
             return true;
         }
         if (s->mates && !add_mates(s, mine, m, mate))
             return false;
+        if (s->mates && paired == 2)
+            s->mates->entering_edges++;
     }
     return true;
 }
@@ -727,6 +758,7 @@ void mci_edge_mates_free(const mci_ctx *ctx, mci_edge_mates *mates)
     mci_free(ctx, mates->pairs);
     mates->pairs = NULL;
     mates->count = 0;
+    mates->entering_edges = 0;
 }
 
 bool mci_edge_mates_has(const mci_edge_mates *mates, uint32_t t, uint32_t u)

@@ -35,6 +35,9 @@ mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
 typedef struct mci_edge_mates {
     uint64_t *pairs;
     size_t count;
+    size_t entering_edges; /* edges where directions do not alternate: a surface of the
+                              shell enters another's wedge there, so the shell may
+                              overlap itself nearby (worth testing for crossings) */
 } mci_edge_mates;
 
 void mci_edge_mates_free(const mci_ctx *ctx, mci_edge_mates *mates);
