@@ -14,6 +14,7 @@
  * point or along an edge have their own vertices.
  */
 #include "csg/void_shells.h"
+#include "exact/predicates.h"
 #include "mesh/validate.h"
 
 #include <math.h>
@@ -285,11 +286,101 @@ static int compare_sizes(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t 
     return sign;
 }
 
+/* Triangles by their three points (ids of equal coordinates, any order): does another
+ * shell have one at the same place? */
+typedef struct place_table {
+    const mcsg_mesh *m;
+    const uint32_t *canon, *shell_of;
+    uint64_t *key;
+    uint32_t *id; /* UINT32_MAX when empty */
+    size_t size;
+} place_table;
+
+static uint64_t place_key(const place_table *p, size_t t)
+{
+    uint32_t c[3];
+    for (int i = 0; i < 3; i++)
+        c[i] = p->canon[p->m->triangles[3 * t + (size_t)i]];
+    for (int i = 0; i < 2; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (c[j] < c[i]) {
+                uint32_t x = c[i];
+                c[i] = c[j], c[j] = x;
+            }
+    return corners_hash(c);
+}
+
+static bool same_place(const place_table *p, size_t t, size_t u)
+{
+    uint32_t a[3], b[3];
+    canonical_corners(p->m, p->canon, t, a);
+    canonical_corners(p->m, p->canon, u, b);
+    return (a[0] == b[0] && a[1] == b[1] && a[2] == b[2]) ||
+           (a[0] == b[0] && a[1] == b[2] && a[2] == b[1]);
+}
+
+static bool build_places(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t *shell_of,
+                         place_table *p)
+{
+    uint32_t *canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *canon);
+    p->m = m, p->canon = canon, p->shell_of = shell_of, p->size = 16;
+    while (p->size < 2 * m->triangle_count)
+        p->size *= 2;
+    p->key = mci_malloc_array(ctx, p->size, sizeof *p->key);
+    p->id = mci_malloc_array(ctx, p->size, sizeof *p->id);
+    if (!canon || !p->key || !p->id ||
+        !mci_first_equal_coordinates(ctx, m->vertices, m->vertex_count, canon))
+        return false;
+    memset(p->id, 0xFF, p->size * sizeof *p->id);
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        uint64_t key = place_key(p, t);
+        size_t slot = key & (p->size - 1);
+        while (p->id[slot] != UINT32_MAX)
+            slot = (slot + 1) & (p->size - 1);
+        p->key[slot] = key, p->id[slot] = (uint32_t)t;
+    }
+    return true;
+}
+
+static void free_places(const mci_ctx *ctx, place_table *p)
+{
+    mci_free(ctx, (void *)p->canon);
+    mci_free(ctx, p->key);
+    mci_free(ctx, p->id);
+}
+
+/* Whether every triangle of shell s lies where a triangle of another shell does (either
+ * way round) or has zero area: then s has no surface of its own, as a sliver that
+ * rounding flattened onto other parts has. */
+static bool shell_covered(const place_table *p, const uint32_t *by_shell, const shell *sh,
+                          size_t s)
+{
+    const mcsg_mesh *m = p->m;
+    for (size_t k = 0; k < sh->count; k++) {
+        size_t t = by_shell[sh->first + k], slot;
+        uint64_t key = place_key(p, t);
+        bool covered = false;
+        for (slot = key & (p->size - 1); p->id[slot] != UINT32_MAX && !covered;
+             slot = (slot + 1) & (p->size - 1))
+            covered = p->key[slot] == key && p->shell_of[m->triangles[3 * (size_t)p->id[slot]]] != s &&
+                      same_place(p, t, p->id[slot]);
+        if (!covered && !mci_triangle_is_degenerate(m->vertices + 3 * (size_t)m->triangles[3 * t],
+                                                    m->vertices + 3 * (size_t)m->triangles[3 * t + 1],
+                                                    m->vertices + 3 * (size_t)m->triangles[3 * t + 2]))
+            return false;
+    }
+    return true;
+}
+
 /* Two triangles with the same corners in the same order face the same way at the same
  * place: the solid lies behind both, covered twice, which no exact result is. Rounding
  * does this when it folds a sliver thinner than the spacing of doubles onto another part
  * of the result, or onto itself. Of two shells folded onto each other, the smaller (exact
- * volumes) is removed. A shell folded onto itself stays: it may be a whole part of the
+ * volumes) is removed if it lies within the other's box (a sliver on that part) or has
+ * no surface of its own (shell_covered); else both stay and the output check reports
+ * the fold: a whole part of the result touching another along a thin triangle that
+ * rounding folded onto the other's is no sliver, and removing it lost that part
+ * silently (fuzz seed 0x64be0023e0c7136b: a cube of volume 54 beside one of 108). A shell folded onto itself stays: it may be a whole part of the
  * result with a sliver folded in (welded vertices join them into one shell), and removing
  * it lost that part (fuzz seed 0x1f709d2716745846: 483 vertices gone); the fold is then
  * left for the output check to report. Marks them in removed; false when out of memory. */
@@ -297,10 +388,12 @@ static bool remove_folds(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t 
                          shell *shells, size_t n, bool *removed, mci_void_shells *result)
 {
     fold_pairs pairs = {NULL, 0, 0};
+    place_table places = {NULL, NULL, NULL, NULL, NULL, 0};
     uint32_t *by_shell = NULL;
     bool ok = find_folds(ctx, m, shell_of, removed, &pairs);
     if (ok && pairs.count > 0)
-        ok = (by_shell = group_by_shell(ctx, m, shell_of, shells, n)) != NULL;
+        ok = (by_shell = group_by_shell(ctx, m, shell_of, shells, n)) != NULL &&
+             build_places(ctx, m, shell_of, &places);
     for (size_t k = 0; ok && k < pairs.count; k++) {
         size_t a = shell_of[m->triangles[3 * (size_t)pairs.v[2 * k]]];
         size_t b = shell_of[m->triangles[3 * (size_t)pairs.v[2 * k + 1]]], victim = n;
@@ -309,6 +402,9 @@ static bool remove_folds(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t 
         if (a != b) {
             int c = compare_sizes(ctx, m, by_shell, &shells[a], &shells[b], &ok);
             victim = c < 0 ? a : c > 0 ? b : a > b ? a : b;
+            if (ok && !box_holds(&shells[victim == a ? b : a], &shells[victim]) &&
+                !shell_covered(&places, by_shell, &shells[victim], victim))
+                victim = n;
         }
         if (ok && victim < n) {
             removed[victim] = true;
@@ -319,6 +415,7 @@ static bool remove_folds(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t 
     }
     mci_free(ctx, pairs.v);
     mci_free(ctx, by_shell);
+    free_places(ctx, &places);
     return ok;
 }
 
