@@ -237,7 +237,8 @@ static void check_scene(scene_case *c, const char *name, bool generic)
         c->leaves[i] = mcsg_tree_leaf_mesh(c->tree, c->ids[i]);
     /* mci_scene_build's steps, to see the arrangements before splitting frees their
      * segments. */
-    CHECK_OK(mci_scene_build_touched(&ctx, c->leaves, c->leaf_count, NULL, NULL, NULL, NULL, &s, &err),
+    CHECK_OK(mci_scene_build_touched(&ctx, c->leaves, c->leaf_count, NULL, NULL, NULL, NULL, &s,
+                                     &err),
              &err);
     CHECK_OK(mci_scene_arrange(&ctx, &s, &err), &err);
     check_contacts(&s, contacts);

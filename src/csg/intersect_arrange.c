@@ -52,7 +52,8 @@ static uint32_t face_with_edge(const mci_scene *s, const mcsg_mesh *m, const lea
                                uint32_t w, uint32_t u, uint32_t base, uint32_t f,
                                const mci_edge_mates *mates)
 {
-    uint32_t first = MCI_NONE, same = MCI_NONE, shell = mci_octree_face_shell(&s->octree, base + f);
+    uint32_t first = MCI_NONE, same = MCI_NONE;
+    uint32_t shell = mci_octree_face_shell(&s->octree, base + f);
     for (uint32_t k = a->start[w]; k < a->start[w + 1]; k++) {
         const uint32_t *t = m->triangles + 3 * (size_t)a->faces[k];
         for (int i = 0; i < 3; i++) {
@@ -60,7 +61,8 @@ static uint32_t face_with_edge(const mci_scene *s, const mcsg_mesh *m, const lea
                 continue;
             if (mates && mci_edge_mates_has(mates, f, a->faces[k]))
                 return a->faces[k];
-            if (same == MCI_NONE && mci_octree_face_shell(&s->octree, base + a->faces[k]) == shell)
+            if (same == MCI_NONE &&
+                mci_octree_face_shell(&s->octree, base + a->faces[k]) == shell)
                 same = a->faces[k];
             if (first == MCI_NONE)
                 first = a->faces[k];
@@ -87,8 +89,8 @@ static bool leaf_neighbours(const mci_ctx *ctx, mci_scene *s, size_t leaf, const
         if (!wanted[base + f])
             continue;
         for (int i = 0; i < 3; i++) {
-            uint32_t nb = face_with_edge(s, m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]], base, f,
-                                         mates);
+            uint32_t nb = face_with_edge(s, m, &a, a.canon[t[(i + 1) % 3]], a.canon[t[i]], base,
+                                         f, mates);
             s->neighbour[3 * (size_t)(base + f) + i] = nb == MCI_NONE ? MCI_NONE : base + nb;
         }
     }

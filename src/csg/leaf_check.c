@@ -3,8 +3,9 @@
  * every primitive must be closed as a chain (each edge used as often one way as the
  * other, vertices identified by coordinates) with finite coordinates. Zero-area
  * triangles bound nothing and are removed (mesh/zero_area.h) when they can be; the
- * primitive is then evaluated as that copy. It may have several shells (paired at edges of more
- * than two triangles, mcsg_check_report), apart, nested, crossing or lying in each other,
+ * primitive is then evaluated as that copy. It may have several shells (paired at
+ * edges of more than two triangles, mcsg_check_report), apart, nested, crossing or
+ * lying in each other,
  * facing out or in: the primitive's solid is where its winding number is positive.
  * Such primitives are marked for classification by winding numbers
  * (mci_ptree.leaf_winding). A leaf that breaks the contract is named in a one-line

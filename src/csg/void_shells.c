@@ -358,15 +358,18 @@ static bool shell_covered(const place_table *p, const uint32_t *by_shell, const 
     const mcsg_mesh *m = p->m;
     for (size_t k = 0; k < sh->count; k++) {
         size_t t = by_shell[sh->first + k], slot;
+        const uint32_t *c = m->triangles + 3 * t;
         uint64_t key = place_key(p, t);
         bool covered = false;
         for (slot = key & (p->size - 1); p->id[slot] != UINT32_MAX && !covered;
-             slot = (slot + 1) & (p->size - 1))
-            covered = p->key[slot] == key && p->shell_of[m->triangles[3 * (size_t)p->id[slot]]] != s &&
-                      same_place(p, t, p->id[slot]);
-        if (!covered && !mci_triangle_is_degenerate(m->vertices + 3 * (size_t)m->triangles[3 * t],
-                                                    m->vertices + 3 * (size_t)m->triangles[3 * t + 1],
-                                                    m->vertices + 3 * (size_t)m->triangles[3 * t + 2]))
+             slot = (slot + 1) & (p->size - 1)) {
+            uint32_t u = p->id[slot];
+            covered = p->key[slot] == key && p->shell_of[m->triangles[3 * (size_t)u]] != s &&
+                      same_place(p, t, u);
+        }
+        if (!covered && !mci_triangle_is_degenerate(m->vertices + 3 * (size_t)c[0],
+                                                    m->vertices + 3 * (size_t)c[1],
+                                                    m->vertices + 3 * (size_t)c[2]))
             return false;
     }
     return true;
@@ -380,8 +383,9 @@ static bool shell_covered(const place_table *p, const uint32_t *by_shell, const 
  * no surface of its own (shell_covered); else both stay and the output check reports
  * the fold: a whole part of the result touching another along a thin triangle that
  * rounding folded onto the other's is no sliver, and removing it lost that part
- * silently (fuzz seed 0x64be0023e0c7136b: a cube of volume 54 beside one of 108). A shell folded onto itself stays: it may be a whole part of the
- * result with a sliver folded in (welded vertices join them into one shell), and removing
+ * silently (fuzz seed 0x64be0023e0c7136b: a cube of volume 54 beside one of 108). A
+ * shell folded onto itself stays: it may be a whole part of the result with a sliver
+ * folded in (welded vertices join them into one shell), and removing
  * it lost that part (fuzz seed 0x1f709d2716745846: 483 vertices gone); the fold is then
  * left for the output check to report. Marks them in removed; false when out of memory. */
 static bool remove_folds(const mci_ctx *ctx, const mcsg_mesh *m, const uint32_t *shell_of,
