@@ -5,8 +5,8 @@
  * triangles bound nothing and are removed (mesh/zero_area.h) when they can be; the
  * primitive is then evaluated as that copy. It may have several shells (paired at
  * edges of more than two triangles, mcsg_check_report), apart, nested, crossing or
- * lying in each other,
- * facing out or in: the primitive's solid is where its winding number is positive.
+ * lying in each other, facing out or in: the primitive's solid is where its winding
+ * number is positive.
  * Such primitives are marked for classification by winding numbers
  * (mci_ptree.leaf_winding). A leaf that breaks the contract is named in a one-line
  * message (its label says which file or primitive it came from, and where in the CSG
