@@ -82,15 +82,16 @@ TEST(collinear_corners_split_the_neighbour)
     free_copy(&out, face_of);
 }
 
+/* Edge 0-1 with 5 and 4 on the bottom side: (0, 5, 4) needs 0 -> 4, which only the
+ * first half of (0, 1, 3) split at 4 has; listed first, it waits for that split. */
+static const uint32_t cascade[] = {0, 5, 4, 0, 2, 5, 5, 2, 4, 4, 2, 1,
+                                   0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+
 TEST(splits_cascade_along_one_edge)
 {
-    /* Edge 0-1 with 5 and 4 on the bottom side: (0, 5, 4) needs 0 -> 4, which only the
-     * first half of (0, 1, 3) split at 4 has; listed first, it waits for that split. */
-    static const uint32_t tris[] = {0, 5, 4, 0, 2, 5, 5, 2, 4, 4, 2, 1,
-                                    0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
     mcsg_mesh out;
     uint32_t *face_of;
-    mci_zero_area res = remove_from(tris, 8, &out, &face_of);
+    mci_zero_area res = remove_from(cascade, 8, &out, &face_of);
     CHECK(res.removed == 2 && res.split == 2 && res.left == 0);
     if (face_of)
         CHECK_EQ_SIZE(from_face(face_of, out.triangle_count, 5), 3);
@@ -111,9 +112,7 @@ TEST(back_to_back_are_left)
 
 static mcsg_status remove_under(const void *unused, const mcsg_options *opts, mcsg_error *err)
 {
-    static const uint32_t tris[] = {0, 5, 4, 0, 2, 5, 5, 2, 4, 4, 2, 1,
-                                    0, 4, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
-    mcsg_mesh m = {(double *)points, (uint32_t *)tris, 6, 8}, out;
+    mcsg_mesh m = {(double *)points, (uint32_t *)cascade, 6, 8}, out;
     uint32_t *face_of;
     mci_zero_area res;
     mci_ctx failing;
