@@ -4,6 +4,7 @@
  */
 #include "base/parallel.h"
 #include "base/sort.h"
+#include "base/sort_template.h"
 #include "csg/intersect_internal.h"
 
 #include <stdlib.h>
@@ -20,8 +21,8 @@ static uint64_t definition_hash(const mci_point *p)
  *      found by hashing, no arithmetic (most shared points are defined identically by
  *      the faces that share them: canonical edge order, canonical TPI plane order);
  *   2. distinct definitions of one point (e.g. a crossing exactly at a vertex) are
- *      found among points whose certified boxes overlap, by a sweep along x, and
- *      joined after an exact equality test;
+ *      found among points whose certified boxes overlap (groups split along the axes
+ *      until no axis splits them) and joined after exact comparisons;
  *   3. numbers follow the first occurrence in (face, local index) order. */
 typedef struct numbering {
     const mci_ctx *ctx;
@@ -159,87 +160,150 @@ static mcsg_status bound_chunk(void *user, size_t begin, size_t end, mcsg_error 
     return MCSG_OK;
 }
 
-/* Sorted by low x (radix), then each run of equal low x by low y: the run's keys become
- * low y << 32 | index. run_end[i] is the first later position with another low x. */
-static void sort_by_low_x_then_y(const boxed_slot *items, uint64_t *order, size_t n,
-                                 uint32_t *run_end)
+static bool boxes_meet(const boxed_slot *a, const boxed_slot *b)
 {
-    for (size_t i = n; i-- > 0;)
-        run_end[i] = i + 1 < n && order[i + 1] >> 32 == order[i] >> 32 ? run_end[i + 1]
-                                                                       : (uint32_t)(i + 1);
-    for (size_t i = 0; i < n; i = run_end[i]) {
-        if (run_end[i] - i < 2)
-            continue;
-        for (size_t k = i; k < run_end[i]; k++)
-            order[k] = (uint64_t)orderable_float(items[(uint32_t)order[k]].lo[1]) << 32 |
-                       (uint32_t)order[k];
-        mci_sort_u64(order + i, run_end[i] - i);
-    }
+    for (int k = 0; k < 3; k++)
+        if (a->lo[k] > b->hi[k] || b->lo[k] > a->hi[k])
+            return false;
+    return true;
 }
 
-static bool boxes_meet_in_yz(const boxed_slot *a, const boxed_slot *b)
-{
-    return !(a->lo[1] > b->hi[1] || b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] ||
-             b->lo[2] > a->hi[2]);
-}
+typedef struct lex_item {
+    const mci_point *p;
+    uint32_t slot;
+} lex_item;
 
-/* Distinct definitions of one point: a sweep along x over the certified boxes, each
- * pair whose boxes overlap tested exactly. Items are sorted by low x, then low y: within
- * a run of equal low x every item overlaps the first in x, and the run is in y order, so
- * its scan stops at the first item beyond the first's y range. Axis-aligned input puts
- * hundreds of points on one x (a column of a grid of holes), which a sweep on x alone
- * compared pairwise (quadratic per column). The joins do not depend on the order, only
- * on the pairs. */
-static void join_overlapping(numbering *nb, const boxed_slot *items, const uint64_t *order,
-                             const uint32_t *run_end, size_t n)
+#define LEX_LESS(a, b) (mci_compare_lex((a)->p, (b)->p) < 0)
+MCI_DEFINE_SORT(sort_lex_items, lex_item, LEX_LESS)
+
+/* Groups up to this size test their overlapping pairs; larger ones sort exactly. */
+enum { PAIRWISE_MAX = 32 };
+
+/* A group that no axis splits (keys: item indices in the low halves): its points are
+ * nearly coincident. A few are compared pair by pair where their boxes overlap; more are
+ * sorted in exact lexicographic order and neighbours compared, since testing every pair
+ * was quadratic where thousands of distinct points nearly coincide (a spindle torus,
+ * whose meridians all cross the axis near one point). */
+static void join_group(numbering *nb, const boxed_slot *items, const uint64_t *keys, size_t k,
+                       lex_item *buffer)
 {
-    for (size_t i = 0; i < n; i++) {
-        const boxed_slot *a = &items[(uint32_t)order[i]];
-        size_t k = i + 1;
-        for (; k < run_end[i]; k++) {
-            const boxed_slot *b = &items[(uint32_t)order[k]];
-            if (b->lo[1] > a->hi[1]) {
-                k = run_end[i];
-                break;
+    if (k <= PAIRWISE_MAX) {
+        for (size_t i = 0; i < k; i++)
+            for (size_t m = i + 1; m < k; m++) {
+                const boxed_slot *a = &items[(uint32_t)keys[i]], *b = &items[(uint32_t)keys[m]];
+                if (boxes_meet(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
+                    join(nb->parent, a->slot, b->slot);
             }
-            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
-                join(nb->parent, a->slot, b->slot);
-        }
-        for (; k < n && items[(uint32_t)order[k]].lo[0] <= a->hi[0]; k++) {
-            const boxed_slot *b = &items[(uint32_t)order[k]];
-            if (boxes_meet_in_yz(a, b) && mci_points_equal(nb->table[a->slot], nb->table[b->slot]))
-                join(nb->parent, a->slot, b->slot);
-        }
+        return;
     }
+    for (size_t i = 0; i < k; i++) {
+        buffer[i].slot = items[(uint32_t)keys[i]].slot;
+        buffer[i].p = nb->table[buffer[i].slot];
+    }
+    sort_lex_items(buffer, k);
+    for (size_t i = 1; i < k; i++)
+        if (mci_points_equal(buffer[i - 1].p, buffer[i].p))
+            join(nb->parent, buffer[i - 1].slot, buffer[i].slot);
+}
+
+/* keys[0 .. n) by the low end of the boxes along axis (ties by item). */
+static bool sort_by_low(const mci_ctx *ctx, const boxed_slot *items, uint64_t *keys, size_t n,
+                        int axis)
+{
+    for (size_t i = 0; i < n; i++)
+        keys[i] = (uint64_t)orderable_float(items[(uint32_t)keys[i]].lo[axis]) << 32 |
+                  (uint32_t)keys[i];
+    if (n > 4096)
+        return mci_radix_sort_u64(ctx, keys, n);
+    mci_sort_u64(keys, n);
+    return true;
+}
+
+/* A run of keys whose boxes chain along the axes tried `unsplit` times in a row. */
+typedef struct group_range {
+    uint32_t begin, end;
+    uint8_t axis, unsplit;
+} group_range;
+
+/* Splits a range sorted along r.axis where the chain of overlapping intervals breaks;
+ * pushes the parts of two or more items (single points equal nothing else). */
+static void split_range(const boxed_slot *items, const uint64_t *keys, group_range r,
+                        group_range *stack, size_t *top)
+{
+    uint8_t next = (uint8_t)((r.axis + 1) % 3);
+    uint32_t start = r.begin;
+    float hi = items[(uint32_t)keys[r.begin]].hi[r.axis];
+    for (uint32_t i = r.begin + 1; i <= r.end; i++) {
+        const boxed_slot *b = i < r.end ? &items[(uint32_t)keys[i]] : NULL;
+        if (b && !(b->lo[r.axis] > hi)) {
+            hi = b->hi[r.axis] > hi ? b->hi[r.axis] : hi;
+            continue;
+        }
+        if (start == r.begin && i == r.end) /* no break: one more axis tried in vain */
+            stack[(*top)++] = (group_range){r.begin, r.end, next, (uint8_t)(r.unsplit + 1)};
+        else if (i - start >= 2)
+            stack[(*top)++] = (group_range){start, i, next, 1};
+        if (b)
+            start = i, hi = b->hi[r.axis];
+    }
+}
+
+/* Distinct definitions of one point: equal points have overlapping certified boxes, so
+ * the items are split recursively where the boxes' intervals along an axis stop
+ * overlapping, until no axis splits a group; each group is then joined. A sweep that
+ * tested every overlapping pair was quadratic in dense groups. The joins depend only on
+ * which points are equal, not on the order. */
+static mcsg_status join_by_splitting(const mci_ctx *ctx, numbering *nb, const boxed_slot *items,
+                                     uint64_t *keys, size_t n, mcsg_error *err)
+{
+    group_range *stack = mci_malloc_array(ctx, n / 2 + 2, sizeof *stack);
+    lex_item *buffer = NULL; /* for the largest group sorted so far */
+    size_t top = 0, capacity = 0;
+    mcsg_status st = stack ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    if (st == MCSG_OK && n >= 2)
+        stack[top++] = (group_range){0, (uint32_t)n, 0, 0};
+    while (st == MCSG_OK && top > 0) {
+        group_range r = stack[--top];
+        size_t k = r.end - r.begin;
+        if (r.unsplit == 3 && k > PAIRWISE_MAX && k > capacity) {
+            mci_free(ctx, buffer);
+            if (!(buffer = mci_malloc_array(ctx, capacity = k, sizeof *buffer)))
+                st = mci_fail_nomem(err, "numbering points");
+        }
+        if (st != MCSG_OK)
+            break;
+        if (r.unsplit == 3)
+            join_group(nb, items, keys + r.begin, k, buffer);
+        else if (!sort_by_low(ctx, items, keys + r.begin, k, r.axis))
+            st = mci_fail_nomem(err, "numbering points");
+        else
+            split_range(items, keys, r, stack, &top);
+    }
+    mci_free(ctx, stack);
+    mci_free(ctx, buffer);
+    return st;
 }
 
 static mcsg_status join_equal_points(const mci_ctx *ctx, numbering *nb, mcsg_error *err)
 {
     size_t roots = 0;
     bounds_job j = {nb, NULL, NULL, 0};
-    uint32_t *run_end;
     mcsg_status st;
     /* Sized for the roots only: most slots are copies. */
     for (uint32_t slot = 0; slot < nb->total; slot++)
         roots += nb->parent[slot] == slot;
     j.items = mci_malloc_array(ctx, roots + 1, sizeof *j.items);
     j.order = mci_malloc_array(ctx, roots + 1, sizeof *j.order);
-    run_end = mci_malloc_array(ctx, roots + 1, sizeof *run_end);
-    st = j.items && j.order && run_end ? MCSG_OK : mci_fail_nomem(err, "numbering points");
+    st = j.items && j.order ? MCSG_OK : mci_fail_nomem(err, "numbering points");
     for (uint32_t slot = 0; st == MCSG_OK && slot < nb->total; slot++)
         if (nb->parent[slot] == slot) /* not a copy of an earlier definition */
             j.items[j.n++].slot = slot;
     if (st == MCSG_OK)
         st = mci_parallel_for_ranges(ctx, j.n, HASH_CHUNK, bound_chunk, &j, err);
-    if (st == MCSG_OK && !mci_radix_sort_u64(ctx, j.order, j.n))
-        st = mci_fail_nomem(err, "numbering points");
-    if (st == MCSG_OK) {
-        sort_by_low_x_then_y(j.items, j.order, j.n, run_end);
-        join_overlapping(nb, j.items, j.order, run_end, j.n);
-    }
+    if (st == MCSG_OK)
+        st = join_by_splitting(ctx, nb, j.items, j.order, j.n, err);
     mci_free(ctx, j.items);
     mci_free(ctx, j.order);
-    mci_free(ctx, run_end);
     return st;
 }
 
