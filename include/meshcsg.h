@@ -550,11 +550,16 @@ typedef struct mcsg_eval_stats {
                                            edge that the exact result keeps apart */
     mcsg_output_check output_check; /* the result against its guarantees; a failure is
                                        also logged as a warning */
-    size_t rounding_reevaluations;  /* rounds of evaluating the rounded result again, alone
-                                       by its winding number, because rounding broke a
-                                       guarantee (docs/robustness.md); at most 3 */
-    int rounding_reevaluation_kept; /* 1 when the result is such a round's, whose check
-                                       passed (output_check is then that round's) */
+    size_t rounding_reevaluations;  /* evaluations of the rounded result (snapped or not)
+                                       again, alone by its winding number, because
+                                       rounding broke a guarantee (docs/robustness.md);
+                                       at most 6 */
+    int rounding_reevaluation_kept; /* 1 when the result is a round's candidate (snapped
+                                       or evaluated again) whose check passed
+                                       (output_check is then that candidate's) */
+    double rounding_snap_grid;      /* when a round's result is kept: the spacing of the
+                                       grid its vertices were snapped to (a power of two
+                                       2^-48 to 2^-40 times the result's size); else 0 */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */
@@ -592,9 +597,10 @@ typedef struct mcsg_eval_stats {
  * not be the intended set; see docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
- * doubles. Then the rounded mesh is evaluated again, alone, by its winding number (up to
- * three rounds; a round whose check passes replaces the result, its provenance mapped
- * back to the tree's leaves; stats->rounding_reevaluations). When none does, the first
+ * doubles. Then the rounded mesh is snapped to a coarser grid and evaluated again, alone,
+ * by its winding number (up to four rounds, docs/robustness.md; the first candidate whose
+ * check passes replaces the result, its provenance mapped back to the tree's leaves;
+ * stats->rounding_reevaluations, rounding_snap_grid). When none does, the first
  * result is still returned with MCSG_OK, the failure is logged as a warning, and
  * mcsg_output_check_failed tells it.
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it

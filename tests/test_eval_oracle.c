@@ -253,7 +253,7 @@ TEST(spindle_torus)
     CHECK(mcsg_tree_add_leaf(tree, &torus, NULL, "spindle torus", &leaf, &err) == MCSG_OK);
     CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
     CHECK_MSG(csg_check_tree(tree, NULL, 0x5b1d1e, true, true, true, &r), "%s", r.why);
-    CHECK(r.checked > 0 && r.inside > 0 && r.inside < r.checked);
+    CHECK_MSG(r.checked > 0 && r.inside > 0 && r.inside < r.checked, "%zu points, %zu checked, %zu inside", r.points, r.checked, r.inside);
     mcsg_tree_free(tree);
 }
 

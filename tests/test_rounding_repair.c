@@ -4,7 +4,8 @@
  *     neighbour (rounding_repair.c: the neighbour is split at the middle corner), and two
  *     flat triangles back to back (zipped);
  *   - two parts touching along an edge that the exact result keeps apart
- *     (separate_copies.c: vertex copies moved apart by one unit in the last place).
+ *     (separate_copies.c: vertex copies moved apart by one unit in the last place);
+ *   - a sliver thinner than a grid's spacing, collapsed by snapping (snap_round.c).
  */
 #include "testlib.h"
 #include "base/core.h"
@@ -12,6 +13,7 @@
 #include "csg/output_check.h"
 #include "csg/rounding_repair.h"
 #include "csg/separate_copies.h"
+#include "csg/snap_round.h"
 #include "exact/predicates.h"
 
 #include <math.h>
@@ -260,6 +262,38 @@ TEST(separation_under_failing_allocations_leaks_nothing)
     CHECK(test_allocation_failures("separating copies", separate_under, NULL, false) > 10);
 }
 
+/* A unit cube and, beside it, a tetrahedron whose fourth corner lies a few units in the
+ * last place off its base's corner c: snapped to a grid of 2^-40, the corner joins c, two
+ * faces get a repeated corner and the other two are the base both ways round. Only the
+ * cube is left, its triangles named by face_of. */
+TEST(sliver_below_the_grid_collapses)
+{
+    double xyz[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1,
+                    3, 0, 0, 4, 0, 0, 3, 1, 0, 3, 1, 0};
+    uint32_t tris[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                       1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7,
+                       8, 10, 9, 8, 9, 11, 9, 10, 11, 10, 8, 11};
+    mcsg_mesh in = {xyz, tris, 12, 16}, out = {0};
+    uint32_t *face_of = NULL;
+    mcsg_error err;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    xyz[3 * 11 + 2] = ldexp(1, -50); /* d = c + (0, 0, 2^-50) */
+    CHECK(mci_snap_exponent(&in, 40) == 3 - 40);
+    CHECK(mci_snap_to_grid(&ctx, &in, -37, &out, &face_of, &err) == MCSG_OK);
+    CHECK(out.triangle_count == 12 && out.vertex_count == 8);
+    for (size_t t = 0; t < out.triangle_count; t++)
+        CHECK(face_of[t] == t);
+    CHECK(fabs(test_signed_volume(&out) - 1) < 1e-12);
+    mci_mesh_free(&ctx, &out);
+    mci_free(&ctx, face_of);
+    /* On a grid finer than the sliver, nothing changes. */
+    CHECK(mci_snap_to_grid(&ctx, &in, -60, &out, &face_of, &err) == MCSG_OK);
+    CHECK(out.triangle_count == 16 && out.vertex_count == 12);
+    mci_mesh_free(&ctx, &out);
+    mci_free(&ctx, face_of);
+}
+
 int main(void)
 {
     RUN(flat_triangle_is_removed_by_splitting_its_neighbour);
@@ -269,6 +303,7 @@ int main(void)
     RUN(copies_that_rounding_made_touch_are_moved_apart);
     RUN(copies_where_the_exact_result_touches_stay);
     RUN(output_check_counts_like_the_mesh_check);
+    RUN(sliver_below_the_grid_collapses);
     RUN(separation_under_failing_allocations_leaks_nothing);
     return test_summary();
 }

@@ -606,10 +606,13 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     if (s->rounding_separated_vertices)
         printf("  touching made by rounding: %zu vertex copies moved apart by one unit in "
                "the last place\n", s->rounding_separated_vertices);
-    if (s->rounding_reevaluations)
+    if (s->rounding_reevaluations || s->rounding_reevaluation_kept)
         printf("  rounding broke a guarantee: the rounded result evaluated again %zu times, "
                "%s\n", s->rounding_reevaluations,
-               s->rounding_reevaluation_kept ? "the last one kept" : "none kept");
+               s->rounding_reevaluation_kept ? "a round's mesh kept" : "none kept");
+    if (s->rounding_snap_grid > 0)
+        printf("  rounding broke a guarantee: vertices snapped to a grid of spacing %g\n",
+               s->rounding_snap_grid);
     printf("  total            %8.3f s\n", s->seconds_total);
 }
 

@@ -931,8 +931,9 @@ static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenanc
         st = mci_progress(&e->ctx, "evaluate rounded result again", 1, err);
     if (st == MCSG_OK && e->stats.rounding_reevaluation_kept)
         mci_log(&e->ctx, MCSG_LOG_INFO, "rounding to doubles broke the result's guarantees; "
-                "the rounded result was evaluated again by its winding number (%zu rounds), "
-                "which keeps them", e->stats.rounding_reevaluations);
+                "the rounded result, snapped to a grid of spacing %g (0: not snapped) and "
+                "evaluated again by its winding number %zu times, keeps them",
+                e->stats.rounding_snap_grid, e->stats.rounding_reevaluations);
     if (st == MCSG_OK)
         mci_log_output_check(&e->ctx, &e->stats.output_check);
     e->stats.seconds_assemble += mci_seconds_now() - t0;

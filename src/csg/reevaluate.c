@@ -1,23 +1,32 @@
 /*
- * Evaluating the rounded result again (reevaluate.h).
+ * Snapping and evaluating the rounded result again (reevaluate.h).
  *
  * Rounding moves each vertex by at most half a unit in the last place, and where the
  * exact result has features thinner than that (a sliver between nearly coplanar faces,
- * two vertices closer than the spacing of doubles) the rounded mesh can fold, weld two
- * parts into an edge of four triangles, or cross itself. The rounded mesh is still
- * closed as a chain, so it is a valid leaf: evaluated alone by its winding number (its
- * shells tested for crossings and cut where they cross, coincident faces of opposite
- * orientation cancelled, edges of four triangles paired by angle), its exact result has
- * none of those defects, and only the new intersection vertices are rounded again. Those
- * can break a guarantee in turn, so a round is kept only when its own check passes, up to
- * three rounds are tried, and otherwise the first result stays (with its report).
+ * vertices closer than the spacing of doubles) the rounded mesh can fold, weld two parts
+ * into an edge of four triangles, or cross itself. The rounded mesh is still closed as a
+ * chain, so it is a valid leaf: evaluated alone by its winding number (its shells tested
+ * for crossings and cut where they cross, coincident faces of opposite orientation
+ * cancelled, edges of four triangles paired by angle), its exact result has none of
+ * those defects, and only the new intersection vertices are rounded again. Those can
+ * break a guarantee in turn where many nearly coincide; snapped to a coarser grid
+ * (snap_round.c) they are one point. Each round tries its starting mesh snapped, the
+ * snapped mesh evaluated again, and the starting mesh evaluated again; the first whose
+ * check passes is kept, and otherwise the first result stays (with its report).
  */
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
+#include "csg/snap_round.h"
 
+#include <math.h>
 #include <string.h>
 
 enum { REEVALUATION_ROUNDS = 3 };
+
+/* The grid each round's starting mesh is snapped to, in bits across the result's largest
+ * coordinate (the last: the last round's result): finer first, each grid's points on the
+ * next one's coarser grid. */
+static const int snap_bits[REEVALUATION_ROUNDS + 1] = {48, 44, 40, 36};
 
 static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
@@ -137,52 +146,147 @@ static mcsg_status round_passes(const mci_ctx *ctx, const mcsg_mesh *first, size
     return s;
 }
 
+/* from (and its sources) snapped to the grid 2^e: *to. */
+static mcsg_status snap_round(const mci_ctx *ctx, const mcsg_mesh *from,
+                              const mcsg_provenance *from_source, bool want_source, int e,
+                              round_state *to, mcsg_error *err)
+{
+    uint32_t *face_of = NULL;
+    mcsg_status s = mci_snap_to_grid(ctx, from, e, &to->mesh, &face_of, err);
+    if (s == MCSG_OK && want_source) {
+        to->source = mci_malloc_array(ctx, to->mesh.triangle_count + 1, sizeof *to->source);
+        if (!to->source)
+            s = mci_fail_nomem(err, "snapping the rounded result to a grid");
+        for (size_t t = 0; s == MCSG_OK && t < to->mesh.triangle_count; t++)
+            to->source[t] = from_source[face_of[t]];
+    }
+    mci_free(ctx, face_of);
+    if (s != MCSG_OK)
+        round_state_free(ctx, to);
+    return s;
+}
+
+/* The touching edges' ends on the grid 2^e (snapping is monotone: still sorted). */
+static double *snap_touching(const mci_ctx *ctx, const double *touching, size_t count, int e)
+{
+    double *snapped = mci_malloc_array(ctx, 6 * count + 1, sizeof *snapped);
+    for (size_t i = 0; snapped && i < 6 * count; i++)
+        snapped[i] = mci_snap_coordinate(touching[i], e);
+    return snapped;
+}
+
+/* Checks candidate; when it passes, it replaces out and *provenance (and is emptied). */
+static mcsg_status keep_if_it_passes(const mci_ctx *ctx, const mci_exact_result *exact,
+                                     size_t *first_pairs, round_state *candidate,
+                                     mcsg_mesh *out, mcsg_provenance **provenance,
+                                     mcsg_eval_stats *stats, bool *kept, mcsg_error *err)
+{
+    mcsg_output_check check;
+    bool passes = false;
+    mcsg_status s = MCSG_OK;
+    *kept = false;
+    if (candidate->mesh.triangle_count == 0)
+        return MCSG_OK; /* a solid result is never kept empty */
+    s = mci_check_output(ctx, &candidate->mesh, exact, &check, err);
+    if (s == MCSG_OK)
+        s = round_passes(ctx, out, first_pairs, &candidate->mesh, &check, &passes, err);
+    if (s != MCSG_OK || !passes)
+        return s;
+    mci_mesh_free(ctx, out);
+    *out = candidate->mesh;
+    if (candidate->source) {
+        mci_free(ctx, *provenance);
+        *provenance = candidate->source;
+    }
+    memset(candidate, 0, sizeof *candidate);
+    stats->output_check = check;
+    stats->output_vertices = out->vertex_count;
+    stats->output_triangles = out->triangle_count;
+    stats->rounding_reevaluation_kept = 1;
+    *kept = true;
+    return MCSG_OK;
+}
+
+/* from evaluated alone and rounded: *next, kept when it passes. */
+static mcsg_status evaluate_round(const mci_ctx *ctx, const round_state *from, bool want_source,
+                                  const mci_exact_result *exact, size_t *first_pairs,
+                                  round_state *next, mcsg_mesh *out,
+                                  mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                                  bool *kept, mcsg_error *err)
+{
+    mcsg_eval_stats st;
+    mcsg_status s = one_round(ctx, &from->mesh, from->source, want_source, next, &st, err);
+    stats->rounding_reevaluations++;
+    if (s == MCSG_OK)
+        s = keep_if_it_passes(ctx, exact, first_pairs, next, out, provenance, stats, kept, err);
+    return s;
+}
+
+/* One round, each step kept if it passes: from snapped to the grid 2^e; when evaluate,
+ * the snapped mesh evaluated alone and rounded, then from itself (the rounds that settled
+ * cases before snapping: example018 moved, whose snapped meshes do not). *next: the last
+ * evaluation, for the next round (empty when both evaluations failed). */
+static mcsg_status snap_and_evaluate(const mci_ctx *ctx, const round_state *from,
+                                     bool want_source, int e, bool evaluate,
+                                     const double *touching, size_t touching_count,
+                                     size_t *first_pairs, round_state *next, mcsg_mesh *out,
+                                     mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                                     bool *kept, mcsg_error *err)
+{
+    double *ends = snap_touching(ctx, touching, touching_count, e);
+    mci_exact_result snapped_exact = {NULL, 0, NULL, NULL, ends, touching_count};
+    mci_exact_result exact = {NULL, 0, NULL, NULL, touching, touching_count};
+    round_state snapped = {{0}, NULL}, from_snapped = {{0}, NULL};
+    mcsg_status s = ends ? snap_round(ctx, &from->mesh, from->source, want_source, e, &snapped,
+                                      err)
+                         : mci_fail_nomem(err, "snapping the rounded result to a grid");
+    memset(next, 0, sizeof *next);
+    if (s == MCSG_OK)
+        s = keep_if_it_passes(ctx, &snapped_exact, first_pairs, &snapped, out, provenance,
+                              stats, kept, err);
+    if (s == MCSG_OK && *kept)
+        stats->rounding_snap_grid = ldexp(1.0, e);
+    if (s == MCSG_OK && !*kept && evaluate && snapped.mesh.triangle_count > 0) {
+        s = evaluate_round(ctx, &snapped, want_source, &snapped_exact, first_pairs,
+                           &from_snapped, out, provenance, stats, kept, err);
+        if (s == MCSG_OK && *kept)
+            stats->rounding_snap_grid = ldexp(1.0, e);
+    }
+    if (s == MCSG_OK && !*kept && evaluate)
+        s = evaluate_round(ctx, from, want_source, &exact, first_pairs, next, out, provenance,
+                           stats, kept, err);
+    if (s == MCSG_OK && next->mesh.triangle_count == 0) {
+        round_state_free(ctx, next);
+        *next = from_snapped;
+    } else {
+        round_state_free(ctx, &from_snapped);
+    }
+    round_state_free(ctx, &snapped);
+    mci_free(ctx, ends);
+    return s;
+}
+
 mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
                                    size_t touching_count, mcsg_mesh *out,
                                    mcsg_provenance **provenance, mcsg_eval_stats *stats,
                                    mcsg_error *err)
 {
-    mci_exact_result exact = {NULL, 0, NULL, NULL, touching, touching_count};
     round_state last = {{0}, NULL}, next;
-    bool want_source = provenance && *provenance, passes = false;
+    bool want_source = provenance && *provenance, kept = false;
     size_t first_pairs = SIZE_MAX;
-    for (int round = 0; round < REEVALUATION_ROUNDS; round++) {
-        mcsg_eval_stats st;
-        mcsg_output_check check;
-        const mcsg_mesh *from = round == 0 ? out : &last.mesh;
-        mcsg_status s;
-        memset(&next, 0, sizeof next);
-        s = one_round(ctx, from, round == 0 ? (want_source ? *provenance : NULL) : last.source,
-                      want_source, &next, &st, err);
-        stats->rounding_reevaluations++;
+    int top = mci_snap_exponent(out, 0);
+    mcsg_status s = MCSG_OK;
+    for (int round = 0; s == MCSG_OK && !kept && round <= REEVALUATION_ROUNDS; round++) {
+        round_state first = {*out, want_source ? *provenance : NULL};
+        const round_state *from = round == 0 ? &first : &last;
+        if (round > 0 && last.mesh.triangle_count == 0)
+            break; /* the last evaluations failed */
+        s = snap_and_evaluate(ctx, from, want_source, top - snap_bits[round],
+                              round < REEVALUATION_ROUNDS, touching, touching_count,
+                              &first_pairs, &next, out, provenance, stats, &kept, err);
         round_state_free(ctx, &last);
-        if (s == MCSG_OK && next.mesh.triangle_count == 0 && out->triangle_count > 0) {
-            round_state_free(ctx, &next);
-            return MCSG_OK; /* the round failed (or emptied a solid result) */
-        }
-        if (s == MCSG_OK)
-            s = mci_check_output(ctx, &next.mesh, &exact, &check, err);
-        if (s == MCSG_OK)
-            s = round_passes(ctx, out, &first_pairs, &next.mesh, &check, &passes, err);
-        if (s != MCSG_OK) {
-            round_state_free(ctx, &next);
-            return s;
-        }
         last = next;
-        if (passes) {
-            mci_mesh_free(ctx, out);
-            *out = last.mesh;
-            if (want_source) {
-                mci_free(ctx, *provenance);
-                *provenance = last.source;
-            }
-            stats->output_check = check;
-            stats->output_vertices = out->vertex_count;
-            stats->output_triangles = out->triangle_count;
-            stats->rounding_reevaluation_kept = 1;
-            return MCSG_OK;
-        }
     }
     round_state_free(ctx, &last);
-    return MCSG_OK;
+    return s;
 }

@@ -1,8 +1,8 @@
 /*
  * When rounding the exact result to doubles broke one of its guarantees (a sliver folded
  * onto a neighbour, parts welded into an edge of four triangles, triangles made to
- * cross): the rounded mesh is evaluated again, exactly, as the only leaf of a union by
- * its winding number, and rounded again. See reevaluate.c.
+ * cross): the rounded mesh is snapped to a coarser grid and evaluated again, exactly, as
+ * the only leaf of a union by its winding number, and rounded again. See reevaluate.c.
  */
 #ifndef MESHCSG_CSG_REEVALUATE_H
 #define MESHCSG_CSG_REEVALUATE_H
@@ -22,13 +22,15 @@ mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_
 
 /* out: mcsg_eval's result, whose check (stats->output_check) failed; provenance (may be
  * NULL) its per-triangle sources; touching[6 * i ..] the rounded ends of the edges where
- * the tree's exact result touches itself (mci_list_touching_edges). Up to a few rounds,
- * each evaluating the last round's mesh alone and checking it with ctx's options, where
- * only those edges may have more than two triangles (a round's own exact result may
- * touch where rounding made parts meet: that still breaks the guarantee). The first
- * round whose check passes replaces out and *provenance (mapped back to the tree's
- * leaves), with stats->output_check and the output counts. When none passes, or a round
- * fails, out is left as it was. Counts the rounds in stats->rounding_reevaluations.
+ * the tree's exact result touches itself (mci_list_touching_edges). Up to four rounds,
+ * each snapping its starting mesh to a grid (finer first), evaluating the snapped mesh
+ * and then the starting mesh alone, and checking each of these with ctx's options, where
+ * only those edges (snapped alike) may have more than two triangles (a round's own exact
+ * result may touch where rounding made parts meet: that still breaks the guarantee). The
+ * first that passes replaces out and *provenance (mapped back to the tree's leaves), with
+ * stats->output_check, the output counts and stats->rounding_snap_grid. When none
+ * passes, or the evaluations fail, out is left as it was. Counts the evaluations in
+ * stats->rounding_reevaluations.
  * Fails only when memory runs out or the check fails (out then as it was). */
 mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
                                    size_t touching_count, mcsg_mesh *out,
