@@ -163,7 +163,7 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, int attem
     double x[3][3], n[3], size = 0, norm = 0;
     int axis, sign, turns[3];
     for (int i = 0; i < 3; i++)
-        mci_point_approx(&c[i], x[i]);
+        mci_point_near(&c[i], x[i]);
     for (int k = 0; k < 3; k++) {
         int i = (k + 1) % 3, j = (k + 2) % 3;
         n[k] = (b[i] - a[i]) * (d[j] - a[j]) - (b[j] - a[j]) * (d[i] - a[i]);

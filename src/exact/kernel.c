@@ -698,6 +698,22 @@ void mci_point_approx(const mci_point *p, double out[3])
     }
 }
 
+void mci_point_near(const mci_point *p, double out[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double q = p->y[k].v / p->w.v, wl = p->w.v - p->w.e;
+        out[k] = p->v[0][k] + q;
+        /* The quotient's error bound against the coordinate: three nearly parallel
+         * planes give a W so uncertain that the quotient is anywhere (a point of a face
+         * computed metres off it). */
+        if (!isfinite(out[k]) || !(wl > 0) ||
+            !(fabs(q) * p->w.e + p->y[k].e <= 0x1p-26 * wl * (fabs(out[k]) + fabs(q)))) {
+            mci_point_round(p, out);
+            return;
+        }
+    }
+}
+
 /* Coordinate k of p correctly rounded, when the filter proves it: base + q is summed
  * exactly as hi + lo (two-sum), q's error bound E is certified, and hi is the nearest
  * double to every value within |lo| + E of it (strictly inside its rounding interval,

@@ -302,6 +302,11 @@ mci_containment mci_point_in_triangle(const mci_point *p, const mci_plane *trian
  * output only after rounding decisions elsewhere, and for display). */
 void mci_point_approx(const mci_point *p, double out[3]);
 
+/* Coordinates of a point within about 2^-26 of their magnitude each: the approximation
+ * where its error bound proves that, else the rounded point (for points that must lie
+ * near the exact one, such as the seeds of rays inside a piece). */
+void mci_point_near(const mci_point *p, double out[3]);
+
 /* The point's coordinates correctly rounded: each is the double nearest to the exact
  * coordinate (ties to even), computed exactly (output vertices). */
 void mci_point_round(const mci_point *p, double out[3]);
