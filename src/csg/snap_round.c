@@ -17,7 +17,6 @@
 #include "csg/snap_round.h"
 #include "csg/manifold_split.h"
 #include "csg/rounding_repair.h"
-#include "base/sort_template.h"
 #include "mesh/zero_area.h"
 
 #include <math.h>
@@ -38,46 +37,27 @@ double mci_snap_coordinate(double x, int e)
     return ldexp(nearbyint(ldexp(x, -e)), e) + 0.0;
 }
 
-typedef struct snapped_vertex {
-    double p[3];
-    uint32_t index;
-} snapped_vertex;
-
-static bool vertex_less(const snapped_vertex *a, const snapped_vertex *b)
-{
-    for (int k = 0; k < 3; k++)
-        if (a->p[k] != b->p[k])
-            return a->p[k] < b->p[k];
-    return a->index < b->index;
-}
-
-MCI_DEFINE_SORT(sort_snapped, snapped_vertex, vertex_less)
-
-/* The snapped vertices, one per grid point in lexicographic order, and id[v] for every
- * input vertex. */
+/* The snapped vertices, one per grid point in order of first use, and id[v] for every
+ * input vertex (canon: room for the input's vertices). */
 static bool weld_snapped(const mci_ctx *ctx, const mcsg_mesh *in, int e, mcsg_mesh *out,
-                         uint32_t *id)
+                         uint32_t *id, uint32_t *canon)
 {
     size_t n = in->vertex_count, count = 0;
-    snapped_vertex *sv = mci_malloc_array(ctx, n + 1, sizeof *sv);
-    out->vertices = mci_malloc_array(ctx, 3 * n + 1, sizeof *out->vertices);
-    if (!sv || !out->vertices) {
-        mci_free(ctx, sv);
+    if (!(out->vertices = mci_malloc_array(ctx, 3 * n + 1, sizeof *out->vertices)))
         return false;
-    }
+    for (size_t i = 0; i < 3 * n; i++)
+        out->vertices[i] = mci_snap_coordinate(in->vertices[i], e);
+    if (!mci_first_equal_coordinates(ctx, out->vertices, n, canon))
+        return false;
     for (size_t v = 0; v < n; v++) {
-        for (int k = 0; k < 3; k++)
-            sv[v].p[k] = mci_snap_coordinate(in->vertices[3 * v + k], e);
-        sv[v].index = (uint32_t)v;
-    }
-    sort_snapped(sv, n);
-    for (size_t i = 0; i < n; i++) {
-        if (i == 0 || memcmp(sv[i].p, sv[i - 1].p, sizeof sv[i].p) != 0)
-            memcpy(out->vertices + 3 * count++, sv[i].p, sizeof sv[i].p);
-        id[sv[i].index] = (uint32_t)(count - 1);
+        if (canon[v] != v) {
+            id[v] = id[canon[v]];
+            continue;
+        }
+        memmove(out->vertices + 3 * count, out->vertices + 3 * v, 3 * sizeof *out->vertices);
+        id[v] = (uint32_t)count++;
     }
     out->vertex_count = count;
-    mci_free(ctx, sv);
     return true;
 }
 
@@ -152,14 +132,16 @@ mcsg_status mci_snap_to_grid(const mci_ctx *ctx, const mcsg_mesh *in, int e, mcs
                              uint32_t **face_of, mcsg_error *err)
 {
     uint32_t *id = mci_malloc_array(ctx, in->vertex_count + 1, sizeof *id);
+    uint32_t *canon = mci_malloc_array(ctx, in->vertex_count + 1, sizeof *canon);
     mci_touching_split split;
     bool ok;
     memset(out, 0, sizeof *out);
     *face_of = mci_malloc_array(ctx, in->triangle_count + 1, sizeof **face_of);
-    ok = id && *face_of && weld_snapped(ctx, in, e, out, id) &&
+    ok = id && canon && *face_of && weld_snapped(ctx, in, e, out, id, canon) &&
          snapped_triangles(ctx, in, id, out, *face_of) && remove_collinear(ctx, out, face_of) &&
          drop_unused_vertices(ctx, out) && mci_split_touching(ctx, out, &split); /* welding joined touching parts' copies */
     mci_free(ctx, id);
+    mci_free(ctx, canon);
     if (ok)
         return MCSG_OK;
     mci_mesh_free(ctx, out);

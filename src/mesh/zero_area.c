@@ -17,7 +17,6 @@
 #include "mesh/zero_area.h"
 #include "exact/predicates.h"
 
-#include <stdlib.h>
 #include <string.h>
 
 enum { LIVE, PENDING, REMOVED };
@@ -44,41 +43,11 @@ static const double *corner(const zero_state *s, size_t t, int k)
     return s->m->vertices + 3 * (size_t)s->tris[3 * t + (size_t)k];
 }
 
-static const mcsg_mesh *sort_mesh; /* qsort has no context argument */
-
-static int compare_coordinates(uint32_t a, uint32_t b)
-{
-    const double *p = sort_mesh->vertices + 3 * (size_t)a, *q = sort_mesh->vertices + 3 * (size_t)b;
-    for (int k = 0; k < 3; k++)
-        if (p[k] != q[k])
-            return p[k] < q[k] ? -1 : 1;
-    return 0;
-}
-
-/* By coordinates (-0 and 0 alike, as vertices are identified), then by index. */
-static int compare_vertices(const void *x, const void *y)
-{
-    uint32_t a = *(const uint32_t *)x, b = *(const uint32_t *)y;
-    int c = compare_coordinates(a, b);
-    return c ? c : (a > b) - (a < b);
-}
-
+/* canon: the lowest vertex with the same coordinates (-0 and 0 alike, as vertices are
+ * identified). */
 static bool identify_vertices(const mci_ctx *ctx, zero_state *s)
 {
-    size_t n = s->m->vertex_count;
-    uint32_t *order = mci_malloc_array(ctx, n + 1, sizeof *order);
-    if (!order)
-        return false;
-    for (size_t v = 0; v < n; v++)
-        order[v] = (uint32_t)v;
-    sort_mesh = s->m;
-    qsort(order, n, sizeof *order, compare_vertices);
-    for (size_t i = 0; i < n; i++)
-        s->canon[order[i]] = i > 0 && compare_coordinates(order[i - 1], order[i]) == 0
-                                 ? s->canon[order[i - 1]]
-                                 : order[i];
-    mci_free(ctx, order);
-    return true;
+    return mci_first_equal_coordinates(ctx, s->m->vertices, s->m->vertex_count, s->canon);
 }
 
 static uint64_t edge_key(const zero_state *s, uint32_t from, uint32_t to)
