@@ -89,8 +89,8 @@ static bool only_zero_area(const mcsg_check_report *r)
            r->inconsistent_edges == 0;
 }
 
-/* Leaf k's mesh without its zero-area triangles (mesh/zero_area.c) in place of its own,
- * when they can all go; *removed: how many went (0: the leaf is as it was). */
+/* Leaf k's mesh without its zero-area triangles (mesh/zero_area.c) in place of its own;
+ * *removed: how many went. */
 static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t *removed,
                                     mcsg_error *err)
 {
@@ -103,17 +103,13 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
         mci_free(job->ctx, copy);
         return mci_fail_nomem(err, "checking the leaves");
     }
-    if (res.left > 0) {
-        mci_free(job->ctx, copy);
-        return MCSG_OK;
-    }
     t->leaf_cleaned[k] = copy;
     t->leaf_face_of[k] = face_of;
     t->leaf_mesh[k] = copy;
     *removed = res.removed;
     mci_log(job->ctx, MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
-            "(they bound nothing), %zu neighbour%s split at a middle corner to keep the "
-            "surface closed", t->leaf_source[k],
+            "(they bound nothing), %zu triangle%s added by splitting neighbours at their "
+            "corners to keep the surface closed", t->leaf_source[k],
             mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
             mcsg_tree_node_label(job->tree, t->leaf_source[k]), res.removed,
             res.removed == 1 ? "" : "s", res.split, res.split == 1 ? "" : "s");

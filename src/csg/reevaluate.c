@@ -223,9 +223,8 @@ static mcsg_status evaluate_round(const mci_ctx *ctx, const round_state *from, b
 }
 
 /* One round, each step kept if it passes: from snapped to the grid 2^e; when evaluate,
- * the snapped mesh evaluated alone and rounded, then from itself (the rounds that settled
- * cases before snapping: example018 moved, whose snapped meshes do not). *next: the last
- * evaluation, for the next round (empty when both evaluations failed). */
+ * the snapped mesh evaluated alone and rounded, then from itself (the rounds of before
+ * snapping). *next: the last evaluation, for the next round (empty when both failed). */
 static mcsg_status snap_and_evaluate(const mci_ctx *ctx, const round_state *from,
                                      bool want_source, int e, bool evaluate,
                                      const double *touching, size_t touching_count,

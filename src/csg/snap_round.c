@@ -82,8 +82,7 @@ static bool snapped_triangles(const mci_ctx *ctx, const mcsg_mesh *in, const uin
                                          &cancelled);
 }
 
-/* Collinear triangles removed where mesh/zero_area.c can (left in place otherwise: the
- * caller's check reports them); face_of composed. */
+/* Collinear triangles removed (mesh/zero_area.c); face_of composed. */
 static bool remove_collinear(const mci_ctx *ctx, mcsg_mesh *m, uint32_t **face_of)
 {
     mcsg_mesh clean = {0};
@@ -91,7 +90,7 @@ static bool remove_collinear(const mci_ctx *ctx, mcsg_mesh *m, uint32_t **face_o
     mci_zero_area res;
     if (!mci_remove_zero_area(ctx, m, &clean, &clean_of, &res))
         return false;
-    if (res.left > 0 || res.removed == 0) {
+    if (res.removed == 0) {
         mci_mesh_free(ctx, &clean);
         mci_free(ctx, clean_of);
         return true;

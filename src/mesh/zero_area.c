@@ -9,12 +9,15 @@
  *     split at b of a triangle holding its long edge the other way, (v, u, x) becoming
  *     (v, b, x) and (b, u, x); the halves use v -> b and b -> u, which the removed
  *     triangle used the other way, and share b - x both ways. Halves may be split again.
- * A triangle whose long edge only zero-area triangles hold the other way (two of them
- * back to back with different middle corners) is left: then nothing is removed and the
- * caller refuses the leaf as before. Every decision is exact: corners are input
- * doubles, and "between" is a comparison of coordinates along an axis where they differ.
+ * Triangles whose long edge only zero-area triangles hold the other way (two of them
+ * back to back with different middle corners) go together, after every other triangle
+ * with an edge through a corner of theirs is split there (refine_at_pending_corners):
+ * on the refined edges the removed triangles' boundaries cancel, so the rest is closed.
+ * Every decision is exact: corners are input doubles, and "between" is a comparison of
+ * coordinates along an axis where they differ.
  */
 #include "mesh/zero_area.h"
+#include "base/sort_template.h"
 #include "exact/predicates.h"
 
 #include <string.h>
@@ -33,6 +36,7 @@ typedef struct zero_state {
     uint32_t *face_of; /* per triangle: m's triangle it is (part of) */
     uint8_t *state;    /* per triangle: LIVE, PENDING (zero area, to go) or REMOVED */
     size_t count;
+    size_t cap[3];     /* capacities of tris (in uint32_t), face_of and state */
     edge_slot *table;  /* directed edges of triangles not of zero area (entries may be
                           stale after a split: checked on lookup) */
     size_t mask;
@@ -179,8 +183,8 @@ static bool build_table(const mci_ctx *ctx, zero_state *s, size_t collinear)
 }
 
 /* Passes over the pending triangles until one removes none (a split may give the edge
- * another one needs). */
-static void remove_all_collinear(zero_state *s, size_t collinear, mci_zero_area *res)
+ * another one needs); returns how many are left. */
+static size_t remove_all_collinear(zero_state *s, size_t collinear, mci_zero_area *res)
 {
     size_t first = s->count;
     bool progress = true;
@@ -194,7 +198,123 @@ static void remove_all_collinear(zero_state *s, size_t collinear, mci_zero_area 
                 progress = true;
             }
     }
-    res->left = collinear;
+    return collinear;
+}
+
+/* Room for `need` triangles. */
+static bool reserve(const mci_ctx *ctx, zero_state *s, size_t need)
+{
+    return mci_grow_array(ctx, (void **)&s->tris, &s->cap[0], 3 * need, sizeof *s->tris, 16) &&
+           mci_grow_array(ctx, (void **)&s->face_of, &s->cap[1], need, sizeof *s->face_of, 16) &&
+           mci_grow_array(ctx, (void **)&s->state, &s->cap[2], need, 1, 16);
+}
+
+typedef struct x_vertex {
+    double x;
+    uint32_t v;
+} x_vertex;
+
+#define X_LESS(a, b) ((a)->x < (b)->x || ((a)->x == (b)->x && (a)->v < (b)->v))
+MCI_DEFINE_SORT(sort_x_vertices, x_vertex, X_LESS)
+
+/* The pending triangles' corners (canonical, each once), by x; *n of them. */
+static x_vertex *pending_corners(const mci_ctx *ctx, const zero_state *s, size_t *n)
+{
+    size_t k = 0;
+    x_vertex *z = mci_malloc_array(ctx, 3 * s->count + 1, sizeof *z);
+    for (size_t t = 0; z && t < s->count; t++)
+        for (int i = 0; s->state[t] == PENDING && i < 3; i++) {
+            uint32_t v = s->canon[s->tris[3 * t + (size_t)i]];
+            z[k++] = (x_vertex){s->m->vertices[3 * (size_t)v], v};
+        }
+    if (z)
+        sort_x_vertices(z, k);
+    for (size_t i = 0; z && i < k; i++)
+        if (*n == 0 || z[*n - 1].v != z[i].v)
+            z[(*n)++] = z[i];
+    return z;
+}
+
+/* The axis along which p and q differ first. */
+static int differing_axis(const double *p, const double *q)
+{
+    return p[0] != q[0] ? 0 : p[1] != q[1] ? 1 : 2;
+}
+
+/* The corners in z[0 .. nz) strictly inside segment p q, in order from p: *k of them,
+ * into at[]. Collinear and strictly between along an axis where p and q differ. */
+static void corners_inside(const zero_state *s, const x_vertex *z, size_t nz, uint32_t p,
+                           uint32_t q, uint32_t *at, size_t *k)
+{
+    const double *a = s->m->vertices + 3 * (size_t)p, *b = s->m->vertices + 3 * (size_t)q;
+    double lo = a[0] < b[0] ? a[0] : b[0], hi = a[0] < b[0] ? b[0] : a[0];
+    int axis = differing_axis(a, b), dir = a[axis] < b[axis] ? 1 : -1;
+    size_t first = 0, last = nz;
+    *k = 0;
+    while (first < last) { /* the first corner with x >= lo */
+        size_t mid = first + (last - first) / 2;
+        if (z[mid].x < lo)
+            first = mid + 1;
+        else
+            last = mid;
+    }
+    for (size_t i = first; i < nz && z[i].x <= hi; i++) {
+        const double *c = s->m->vertices + 3 * (size_t)z[i].v;
+        size_t j;
+        if (!(dir * (c[axis] - a[axis]) > 0 && dir * (b[axis] - c[axis]) > 0) ||
+            !mci_triangle_is_degenerate(a, b, c))
+            continue;
+        for (j = *k; j > 0 && dir * (s->m->vertices[3 * (size_t)at[j - 1] + axis] - c[axis]) > 0;
+             j--)
+            at[j] = at[j - 1];
+        at[j] = z[i].v;
+        ++*k;
+    }
+}
+
+/* Splits live triangle t across its edge from corner i at the k points at[]: t keeps
+ * (p, at[0], x), and (at[j], at[j + 1], x) ... (at[k - 1], q, x) are added. */
+static void split_edge(zero_state *s, size_t t, int i, const uint32_t *at, size_t k)
+{
+    uint32_t q = s->tris[3 * t + (size_t)(i + 1) % 3], x = s->tris[3 * t + (size_t)(i + 2) % 3];
+    s->tris[3 * t + (size_t)(i + 1) % 3] = at[0];
+    for (size_t j = 0; j < k; j++) {
+        uint32_t *n = s->tris + 3 * s->count;
+        n[0] = at[j], n[1] = j + 1 < k ? at[j + 1] : q, n[2] = x;
+        s->face_of[s->count] = s->face_of[t];
+        s->state[s->count++] = LIVE;
+    }
+}
+
+/* The pending triangles that no single split removes go all at once: every live
+ * triangle's edge through a corner of theirs is split there (also the halves' new
+ * edges), so that the edges on their lines are refined at the same points; there the
+ * boundary of each pending triangle (its two short edges one way, the long one back)
+ * cancels, and the rest of the leaf, closed with them, is closed without them. */
+static bool refine_at_pending_corners(const mci_ctx *ctx, zero_state *s, mci_zero_area *res)
+{
+    size_t nz = 0, k;
+    x_vertex *z = pending_corners(ctx, s, &nz);
+    uint32_t *at = mci_malloc_array(ctx, nz + 1, sizeof *at);
+    bool ok = z && at;
+    for (size_t t = 0; ok && t < s->count; t++)
+        for (int i = 0; ok && s->state[t] == LIVE && i < 3; i++) {
+            corners_inside(s, z, nz, s->tris[3 * t + (size_t)i], s->tris[3 * t + (size_t)(i + 1) % 3],
+                           at, &k);
+            if (k == 0 || !(ok = reserve(ctx, s, s->count + k)))
+                continue;
+            split_edge(s, t, i, at, k);
+            res->split += k;
+            i = -1; /* the new edge from at[0] may hold corners too */
+        }
+    for (size_t t = 0; ok && t < s->count; t++)
+        if (s->state[t] == PENDING) {
+            s->state[t] = REMOVED;
+            res->removed++;
+        }
+    mci_free(ctx, z);
+    mci_free(ctx, at);
+    return ok;
 }
 
 /* The live triangles, in order, as a mesh with m's vertices. */
@@ -234,9 +354,9 @@ static void free_state(const mci_ctx *ctx, zero_state *s)
 bool mci_remove_zero_area(const mci_ctx *ctx, const mcsg_mesh *m, mcsg_mesh *out,
                           uint32_t **face_of, mci_zero_area *res)
 {
-    size_t n = m->triangle_count, cap = 2 * n + 1; /* each split adds one triangle */
-    zero_state s = {m, NULL, NULL, NULL, NULL, n, NULL, 0};
-    size_t collinear;
+    size_t n = m->triangle_count, cap = 2 * n + 1; /* a single split adds one triangle */
+    zero_state s = {m, NULL, NULL, NULL, NULL, n, {3 * cap, cap, cap}, NULL, 0};
+    size_t collinear, left = 0;
     bool ok;
     memset(res, 0, sizeof *res);
     memset(out, 0, sizeof *out);
@@ -250,8 +370,10 @@ bool mci_remove_zero_area(const mci_ctx *ctx, const mcsg_mesh *m, mcsg_mesh *out
         memcpy(s.tris, m->triangles, 3 * n * sizeof *s.tris);
     collinear = ok ? mark_zero_area(&s, res) : 0;
     if (ok && collinear > 0 && (ok = build_table(ctx, &s, collinear)))
-        remove_all_collinear(&s, collinear, res);
-    if (ok && res->left == 0)
+        left = remove_all_collinear(&s, collinear, res);
+    if (ok && left > 0)
+        ok = refine_at_pending_corners(ctx, &s, res);
+    if (ok)
         ok = build_copy(ctx, &s, out, face_of);
     free_state(ctx, &s);
     return ok;

@@ -11,15 +11,13 @@
 
 typedef struct mci_zero_area {
     size_t removed; /* zero-area triangles removed */
-    size_t split;   /* triangles split at the middle corner of a removed one */
-    size_t left;    /* zero-area triangles that could not be removed (see zero_area.c) */
+    size_t split;   /* triangles added by splitting others at corners of removed ones */
 } mci_zero_area;
 
 /* A copy of m (vertices unchanged) without its zero-area triangles, and (*face_of)[t]:
  * the triangle of m that triangle t of the copy is, or is part of. m must have finite
  * coordinates, valid indices, and be closed as a chain; the copy then is too, and has
- * the same winding number as m at every point off m. When some could not be removed
- * (res->left > 0), out and *face_of are left empty. False only when out of memory
+ * the same winding number as m at every point off m. False only when out of memory
  * (nothing allocated). */
 bool mci_remove_zero_area(const mci_ctx *ctx, const mcsg_mesh *m, mcsg_mesh *out,
                           uint32_t **face_of, mci_zero_area *res);
