@@ -874,7 +874,9 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
         st = mci_progress(&e->ctx, "assemble", 1, err);
     if (st != MCSG_OK)
         mci_mesh_free(&e->ctx, out);
-    if (st == MCSG_ERR_INTERNAL)
+    /* A round of evaluating a rounded result again only logs why it failed: the
+     * explanation, another self-intersection test of the whole mesh, is not worth it. */
+    if (st == MCSG_ERR_INTERNAL && !e->ctx.reevaluation_round)
         st = mci_explain_internal_error(&e->ctx, tree, &e->tree, err);
     return st;
 }

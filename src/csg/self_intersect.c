@@ -84,6 +84,26 @@ static bool coplanar_boundaries_meet(const double *const a[3], const double *con
     return false;
 }
 
+/* Whether the corners of b that a lacks lie strictly on one side of a's plane: then b
+ * meets that plane, and a, at most in their common corners, which is no crossing. Most
+ * candidate pairs of a mesh are neighbours, and this decides them without the
+ * triangle-triangle test. */
+static bool off_plane_apart(const double *const b[3], const double *const a[3],
+                            const mci_plane *plane)
+{
+    int side = 0;
+    for (int i = 0; i < 3; i++) {
+        int o;
+        if (same_point(b[i], a[0]) || same_point(b[i], a[1]) || same_point(b[i], a[2]))
+            continue;
+        o = mci_orient3d_vertex(b[i], plane);
+        if (o == 0 || (side != 0 && o != side))
+            return false;
+        side = o;
+    }
+    return side != 0;
+}
+
 bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t)
 {
     const double *a[3] = {vertex(m, s, 0), vertex(m, s, 1), vertex(m, s, 2)};
@@ -99,6 +119,8 @@ bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t)
         return true;
     mci_plane_init(&ps, a[0], a[1], a[2]);
     mci_plane_init(&pt, b[0], b[1], b[2]);
+    if (off_plane_apart(b, a, &ps) || off_plane_apart(a, b, &pt))
+        return false;
     mci_triangle_intersection(&ps, &pt, &r);
     switch (r.kind) {
     case MCI_TT_DISJOINT:
