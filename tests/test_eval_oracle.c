@@ -257,12 +257,88 @@ TEST(spindle_torus)
     mcsg_tree_free(tree);
 }
 
+/* One mesh of several spheres (r, centre), the inward ones turned inside out. */
+typedef struct sphere_part {
+    double r, c[3];
+    bool inward;
+} sphere_part;
+
+static mcsg_mesh spheres_in_one_mesh(const sphere_part *parts, int n, int copies)
+{
+    mcsg_mesh all = {NULL, NULL, 0, 0};
+    mcsg_resolution res = {24, 0, 0};
+    mcsg_error err;
+    for (int k = 0; k < n * copies; k++) {
+        const sphere_part *p = &parts[k % n];
+        mcsg_mesh m;
+        CHECK_OK(mcsg_make_sphere(p->r, res, NULL, &m, &err), &err);
+        all.vertices = realloc(all.vertices, 3 * (all.vertex_count + m.vertex_count) * sizeof(double));
+        all.triangles = realloc(all.triangles, 3 * (all.triangle_count + m.triangle_count) * sizeof(uint32_t));
+        for (size_t i = 0; i < 3 * m.vertex_count; i++)
+            all.vertices[3 * all.vertex_count + i] = m.vertices[i] + p->c[i % 3];
+        for (size_t i = 0; i < 3 * m.triangle_count; i++)
+            all.triangles[3 * all.triangle_count + i] =
+                (uint32_t)all.vertex_count + m.triangles[p->inward ? i - i % 3 + (3 - i % 3) % 3 : i];
+        all.vertex_count += m.vertex_count;
+        all.triangle_count += m.triangle_count;
+        mcsg_mesh_free(&m, NULL);
+    }
+    return all;
+}
+
+/* mcsg_mesh_repair on the mesh: shells and cavities as expected, no crossing triangles,
+ * the output check passed; and the same evaluation against the winding-number oracle. */
+static void expect_repair(const char *what, mcsg_mesh *mesh, size_t shells, size_t cavities)
+{
+    mcsg_mesh out;
+    mcsg_repair_stats st;
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    csg_result r;
+    size_t pairs = 1;
+    CHECK_OK(mcsg_mesh_repair(mesh, NULL, &out, &st, &err), &err);
+    CHECK_MSG(st.shells_out == shells && st.cavities == cavities, "%s: %zu shells out, %zu "
+              "cavities", what, st.shells_out, st.cavities);
+    CHECK_MSG(!mcsg_output_check_failed(&st.eval.output_check), "%s: output check failed", what);
+    CHECK_OK(mcsg_mesh_self_intersections(&out, NULL, &pairs, NULL, &err), &err);
+    CHECK_MSG(pairs == 0, "%s: %zu crossing pairs in the repaired mesh", what, pairs);
+    mcsg_mesh_free(&out, NULL);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, mesh, NULL, what, &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0x2e9a12, true, true, true, &r), "%s: %s", what, r.why);
+    CHECK_MSG(r.checked > 0 && r.inside > 0 && r.inside < r.checked, "%s: %zu points, %zu "
+              "checked, %zu inside", what, r.points, r.checked, r.inside);
+    mcsg_tree_free(tree);
+    free(mesh->vertices);
+    free(mesh->triangles);
+}
+
+/* Generated imperfect meshes made printable: overlapping spheres in one file become one
+ * shell; a sphere with an inward inner shell holding a ball keeps its cavity and the
+ * ball; a sphere listed twice (winding number 2) is the sphere. */
+TEST(repair_of_generated_imperfect_meshes)
+{
+    static const sphere_part three[] = {
+        {1, {0, 0, 0}, false}, {1, {0.8, 0, 0.1}, false}, {1, {0.4, 0.7, -0.2}, false}};
+    static const sphere_part hollow[] = {
+        {2, {0, 0, 0}, false}, {1, {0.1, 0, 0}, true}, {0.5, {0.2, 0.1, 0}, false}};
+    mcsg_mesh m = spheres_in_one_mesh(three, 3, 1);
+    expect_repair("three overlapping spheres", &m, 1, 0);
+    m = spheres_in_one_mesh(hollow, 3, 1);
+    expect_repair("a hollow sphere holding a ball", &m, 3, 1);
+    m = spheres_in_one_mesh(three, 1, 2);
+    expect_repair("a sphere listed twice", &m, 1, 0);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
     csg_self_check = true;
     RUN(oracle_notices_a_wrong_result);
     RUN(spindle_torus);
+    RUN(repair_of_generated_imperfect_meshes);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();
