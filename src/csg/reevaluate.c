@@ -17,6 +17,7 @@
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
 #include "csg/snap_round.h"
+#include "mesh/validate.h"
 
 #include <math.h>
 #include <string.h>
@@ -175,93 +176,137 @@ static double *snap_touching(const mci_ctx *ctx, const double *touching, size_t 
     return snapped;
 }
 
-/* Checks candidate; when it passes, it replaces out and *provenance (and is emptied). */
-static mcsg_status keep_if_it_passes(const mci_ctx *ctx, const mci_exact_result *exact,
-                                     size_t *first_pairs, round_state *candidate,
-                                     mcsg_mesh *out, mcsg_provenance **provenance,
-                                     mcsg_eval_stats *stats, bool *kept, mcsg_error *err)
+/* The size of a mesh's solid, in doubles: its signed volume, the sum of the volume's
+ * terms' magnitudes (the scale of its rounding error) and its surface's area. */
+typedef struct solid_size {
+    double volume, magnitude, area;
+} solid_size;
+
+static solid_size size_of(const mcsg_mesh *m)
+{
+    mci_volume_sum v = {0, 0, 0, 0};
+    solid_size z = {0, 0, 0};
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const double *a = m->vertices + 3 * (size_t)m->triangles[3 * t],
+                     *b = m->vertices + 3 * (size_t)m->triangles[3 * t + 1],
+                     *c = m->vertices + 3 * (size_t)m->triangles[3 * t + 2];
+        double u[3], w[3], n[3];
+        mci_volume_sum_add(&v, a, b, c);
+        for (int k = 0; k < 3; k++)
+            u[k] = b[k] - a[k], w[k] = c[k] - a[k];
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        z.area += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    }
+    z.volume = v.sum / 6;
+    z.magnitude = v.magnitude / 6;
+    return z;
+}
+
+/* What the rounds share: the caller's result (replaced by the first candidate that
+ * passes), the first result's crossings and size, and how far the rounds so far may
+ * have moved the surface. */
+typedef struct rounds {
+    const mci_ctx *ctx;
+    mcsg_mesh *out;
+    mcsg_provenance **provenance;
+    mcsg_eval_stats *stats;
+    bool want_source, kept;
+    size_t first_pairs; /* SIZE_MAX until counted */
+    solid_size first;
+    double moved;       /* a bound on how far any point of a candidate is from the first
+                           result's surface */
+    const double *touching;
+    size_t touching_count;
+} rounds;
+
+/* Whether the candidate's volume is the first result's within what moving its surface
+ * by r->moved can change (both areas times that distance), plus the sums' rounding. A
+ * candidate whose evaluation lost or added a part (a misclassified region of a shell
+ * crossing itself) is refused: its check alone would pass it. */
+static bool keeps_the_solid(const rounds *r, const mcsg_mesh *candidate)
+{
+    solid_size c = size_of(candidate);
+    double bound = (r->first.area + c.area) * r->moved +
+                   0x1p-40 * (r->first.magnitude + c.magnitude);
+    return fabs(c.volume - r->first.volume) <= bound;
+}
+
+/* Checks candidate; when it passes, it replaces the result (and is emptied). */
+static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
+                                     round_state *candidate, mcsg_error *err)
 {
     mcsg_output_check check;
     bool passes = false;
-    mcsg_status s = MCSG_OK;
-    *kept = false;
-    if (candidate->mesh.triangle_count == 0)
+    mcsg_status s;
+    if (candidate->mesh.triangle_count == 0 || !keeps_the_solid(r, &candidate->mesh))
         return MCSG_OK; /* a solid result is never kept empty */
-    s = mci_check_output(ctx, &candidate->mesh, exact, &check, err);
+    s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
     if (s == MCSG_OK)
-        s = round_passes(ctx, out, first_pairs, &candidate->mesh, &check, &passes, err);
+        s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
+                         err);
     if (s != MCSG_OK || !passes)
         return s;
-    mci_mesh_free(ctx, out);
-    *out = candidate->mesh;
+    mci_mesh_free(r->ctx, r->out);
+    *r->out = candidate->mesh;
     if (candidate->source) {
-        mci_free(ctx, *provenance);
-        *provenance = candidate->source;
+        mci_free(r->ctx, *r->provenance);
+        *r->provenance = candidate->source;
     }
     memset(candidate, 0, sizeof *candidate);
-    stats->output_check = check;
-    stats->output_vertices = out->vertex_count;
-    stats->output_triangles = out->triangle_count;
-    stats->rounding_reevaluation_kept = 1;
-    *kept = true;
+    r->stats->output_check = check;
+    r->stats->output_vertices = r->out->vertex_count;
+    r->stats->output_triangles = r->out->triangle_count;
+    r->stats->rounding_reevaluation_kept = 1;
+    r->kept = true;
     return MCSG_OK;
 }
 
 /* from evaluated alone and rounded: *next, kept when it passes. */
-static mcsg_status evaluate_round(const mci_ctx *ctx, const round_state *from, bool want_source,
-                                  const mci_exact_result *exact, size_t *first_pairs,
-                                  round_state *next, mcsg_mesh *out,
-                                  mcsg_provenance **provenance, mcsg_eval_stats *stats,
-                                  bool *kept, mcsg_error *err)
+static mcsg_status evaluate_round(rounds *r, const round_state *from,
+                                  const mci_exact_result *exact, round_state *next,
+                                  mcsg_error *err)
 {
     mcsg_eval_stats st;
-    mcsg_status s = one_round(ctx, &from->mesh, from->source, want_source, next, &st, err);
-    stats->rounding_reevaluations++;
+    mcsg_status s = one_round(r->ctx, &from->mesh, from->source, r->want_source, next, &st, err);
+    r->stats->rounding_reevaluations++;
     if (s == MCSG_OK)
-        s = keep_if_it_passes(ctx, exact, first_pairs, next, out, provenance, stats, kept, err);
+        s = keep_if_it_passes(r, exact, next, err);
     return s;
 }
 
 /* One round, each step kept if it passes: from snapped to the grid 2^e; when evaluate,
  * the snapped mesh evaluated alone and rounded, then from itself (the rounds of before
  * snapping). *next: the last evaluation, for the next round (empty when both failed). */
-static mcsg_status snap_and_evaluate(const mci_ctx *ctx, const round_state *from,
-                                     bool want_source, int e, bool evaluate,
-                                     const double *touching, size_t touching_count,
-                                     size_t *first_pairs, round_state *next, mcsg_mesh *out,
-                                     mcsg_provenance **provenance, mcsg_eval_stats *stats,
-                                     bool *kept, mcsg_error *err)
+static mcsg_status snap_and_evaluate(rounds *r, const round_state *from, int e, bool evaluate,
+                                     round_state *next, mcsg_error *err)
 {
-    double *ends = snap_touching(ctx, touching, touching_count, e);
-    mci_exact_result snapped_exact = {NULL, 0, NULL, NULL, ends, touching_count};
-    mci_exact_result exact = {NULL, 0, NULL, NULL, touching, touching_count};
+    double *ends = snap_touching(r->ctx, r->touching, r->touching_count, e);
+    mci_exact_result snapped_exact = {NULL, 0, NULL, NULL, ends, r->touching_count};
+    mci_exact_result exact = {NULL, 0, NULL, NULL, r->touching, r->touching_count};
     round_state snapped = {{0}, NULL}, from_snapped = {{0}, NULL};
-    mcsg_status s = ends ? snap_round(ctx, &from->mesh, from->source, want_source, e, &snapped,
-                                      err)
+    mcsg_status s = ends ? snap_round(r->ctx, &from->mesh, from->source, r->want_source, e,
+                                      &snapped, err)
                          : mci_fail_nomem(err, "snapping the rounded result to a grid");
     memset(next, 0, sizeof *next);
+    r->moved += 2 * ldexp(1.0, e); /* half the grid's diagonal, and more */
     if (s == MCSG_OK)
-        s = keep_if_it_passes(ctx, &snapped_exact, first_pairs, &snapped, out, provenance,
-                              stats, kept, err);
-    if (s == MCSG_OK && *kept)
-        stats->rounding_snap_grid = ldexp(1.0, e);
-    if (s == MCSG_OK && !*kept && evaluate && snapped.mesh.triangle_count > 0) {
-        s = evaluate_round(ctx, &snapped, want_source, &snapped_exact, first_pairs,
-                           &from_snapped, out, provenance, stats, kept, err);
-        if (s == MCSG_OK && *kept)
-            stats->rounding_snap_grid = ldexp(1.0, e);
-    }
-    if (s == MCSG_OK && !*kept && evaluate)
-        s = evaluate_round(ctx, from, want_source, &exact, first_pairs, next, out, provenance,
-                           stats, kept, err);
+        s = keep_if_it_passes(r, &snapped_exact, &snapped, err);
+    if (s == MCSG_OK && !r->kept && evaluate && snapped.mesh.triangle_count > 0)
+        s = evaluate_round(r, &snapped, &snapped_exact, &from_snapped, err);
+    if (s == MCSG_OK && r->kept)
+        r->stats->rounding_snap_grid = ldexp(1.0, e);
+    if (s == MCSG_OK && !r->kept && evaluate)
+        s = evaluate_round(r, from, &exact, next, err);
     if (s == MCSG_OK && next->mesh.triangle_count == 0) {
-        round_state_free(ctx, next);
+        round_state_free(r->ctx, next);
         *next = from_snapped;
     } else {
-        round_state_free(ctx, &from_snapped);
+        round_state_free(r->ctx, &from_snapped);
     }
-    round_state_free(ctx, &snapped);
-    mci_free(ctx, ends);
+    round_state_free(r->ctx, &snapped);
+    mci_free(r->ctx, ends);
     return s;
 }
 
@@ -270,19 +315,18 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
                                    mcsg_provenance **provenance, mcsg_eval_stats *stats,
                                    mcsg_error *err)
 {
-    round_state last = {{0}, NULL}, next;
-    bool want_source = provenance && *provenance, kept = false;
-    size_t first_pairs = SIZE_MAX;
     int top = mci_snap_exponent(out, 0);
+    rounds r = {ctx, out, provenance, stats, provenance && *provenance, false, SIZE_MAX,
+                size_of(out), ldexp(1.0, top - 48), touching, touching_count};
+    round_state last = {{0}, NULL}, next;
     mcsg_status s = MCSG_OK;
-    for (int round = 0; s == MCSG_OK && !kept && round <= REEVALUATION_ROUNDS; round++) {
-        round_state first = {*out, want_source ? *provenance : NULL};
+    for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
+        round_state first = {*out, r.want_source ? *provenance : NULL};
         const round_state *from = round == 0 ? &first : &last;
         if (round > 0 && last.mesh.triangle_count == 0)
             break; /* the last evaluations failed */
-        s = snap_and_evaluate(ctx, from, want_source, top - snap_bits[round],
-                              round < REEVALUATION_ROUNDS, touching, touching_count,
-                              &first_pairs, &next, out, provenance, stats, &kept, err);
+        s = snap_and_evaluate(&r, from, top - snap_bits[round], round < REEVALUATION_ROUNDS,
+                              &next, err);
         round_state_free(ctx, &last);
         last = next;
     }
