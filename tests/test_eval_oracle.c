@@ -253,7 +253,8 @@ TEST(spindle_torus)
     CHECK(mcsg_tree_add_leaf(tree, &torus, NULL, "spindle torus", &leaf, &err) == MCSG_OK);
     CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
     CHECK_MSG(csg_check_tree(tree, NULL, 0x5b1d1e, true, true, true, &r), "%s", r.why);
-    CHECK_MSG(r.checked > 0 && r.inside > 0 && r.inside < r.checked, "%zu points, %zu checked, %zu inside", r.points, r.checked, r.inside);
+    CHECK_MSG(r.checked > 0 && r.inside > 0 && r.inside < r.checked,
+              "%zu points, %zu checked, %zu inside", r.points, r.checked, r.inside);
     mcsg_tree_free(tree);
 }
 
@@ -272,13 +273,16 @@ static mcsg_mesh spheres_in_one_mesh(const sphere_part *parts, int n, int copies
         const sphere_part *p = &parts[k % n];
         mcsg_mesh m;
         CHECK_OK(mcsg_make_sphere(p->r, res, NULL, &m, &err), &err);
-        all.vertices = realloc(all.vertices, 3 * (all.vertex_count + m.vertex_count) * sizeof(double));
-        all.triangles = realloc(all.triangles, 3 * (all.triangle_count + m.triangle_count) * sizeof(uint32_t));
+        size_t nv = all.vertex_count + m.vertex_count, nt = all.triangle_count + m.triangle_count;
+        all.vertices = realloc(all.vertices, 3 * nv * sizeof *all.vertices);
+        all.triangles = realloc(all.triangles, 3 * nt * sizeof *all.triangles);
         for (size_t i = 0; i < 3 * m.vertex_count; i++)
             all.vertices[3 * all.vertex_count + i] = m.vertices[i] + p->c[i % 3];
-        for (size_t i = 0; i < 3 * m.triangle_count; i++)
+        for (size_t i = 0; i < 3 * m.triangle_count; i++) { /* inward: (a, c, b) */
+            size_t corner = p->inward ? i - i % 3 + (3 - i % 3) % 3 : i;
             all.triangles[3 * all.triangle_count + i] =
-                (uint32_t)all.vertex_count + m.triangles[p->inward ? i - i % 3 + (3 - i % 3) % 3 : i];
+                (uint32_t)all.vertex_count + m.triangles[corner];
+        }
         all.vertex_count += m.vertex_count;
         all.triangle_count += m.triangle_count;
         mcsg_mesh_free(&m, NULL);

@@ -136,9 +136,10 @@ mcsg_status mci_snap_to_grid(const mci_ctx *ctx, const mcsg_mesh *in, int e, mcs
     bool ok;
     memset(out, 0, sizeof *out);
     *face_of = mci_malloc_array(ctx, in->triangle_count + 1, sizeof **face_of);
+    /* Welding joined the vertex copies of touching parts: they are made again last. */
     ok = id && canon && *face_of && weld_snapped(ctx, in, e, out, id, canon) &&
          snapped_triangles(ctx, in, id, out, *face_of) && remove_collinear(ctx, out, face_of) &&
-         drop_unused_vertices(ctx, out) && mci_split_touching(ctx, out, &split); /* welding joined touching parts' copies */
+         drop_unused_vertices(ctx, out) && mci_split_touching(ctx, out, &split);
     mci_free(ctx, id);
     mci_free(ctx, canon);
     if (ok)

@@ -299,8 +299,8 @@ static bool refine_at_pending_corners(const mci_ctx *ctx, zero_state *s, mci_zer
     bool ok = z && at;
     for (size_t t = 0; ok && t < s->count; t++)
         for (int i = 0; ok && s->state[t] == LIVE && i < 3; i++) {
-            corners_inside(s, z, nz, s->tris[3 * t + (size_t)i], s->tris[3 * t + (size_t)(i + 1) % 3],
-                           at, &k);
+            const uint32_t *c = s->tris + 3 * t;
+            corners_inside(s, z, nz, c[i], c[(i + 1) % 3], at, &k);
             if (k == 0 || !(ok = reserve(ctx, s, s->count + k)))
                 continue;
             split_edge(s, t, i, at, k);
