@@ -336,6 +336,37 @@ TEST(repair_of_generated_imperfect_meshes)
     expect_repair("a sphere listed twice", &m, 1, 0);
 }
 
+/* A shell crossing itself with slivers folded flat onto their neighbours (the first
+ * rounded result of fuzz seed 0x5abd6165dd3fe5e4 snapped to a grid of 2^-40: two coaxial
+ * cylinders whose caps nearly coincide). A sliver's front is its neighbour's back, and
+ * once joined in one region its seed ray gave every piece of the cylinder the sliver's
+ * numbers: the repaired solid was empty. Its volume is the mesh's own (its winding
+ * number is 0 or 1 everywhere), and the oracle agrees at sampled points. Rounding still
+ * breaks this result's guarantees (reported), and its provenance is not checked: one
+ * output triangle lies 6e-6 off the plane of the face it names (open). */
+TEST(folded_slivers_keep_the_solid)
+{
+    mcsg_mesh m, out;
+    mcsg_repair_stats st;
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    csg_result r;
+    CHECK_OK(mcsg_mesh_read(test_data("rounding/folded-cap-sliver.off"), MCSG_FORMAT_AUTO, NULL,
+                            &m, &err), &err);
+    CHECK_OK(mcsg_mesh_repair(&m, NULL, &out, &st, &err), &err);
+    CHECK_MSG(fabs(test_signed_volume(&out) - 4136.890521604279) < 1e-6, "volume %.17g",
+              test_signed_volume(&out));
+    mcsg_mesh_free(&out, NULL);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "folded slivers", &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0xf01d, false, true, true, &r), "%s", r.why);
+    CHECK(r.checked > 0 && r.inside > 0);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&m, NULL);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -343,6 +374,7 @@ int main(void)
     RUN(oracle_notices_a_wrong_result);
     RUN(spindle_torus);
     RUN(repair_of_generated_imperfect_meshes);
+    RUN(folded_slivers_keep_the_solid);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();

@@ -406,6 +406,44 @@ static mcsg_status collect_separators(mci_leaf_work *w)
     return MCSG_OK;
 }
 
+/* The turn of the triangle a, b, c seen along `axis`. */
+static int projected_turn(const mci_plane *t, int axis)
+{
+    mci_point a, b, c;
+    mci_point_explicit(&a, t->a);
+    mci_point_explicit(&b, t->b);
+    mci_point_explicit(&c, t->c);
+    return mci_orient2d_projected(&a, &b, &c, axis);
+}
+
+/* Whether faces f and g, across an edge of their pieces, lie in one plane facing
+ * opposite ways: a surface folded flat onto itself (a sliver that rounding turned over,
+ * in a leaf crossing itself). Each one's front is the other's back there, and the
+ * winding numbers on the two sides of the plane differ by what the faces covering it
+ * add up to, so their pieces do not share a region's numbers. */
+static bool folded_flat(const mci_leaf_work *w, uint32_t f, uint32_t g)
+{
+    mci_plane pf, pg;
+    int axis, sign;
+    mci_scene_face_plane(w->s, f, &pf);
+    mci_scene_face_plane(w->s, g, &pg);
+    if (mci_orient3d_vertex(pg.a, &pf) != 0 || mci_orient3d_vertex(pg.b, &pf) != 0 ||
+        mci_orient3d_vertex(pg.c, &pf) != 0)
+        return false;
+    axis = mci_plane_projection_axis(&pf, &sign);
+    return axis >= 0 && projected_turn(&pg, axis) == -sign;
+}
+
+/* Whether pieces are joined across slot k: not a separator, and, in a leaf classified
+ * by winding numbers, not a fold flat onto the piece across. */
+static bool joins(const mci_leaf_work *w, size_t k)
+{
+    uint32_t f = w->pface[k / 3], g = w->pface[w->mate[k] / 3];
+    if (w->is_sep[k])
+        return false;
+    return f == g || !w->cl->tree->leaf_winding[w->leaf] || !folded_flat(w, f, g);
+}
+
 /* Regions: pieces joined across non-separator edges; numbered by first piece. */
 static mcsg_status build_regions(mci_leaf_work *w)
 {
@@ -418,7 +456,7 @@ static mcsg_status build_regions(mci_leaf_work *w)
     for (uint32_t p = 0; p < w->np; p++)
         parent[p] = p;
     for (size_t k = 0; k < 3 * w->np; k++) {
-        if (!w->is_sep[k]) {
+        if (joins(w, k)) {
             uint32_t a = mci_find_root(parent, (uint32_t)(k / 3));
             uint32_t b = mci_find_root(parent, w->mate[k] / 3);
             parent[a > b ? a : b] = a > b ? b : a;
