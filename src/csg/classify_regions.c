@@ -438,10 +438,13 @@ static bool folded_flat(const mci_leaf_work *w, uint32_t f, uint32_t g)
  * by winding numbers, not a fold flat onto the piece across. */
 static bool joins(const mci_leaf_work *w, size_t k)
 {
-    uint32_t f = w->pface[k / 3], g = w->pface[w->mate[k] / 3];
+    uint32_t f, g;
     if (w->is_sep[k])
-        return false;
-    return f == g || !w->cl->tree->leaf_winding[w->leaf] || !folded_flat(w, f, g);
+        return false; /* walls too: they have no mate */
+    if (!w->cl->tree->leaf_winding[w->leaf])
+        return true;
+    f = w->pface[k / 3], g = w->pface[w->mate[k] / 3];
+    return f == g || !folded_flat(w, f, g);
 }
 
 /* Regions: pieces joined across non-separator edges; numbered by first piece. */
