@@ -342,8 +342,9 @@ TEST(repair_of_generated_imperfect_meshes)
  * once joined in one region its seed ray gave every piece of the cylinder the sliver's
  * numbers: the repaired solid was empty. Its volume is the mesh's own (its winding
  * number is 0 or 1 everywhere), and the oracle agrees at sampled points. Rounding still
- * breaks this result's guarantees (reported), and its provenance is not checked: one
- * output triangle lies 6e-6 off the plane of the face it names (open). */
+ * breaks this result's guarantees (reported), and its provenance is not checked: two
+ * output triangles made where rounding split turned-over triangles away name a sliver
+ * neighbour's face (area 1e-12), up to 2e-5 off its plane (open). */
 TEST(folded_slivers_keep_the_solid)
 {
     mcsg_mesh m, out;
