@@ -219,6 +219,7 @@ typedef struct rounds {
                            result's surface */
     const double *touching;
     size_t touching_count;
+    size_t most_triangles; /* a round's evaluated mesh beyond this is abandoned */
 } rounds;
 
 /* Whether the candidate's volume is the first result's within what moving its surface
@@ -263,7 +264,11 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     return MCSG_OK;
 }
 
-/* from evaluated alone and rounded: *next, kept when it passes. */
+/* from evaluated alone and rounded: *next, kept when it passes. A mesh that grew to
+ * several times the first result is no cleanup of it but a tangle rounding made worse:
+ * it is dropped (next empty), before its crossings are counted or it starts a round (a
+ * fuzz tree's third round reached 150,000 triangles from 2,750, and a run ran out of
+ * memory). */
 static mcsg_status evaluate_round(rounds *r, const round_state *from,
                                   const mci_exact_result *exact, round_state *next,
                                   mcsg_error *err)
@@ -271,6 +276,12 @@ static mcsg_status evaluate_round(rounds *r, const round_state *from,
     mcsg_eval_stats st;
     mcsg_status s = one_round(r->ctx, &from->mesh, from->source, r->want_source, next, &st, err);
     r->stats->rounding_reevaluations++;
+    if (s == MCSG_OK && next->mesh.triangle_count > r->most_triangles) {
+        mci_log(r->ctx, MCSG_LOG_INFO, "evaluating the rounded result again gave %zu "
+                "triangles from %zu: abandoned", next->mesh.triangle_count,
+                r->out->triangle_count);
+        round_state_free(r->ctx, next);
+    }
     if (s == MCSG_OK)
         s = keep_if_it_passes(r, exact, next, err);
     return s;
@@ -317,7 +328,8 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
 {
     int top = mci_snap_exponent(out, 0);
     rounds r = {ctx, out, provenance, stats, provenance && *provenance, false, SIZE_MAX,
-                size_of(out), ldexp(1.0, top - 48), touching, touching_count};
+                size_of(out), ldexp(1.0, top - 48), touching, touching_count,
+                4 * out->triangle_count + 1000};
     round_state last = {{0}, NULL}, next;
     mcsg_status s = MCSG_OK;
     for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
