@@ -406,16 +406,6 @@ static mcsg_status collect_separators(mci_leaf_work *w)
     return MCSG_OK;
 }
 
-/* The turn of the triangle a, b, c seen along `axis`. */
-static int projected_turn(const mci_plane *t, int axis)
-{
-    mci_point a, b, c;
-    mci_point_explicit(&a, t->a);
-    mci_point_explicit(&b, t->b);
-    mci_point_explicit(&c, t->c);
-    return mci_orient2d_projected(&a, &b, &c, axis);
-}
-
 /* Whether faces f and g, across an edge of their pieces, lie in one plane facing
  * opposite ways: a surface folded flat onto itself (a sliver that rounding turned over,
  * in a leaf crossing itself). Each one's front is the other's back there, and the
@@ -431,7 +421,7 @@ static bool folded_flat(const mci_leaf_work *w, uint32_t f, uint32_t g)
         mci_orient3d_vertex(pg.c, &pf) != 0)
         return false;
     axis = mci_plane_projection_axis(&pf, &sign);
-    return axis >= 0 && projected_turn(&pg, axis) == -sign;
+    return axis >= 0 && mci_plane_normal_sign(&pg, axis) == -sign;
 }
 
 /* Whether pieces are joined across slot k: not a separator, and, in a leaf classified

@@ -1556,6 +1556,11 @@ static int normal_sign_exact(const mci_plane *plane, int axis)
     return mci_orient2d_projected_exact(&a, &b, &c, axis);
 }
 
+int mci_plane_normal_sign(const mci_plane *plane, int axis)
+{
+    return normal_sign_exact(plane, axis);
+}
+
 int mci_plane_projection_axis(const mci_plane *plane, int *sign)
 {
     int order[3] = {0, 1, 2};

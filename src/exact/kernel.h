@@ -282,6 +282,9 @@ int mci_order_on_edge_line(const mci_point *a, const mci_point *b, const double 
  * coordinate plane bijectively; *sign receives sign(n_k), the orientation of the
  * triangle a, b, c in that projection. Returns -1 for a degenerate plane (n = 0). */
 int mci_plane_projection_axis(const mci_plane *plane, int *sign);
+/* The exact sign of the plane's normal component `axis`: the turn of its triangle a, b, c
+ * seen along that axis. */
+int mci_plane_normal_sign(const mci_plane *plane, int axis);
 
 typedef enum mci_containment {
     MCI_OUTSIDE = 0,
