@@ -559,7 +559,7 @@ typedef struct mcsg_eval_stats {
                                        (output_check is then that candidate's) */
     double rounding_snap_grid;      /* when a round's result is kept: the spacing of the
                                        grid its vertices were snapped to (a power of two
-                                       2^-48 to 2^-40 times the result's size); else 0 */
+                                       2^-48 to 2^-36 times the result's size); else 0 */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */

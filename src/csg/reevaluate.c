@@ -288,8 +288,9 @@ static mcsg_status evaluate_round(rounds *r, const round_state *from,
 }
 
 /* One round, each step kept if it passes: from snapped to the grid 2^e; when evaluate,
- * the snapped mesh evaluated alone and rounded, then from itself (the rounds of before
- * snapping). *next: the last evaluation, for the next round (empty when both failed). */
+ * the snapped mesh evaluated alone and rounded, then from itself (candidates that
+ * snapping loses). *next: the last evaluation, for the next round (empty when both
+ * failed). */
 static mcsg_status snap_and_evaluate(rounds *r, const round_state *from, int e, bool evaluate,
                                      round_state *next, mcsg_error *err)
 {
