@@ -90,6 +90,29 @@ static double edge_length2(double x[3][3], int i)
     return sum;
 }
 
+/* The normal of the plane's triangle from its doubles, and its largest component's
+ * magnitude (0 for a degenerate plane). A triangle so thin that the product rounds to
+ * nothing gets the unit vector along its projection axis, on the normal's side (decided
+ * exactly): a line along it still crosses the plane near the triangle. */
+static double approx_normal(const mci_plane *plane, double n[3])
+{
+    const double *a = plane->a, *b = plane->b, *d = plane->c;
+    double norm = 0;
+    int axis, sign;
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        n[k] = (b[i] - a[i]) * (d[j] - a[j]) - (b[j] - a[j]) * (d[i] - a[i]);
+        norm = fmax(norm, fabs(n[k]));
+    }
+    if (norm > 0 && isfinite(norm))
+        return norm;
+    if ((axis = mci_plane_projection_axis(plane, &sign)) < 0)
+        return 0;
+    n[0] = n[1] = n[2] = 0;
+    n[axis] = sign;
+    return 1;
+}
+
 /* A point strictly inside a triangle narrower than the spacing of doubles, where no
  * line through doubles near its centroid pierces it: the line runs from ends[0], a
  * double next to the plane at the long edge's middle, to ends[1], far on the other
@@ -110,10 +133,8 @@ static bool point_inside_sliver(const mci_point c[3], double x[3][3],
     q.turn = q.axis < 0 ? 0 : mci_orient2d_projected(q.a, q.b, q.c, q.axis);
     if (q.turn == 0)
         return false;
+    approx_normal(plane, n);
     for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        n[k] = (plane->b[i] - plane->a[i]) * (plane->c[j] - plane->a[j]) -
-               (plane->b[j] - plane->a[j]) * (plane->c[i] - plane->a[i]);
         u[k] = x[(longest + 1) % 3][k] - x[longest][k];
         mid[k] = 0.5 * (x[longest][k] + x[(longest + 1) % 3][k]);
         big = fmax(big, fabs(mid[k]));
@@ -159,15 +180,11 @@ static bool point_inside(const mci_point c[3], const mci_plane *plane, int attem
     static const double weight[MCI_INSIDE_ATTEMPTS][3] = {
         {1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.3, 0.2}, {0.2, 0.5, 0.3}, {0.3, 0.2, 0.5}};
     const double *wt = weight[attempt];
-    const double *a = plane->a, *b = plane->b, *d = plane->c;
-    double x[3][3], n[3], size = 0, norm = 0;
+    double x[3][3], n[3], size = 0, norm = approx_normal(plane, n);
     int axis, sign, turns[3];
     for (int i = 0; i < 3; i++)
         mci_point_near(&c[i], x[i]);
     for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        n[k] = (b[i] - a[i]) * (d[j] - a[j]) - (b[j] - a[j]) * (d[i] - a[i]);
-        norm = fmax(norm, fabs(n[k]));
         for (int v = 0; v < 3; v++)
             size = fmax(size, fabs(x[v][k] - x[(v + 1) % 3][k]));
     }

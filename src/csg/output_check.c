@@ -330,24 +330,32 @@ static size_t add_count(char *out, size_t at, size_t size, size_t n, const char 
     return w > 0 ? at + (size_t)w : at;
 }
 
+void mci_describe_output_check(const mcsg_output_check *c, char *what, size_t size)
+{
+    size_t at = 0;
+    if (size == 0)
+        return;
+    what[0] = 0;
+    at = add_count(what, at, size, c->welded_nonmanifold_edges,
+                   "edge of more than two triangles once vertices are welded by coordinates",
+                   "edges of more than two triangles once vertices are welded by coordinates");
+    at = add_count(what, at, size, c->index_nonmanifold_edges,
+                   "edge not manifold by vertex index", "edges not manifold by vertex index");
+    at = add_count(what, at, size, c->open_edges, "open edge", "open edges");
+    at = add_count(what, at, size, c->misoriented_edges, "misoriented edge",
+                   "misoriented edges");
+    at = add_count(what, at, size, c->degenerate_triangles, "zero-area triangle",
+                   "zero-area triangles");
+    add_count(what, at, size, c->crossing_pairs, "pair of crossing triangles",
+              "pairs of crossing triangles");
+}
+
 void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *c)
 {
     char what[512];
-    size_t at = 0;
     if (!mcsg_output_check_failed(c))
         return;
-    at = add_count(what, at, sizeof what, c->welded_nonmanifold_edges,
-                   "edge of more than two triangles once vertices are welded by coordinates",
-                   "edges of more than two triangles once vertices are welded by coordinates");
-    at = add_count(what, at, sizeof what, c->index_nonmanifold_edges,
-                   "edge not manifold by vertex index", "edges not manifold by vertex index");
-    at = add_count(what, at, sizeof what, c->open_edges, "open edge", "open edges");
-    at = add_count(what, at, sizeof what, c->misoriented_edges, "misoriented edge",
-                   "misoriented edges");
-    at = add_count(what, at, sizeof what, c->degenerate_triangles, "zero-area triangle",
-                   "zero-area triangles");
-    add_count(what, at, sizeof what, c->crossing_pairs, "pair of crossing triangles",
-              "pairs of crossing triangles");
+    mci_describe_output_check(c, what, sizeof what);
     mci_log(ctx, MCSG_LOG_WARNING, "the result breaks its guarantees after rounding to "
             "doubles: %s", what);
 }

@@ -51,6 +51,10 @@ mcsg_status mci_check_output(const mci_ctx *ctx, const mcsg_mesh *m,
 mcsg_status mci_count_crossings(const mci_ctx *ctx, const mcsg_mesh *m, size_t *pairs,
                                 mcsg_error *err);
 
+/* What the check found broken, as "N what, N what" (empty when nothing): into what,
+ * at most size bytes with the terminating zero. */
+void mci_describe_output_check(const mcsg_output_check *check, char *what, size_t size);
+
 /* One warning line naming what the check found broken, if anything. */
 void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *check);
 

@@ -234,6 +234,16 @@ static bool keeps_the_solid(const rounds *r, const mcsg_mesh *candidate)
     return fabs(c.volume - r->first.volume) <= bound;
 }
 
+/* Why a candidate is not kept, for --verbose. */
+static void log_refused(const mci_ctx *ctx, const round_state *candidate,
+                        const mcsg_output_check *check)
+{
+    char what[512];
+    mci_describe_output_check(check, what, sizeof what);
+    mci_log(ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: %s",
+            candidate->mesh.triangle_count, what[0] ? what : "more crossing triangles");
+}
+
 /* Checks candidate; when it passes, it replaces the result (and is emptied). */
 static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
                                      round_state *candidate, mcsg_error *err)
@@ -241,12 +251,19 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     mcsg_output_check check;
     bool passes = false;
     mcsg_status s;
-    if (candidate->mesh.triangle_count == 0 || !keeps_the_solid(r, &candidate->mesh))
+    if (candidate->mesh.triangle_count == 0)
         return MCSG_OK; /* a solid result is never kept empty */
+    if (!keeps_the_solid(r, &candidate->mesh)) {
+        mci_log(r->ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: its "
+                "volume is not the first result's", candidate->mesh.triangle_count);
+        return MCSG_OK;
+    }
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
     if (s == MCSG_OK)
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
                          err);
+    if (s == MCSG_OK && !passes)
+        log_refused(r->ctx, candidate, &check);
     if (s != MCSG_OK || !passes)
         return s;
     mci_mesh_free(r->ctx, r->out);
