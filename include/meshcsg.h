@@ -279,10 +279,11 @@ typedef struct mcsg_check_report {
      * triangles at an edge (it meets itself there), they are paired by angle about the
      * edge, each with the one it bounds a wedge of solid with (triangles in one
      * half-plane, such as a sliver folded flat, taken in an order that makes directions
-     * alternate), or, where directions do not alternate (one surface entering another's
-     * wedge), each with a neighbour about the edge running the other way. An edge where
-     * neither works (three or more surfaces of one shell crossing at the edge) is
-     * counted here: mcsg_eval does not take such a primitive. */
+     * alternate), or, where directions do not alternate (surfaces entering each other's
+     * wedges), without crossing pairs: taken in turn about the edge, each with the last
+     * one not yet paired running the other way. An edge where directions do not
+     * alternate and two of the shell's triangles there lie in one half-plane is counted
+     * here: mcsg_eval does not take such a primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;

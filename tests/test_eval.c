@@ -674,6 +674,17 @@ TEST(leaves_entering_themselves_at_an_edge)
         "polyhedron(points=[[0,0,0],[1,1,0],[2,1.5,0],[2,0,0],[0,2,0],[0,0,1],[1,1,1],[2,1.5,1"
         "],[2,0,1],[0,2,1]], faces=[[6,1,0],[5,6,0],[7,2,1],[6,7,1],[8,3,2],[7,8,2],[6,1,3],[8"
         ",6,3],[9,4,1],[6,9,1],[5,0,4],[9,5,4],[1,4,0],[2,3,1],[9,6,5],[8,7,6]]);";
+    /* Three lobes nested about the edge x = y = 0 of a prism (the triangles (0,0),
+     * (10,0), (0,10); (0,0), (6,1), (1,6); (0,0), (3,1), (1,3), all counterclockwise,
+     * one shell by the order of its faces): directions about the edge run out, out,
+     * out, in, in, in, so neither pairing of neighbours works; the pairs are nested
+     * instead. Winding numbers 1, 2 and 3: the solid is the outer lobe's prism, 500. */
+    static const char *const nested3 =
+        "polyhedron(points=[[0,0,0],[10,0,0],[10,0,10],[0,0,10],[0,10,0],[0,10,10],[6,1,0],[6"
+        ",1,10],[1,6,0],[1,6,10],[3,1,0],[3,1,10],[1,3,0],[1,3,10]], faces=[[3,0,4],[3,7,0],["
+        "3,0,8],[3,11,0],[3,0,12],[3,2,0],[2,1,0],[5,4,1],[2,5,1],[5,3,4],[7,6,0],[9,8,6],[7,"
+        "9,6],[9,3,8],[11,10,0],[13,12,10],[11,13,10],[13,3,12],[1,4,0],[5,2,3],[6,8,0],[9,7,"
+        "3],[10,12,0],[13,11,3]]);";
     char text[2048];
     snprintf(text, sizeof text, "union() { %s }", nested);
     expect_solid(text, 1000, 1);
@@ -691,6 +702,15 @@ TEST(leaves_entering_themselves_at_an_edge)
     snprintf(text, sizeof text, "difference() { translate([-1,1,-1]) cube([4,2,3]); %s }",
              bowtie);
     expect_solid(text, 23.5, 1);
+    snprintf(text, sizeof text, "union() { %s }", nested3);
+    expect_solid(text, 500, 1);
+    /* Cut across all three lobes: x <= 2 holds 18 of the outer lobe's area. */
+    snprintf(text, sizeof text, "intersection() { %s translate([-1,-1,-1]) cube([3,12,12]); }",
+             nested3);
+    expect_solid(text, 180, 1);
+    snprintf(text, sizeof text, "difference() { translate([-1,-1,-1]) cube([3,12,12]); %s }",
+             nested3);
+    expect_solid(text, 252, 1);
 }
 
 TEST(curved_volumes_add_up)

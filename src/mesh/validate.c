@@ -365,28 +365,28 @@ static bool alternate_ties(const edge_use *group, size_t n, const bool *tie, int
     return true;
 }
 
-/* Where directions do not alternate around the edge (one surface of the shell crossing
- * another there, or lying inside its wedge), the uses in turn order (no two in one
- * half-plane) paired as neighbours, (0, 1), (2, 3), ... or (1, 2), ..., (n - 1, 0), each
- * pair one way and the other: two neighbours bound a wedge no other triangle enters,
- * with equal winding numbers on their sides facing it and on their other sides, so
- * their pieces may be joined into one region as a solid wedge's are. False when neither
- * pairing runs both ways in every pair (three surfaces crossing at the edge). */
-static bool pair_neighbours(const edge_use *group, size_t n, const uint8_t *order,
+/* Where directions do not alternate around the edge (surfaces of the shell crossing
+ * each other there, or one lying inside another's wedge), the uses in turn order (no two
+ * in one half-plane) paired without crossing: a stack takes them in turn, and one running
+ * the other way than the top pairs with it. The uses between two partners, either way
+ * round the edge, are whole pairs, as many one way as the other, so the winding numbers
+ * beside the partners are equal on the sides facing each other and on their other sides:
+ * their pieces may be joined into one region as a solid wedge's are, and each pair is one
+ * sheet for the local test. Always succeeds on a balanced edge. */
+static void pair_neighbours(const edge_use *group, size_t n, const uint8_t *order,
                             uint8_t *mate)
 {
-    for (size_t phase = 0; phase < 2; phase++) {
-        bool ok = true;
-        for (size_t i = phase; i < n + phase && ok; i += 2)
-            ok = group[order[i % n]].forward != group[order[(i + 1) % n]].forward;
-        for (size_t i = phase; i < n + phase && ok; i += 2) {
-            uint8_t a = order[i % n], b = order[(i + 1) % n];
-            mate[a] = b, mate[b] = a;
+    uint8_t stack[ANGLE_PAIRING_MAX];
+    size_t top = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint8_t here = order[i];
+        if (top > 0 && group[stack[top - 1]].forward != group[here].forward) {
+            uint8_t other = stack[--top];
+            mate[here] = other, mate[other] = here;
+        } else {
+            stack[top++] = here;
         }
-        if (ok)
-            return true;
     }
-    return false;
 }
 
 /* Pairs the uses of a balanced edge of more than two triangles by angle, as
@@ -396,8 +396,9 @@ static bool pair_neighbours(const edge_use *group, size_t n, const uint8_t *orde
  * flat, a face listed twice) may be taken in any order that makes directions alternate;
  * such a pair bounds a wedge of no width. Where directions cannot alternate and no two
  * lie in one half-plane, pair_neighbours pairs them. mate[i] is i's partner (positions
- * in group). 0 when the edge has too many uses or none of these pairings works, 2
- * when pair_neighbours paired them, else 1. */
+ * in group). 0 when the edge has too many uses, or directions cannot alternate and two
+ * lie in one half-plane (no order of theirs is known to keep the winding numbers beside
+ * partners equal); 2 when pair_neighbours paired them, else 1. */
 static int pair_by_angle(const check_state *s, const edge_use *group, size_t n,
                          uint8_t *mate)
 {
@@ -413,8 +414,12 @@ static int pair_by_angle(const check_state *s, const edge_use *group, size_t n,
         phase++;
     for (size_t i = 0; i < n; i++)
         ties |= tie[i];
-    if (phase == 2)
-        return !ties && pair_neighbours(group, n, order, mate) ? 2 : 0;
+    if (phase == 2 && ties)
+        return 0;
+    if (phase == 2) {
+        pair_neighbours(group, n, order, mate);
+        return 2;
+    }
     for (size_t i = 0; i < n; i++) {
         uint8_t here = order[i], before = order[(i + n - 1) % n];
         if (group[here].forward)
