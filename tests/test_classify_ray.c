@@ -9,6 +9,7 @@
 #include "testlib.h"
 #include "csg/leaf_boxes.h"
 #include "csg/classify.h"
+#include "csg/classify_leaf.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -209,6 +210,50 @@ TEST(windings_on_both_sides_of_a_face)
     free(twice.triangles);
 }
 
+/* Whether some attempt finds a point strictly inside the triangle a, b, c (its own
+ * plane), checked by its turns against the edges. */
+static bool inside_point_found(const double *a, const double *b, const double *c)
+{
+    mci_plane plane;
+    mci_point corner[3], out;
+    double ends[2][3];
+    int sign, axis;
+    mci_plane_init(&plane, a, b, c);
+    mci_point_explicit(&corner[0], a);
+    mci_point_explicit(&corner[1], b);
+    mci_point_explicit(&corner[2], c);
+    axis = mci_plane_projection_axis(&plane, &sign);
+    for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS; attempt++) {
+        int turns[3];
+        if (!mci_point_inside_triangle(corner, &plane, attempt, ends, &out))
+            continue;
+        for (int i = 0; i < 3; i++)
+            turns[i] = mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], &out, axis);
+        CHECK_MSG(turns[0] == sign && turns[1] == sign && turns[2] == sign,
+                  "attempt %d: the point is not strictly inside", attempt);
+        return true;
+    }
+    return false;
+}
+
+/* Ray seeds in slivers narrower than the spacing of doubles: one in the plane y = 0
+ * (7e-17 wide, from a rounded sponge evaluated again: the line's near end was moved off
+ * the plane by a denormal, so the line met the plane at that end whatever its far end),
+ * and one whose normal computed in doubles is 0 (exactly 2^-54: (1 + 2^-27)^2 rounds to
+ * 1 + 2^-26). */
+TEST(slivers_get_inside_points)
+{
+    static const double a[3] = {33.264638957550233, 0, 11.760821572499935},
+                        b[3] = {27.216519079750014, 0, 16.037483962500119},
+                        c[3] = {33.275569907228288, 0, 11.753092231428719};
+    static const double o[3] = {0, 0, 0};
+    double u[3] = {1 + 0x1p-27, 1, 0}, v[3] = {1 + 0x1p-26, 1 + 0x1p-27, 0};
+    CHECK(inside_point_found(a, b, c));
+    CHECK(inside_point_found(o, u, v));
+    CHECK(inside_point_found(o, v, u));
+    CHECK(inside_point_found(c, b, a));
+}
+
 TEST(box_overlaps_match_every_pair)
 {
     mci_ctx ctx;
@@ -253,5 +298,6 @@ int main(void)
     RUN(octree_rays_know_the_box);
     RUN(box_overlaps_match_every_pair);
     RUN(windings_on_both_sides_of_a_face);
+    RUN(slivers_get_inside_points);
     return test_summary();
 }

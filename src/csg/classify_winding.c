@@ -147,12 +147,14 @@ static bool point_inside_sliver(const mci_point c[3], double x[3][3],
     if (!(len > 0) || !(nlen > 0) || !isfinite(len) || !isfinite(big) || big == 0)
         return false;
     /* ends[0]: the long edge's middle, moved off the plane along the projection axis by
-     * the fewest units that leave it. */
+     * the fewest units of the largest coordinate that leave it (a unit of that
+     * coordinate itself is a denormal on a plane through 0, and the line would then
+     * meet the plane at ends[0] whatever ends[1]). */
     memcpy(ends[0], mid, sizeof mid);
     for (int step = 0; (s0 = mci_orient3d_vertex(ends[0], plane)) == 0; step++) {
         if (step == 64)
             return false;
-        ends[0][q.axis] = nextafter(ends[0][q.axis], INFINITY);
+        ends[0][q.axis] += ldexp(1.0, ilogb(big) - 52);
     }
     /* far: as far again as the point is from the origin, on the other side. */
     memcpy(q.far, ends[0], sizeof q.far);
@@ -166,14 +168,9 @@ static bool point_inside_sliver(const mci_point c[3], double x[3][3],
     return sliver_bisect(&q, -64 * big * 0x1p-52, 64 * big * 0x1p-52);
 }
 
-/* A point strictly inside the triangle with corners c[0..2] in plane `plane` (input
- * vertices; the corners may be implicit points): where a line through the corners'
- * approximate centroid, along the plane's approximate normal, pierces the plane (an LPI
- * of input vertices; `ends` holds the line's two ends, which the point refers to). False
- * when the doubles do not give a line crossing the plane or a point strictly inside
- * (slivers). */
-static bool point_inside(const mci_point c[3], const mci_plane *plane, int attempt,
-                         double ends[2][3], mci_point *out)
+/* See classify_leaf.h. */
+bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int attempt,
+                                double ends[2][3], mci_point *out)
 {
     /* Barycentric weights, the centroid first: a point on the border of a face of another
      * surface lying in this one decides nothing, and another point rarely is too. */
@@ -214,7 +211,7 @@ bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double
     for (int i = 0; i < 3; i++)
         mci_leaf_piece_point(w, p, i, &c[i]);
     mci_scene_face_plane(w->s, w->pface[p], plane);
-    return point_inside(c, plane, attempt, ends, out);
+    return mci_point_inside_triangle(c, plane, attempt, ends, out);
 }
 
 bool mci_leaf_own_seed(mci_leaf_work *w, uint32_t r)
