@@ -260,7 +260,8 @@ typedef struct mcsg_check_report {
                                      negative: every triangle faces inward */
     int volume_sign;              /* exact sign of the volume (+1, -1, or 0) when closed
                                      and consistent; 0 otherwise. A closed mesh with
-                                     volume 0 encloses nothing: it folds onto itself */
+                                     volume 0 folds onto itself or crosses itself into
+                                     lobes whose winding numbers cancel */
     uint32_t example_out_of_range_triangle;
     uint32_t example_nonfinite_vertex;
     uint32_t example_degenerate_triangle;
@@ -579,8 +580,7 @@ typedef struct mcsg_eval_stats {
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
  * coordinates, no shell meeting itself at an edge with more than two triangles that
- * cannot be paired about it (self_touching_edges), and a non-zero volume
- * when it has one shell. Zero-area triangles bound nothing and are removed first, with a
+ * cannot be paired about it (self_touching_edges). Zero-area triangles bound nothing and are removed first, with a
  * warning (one with three collinear corners splits a neighbour at its middle corner;
  * provenance names the leaf's own triangles); only where two of them lie back to back
  * along one edge with different middle corners is the leaf refused.

@@ -713,6 +713,34 @@ TEST(leaves_entering_themselves_at_an_edge)
     expect_solid(text, 252, 1);
 }
 
+/* A single shell enclosing no volume is valid input: folded flat (a tetrahedron with
+ * all four corners in z = 0) its winding number is 0 everywhere; a bowtie prism whose
+ * lobes (area 1 each) run counterclockwise and clockwise has numbers 1 and -1, and the
+ * first lobe is the solid. */
+TEST(shells_enclosing_no_volume)
+{
+    static const char *const flat =
+        "polyhedron(points=[[0,0,0],[4,0,0],[0,4,0],[1,1,0]], faces=[[0,2,1],[0,1,3],[0,3,2],"
+        "[1,2,3]]);";
+    static const char *const bowtie =
+        "polyhedron(points=[[0,0,0],[1,1,0],[2,2,0],[2,0,0],[0,2,0],[0,0,1],[1,1,1],[2,2,1],"
+        "[2,0,1],[0,2,1]], faces=[[6,1,0],[5,6,0],[7,2,1],[6,7,1],[8,3,2],[7,8,2],[6,1,3],[8"
+        ",6,3],[9,4,1],[6,9,1],[5,0,4],[9,5,4],[1,4,0],[2,3,1],[9,6,5],[8,7,6]]);";
+    char text[1024];
+    snprintf(text, sizeof text, "union() { translate([-1,-1,-1]) cube(3); %s }", flat);
+    expect_solid(text, 27, 1);
+    snprintf(text, sizeof text, "difference() { translate([-1,-1,-1]) cube(3); %s }", flat);
+    expect_solid(text, 27, 1);
+    snprintf(text, sizeof text, "union() { %s }", bowtie);
+    expect_solid(text, 1, 1);
+    snprintf(text, sizeof text, "intersection() { %s translate([-1,1,-1]) cube([4,2,3]); }",
+             bowtie);
+    expect_solid(text, 0.5, 1);
+    snprintf(text, sizeof text, "difference() { translate([-1,1,-1]) cube([4,2,3]); %s }",
+             bowtie);
+    expect_solid(text, 23.5, 1);
+}
+
 TEST(curved_volumes_add_up)
 {
     static const char *a = "sphere(1, $fn=24);";
@@ -1482,6 +1510,7 @@ int main(void)
     RUN(leaves_closed_as_chains);
     RUN(leaf_touching_itself_along_an_edge);
     RUN(leaves_entering_themselves_at_an_edge);
+    RUN(shells_enclosing_no_volume);
     RUN(rounding_broken_result_is_evaluated_again);
     RUN(leaves_crossing_themselves);
     RUN(repair_joins_overlapping_shells);

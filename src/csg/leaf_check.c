@@ -72,11 +72,8 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
         format_point(b, sizeof b, m, r->example_self_touching_edge[1]);
         snprintf(out, size, "not supported: %zu edges where one shell meets itself with "
                  "more than two triangles that cannot be paired about the edge (surfaces "
-                 "entering each other's wedges, two of them in one plane), e.g. from %s to %s", r->self_touching_edges,
-                 a, b);
-    } else if (r->volume_sign == 0 && r->components == 1) {
-        snprintf(out, size, "the mesh encloses no volume (its triangles fold onto each "
-                 "other, e.g. all in one plane)");
+                 "entering each other's wedges, two of them in one plane), e.g. from %s "
+                 "to %s", r->self_touching_edges, a, b);
     }
 }
 
@@ -165,8 +162,14 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     if (problem[0] == '\0') {
         /* Where one shell meets itself at an edge, parts of it may lie inside others or
          * face inward (pair_neighbours in validate.c): only winding numbers tell. */
+        /* A single shell enclosing no volume either folds onto itself (nothing is
+         * inside it) or crosses itself into lobes whose numbers cancel: its faces are
+         * intersected with each other, as for a shell found crossing itself, without
+         * testing (such leaves are rare). */
+        bool no_volume = report.components == 1 && report.volume_sign == 0;
+        job->ptree->leaf_crossing[k] |= no_volume;
         job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0 ||
-                                      job->ptree->leaf_mates[k].count > 0;
+                                      job->ptree->leaf_mates[k].count > 0 || no_volume;
         return MCSG_OK;
     }
     return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
