@@ -580,10 +580,10 @@ typedef struct mcsg_eval_stats {
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
  * coordinates, no shell meeting itself at an edge with more than two triangles that
- * cannot be paired about it (self_touching_edges). Zero-area triangles bound nothing and are removed first, with a
- * warning (one with three collinear corners splits a neighbour at its middle corner;
- * provenance names the leaf's own triangles); only where two of them lie back to back
- * along one edge with different middle corners is the leaf refused.
+ * cannot be paired about it (self_touching_edges). Zero-area triangles bound nothing
+ * and are removed first, with a warning (one with three collinear corners splits a
+ * neighbour at its middle corner, several back to back split every edge through their
+ * corners; provenance names the leaf's own triangles).
  * A leaf is the set where its winding number is positive: it may have several shells,
  * facing out or in, nested, overlapping, sharing edges or faces, and repeated triangles
  * (overlapping outward shells are their union, an inward shell inside an outward one is
