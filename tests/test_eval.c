@@ -655,6 +655,20 @@ TEST(leaf_touching_itself_along_an_edge)
  * surface of the shell enters another's wedge there. The pieces are paired as
  * neighbours about the edge (validate.c pair_neighbours), the leaf is classified by
  * winding numbers, and tested for crossings (its parts often overlap in their faces). */
+/* A leaf alone (volume `alone`), its intersection with `box` (`common`) and the box
+ * minus it (`box_minus_leaf`), each one component. */
+static void expect_leaf_and_box(const char *leaf, const char *box, double alone,
+                                double common, double box_minus_leaf)
+{
+    char text[2048];
+    snprintf(text, sizeof text, "union() { %s }", leaf);
+    expect_solid(text, alone, 1);
+    snprintf(text, sizeof text, "intersection() { %s %s }", leaf, box);
+    expect_solid(text, common, 1);
+    snprintf(text, sizeof text, "difference() { %s %s }", box, leaf);
+    expect_solid(text, box_minus_leaf, 1);
+}
+
 TEST(leaves_entering_themselves_at_an_edge)
 {
     /* A box with a prism inside sharing its edge x = y = 10, joined into one shell
@@ -691,26 +705,12 @@ TEST(leaves_entering_themselves_at_an_edge)
     snprintf(text, sizeof text, "difference() { %s translate([-1,-1,4]) cube([12,12,2]); }",
              nested);
     expect_solid(text, 800, 2);
-    snprintf(text, sizeof text, "union() { %s }", bowtie);
-    expect_solid(text, 1, 1);
     /* The plane y = 1 through the crossing edge: half of the first lobe on each side. */
+    expect_leaf_and_box(bowtie, "translate([-1,1,-1]) cube([4,2,3]);", 1, 0.5, 23.5);
     snprintf(text, sizeof text, "union() { %s translate([-1,1,-1]) cube([4,2,3]); }", bowtie);
     expect_solid(text, 24.5, 1);
-    snprintf(text, sizeof text, "intersection() { %s translate([-1,1,-1]) cube([4,2,3]); }",
-             bowtie);
-    expect_solid(text, 0.5, 1);
-    snprintf(text, sizeof text, "difference() { translate([-1,1,-1]) cube([4,2,3]); %s }",
-             bowtie);
-    expect_solid(text, 23.5, 1);
-    snprintf(text, sizeof text, "union() { %s }", nested3);
-    expect_solid(text, 500, 1);
     /* Cut across all three lobes: x <= 2 holds 18 of the outer lobe's area. */
-    snprintf(text, sizeof text, "intersection() { %s translate([-1,-1,-1]) cube([3,12,12]); }",
-             nested3);
-    expect_solid(text, 180, 1);
-    snprintf(text, sizeof text, "difference() { translate([-1,-1,-1]) cube([3,12,12]); %s }",
-             nested3);
-    expect_solid(text, 252, 1);
+    expect_leaf_and_box(nested3, "translate([-1,-1,-1]) cube([3,12,12]);", 500, 180, 252);
 }
 
 /* A single shell enclosing no volume is valid input: folded flat (a tetrahedron with
@@ -731,14 +731,7 @@ TEST(shells_enclosing_no_volume)
     expect_solid(text, 27, 1);
     snprintf(text, sizeof text, "difference() { translate([-1,-1,-1]) cube(3); %s }", flat);
     expect_solid(text, 27, 1);
-    snprintf(text, sizeof text, "union() { %s }", bowtie);
-    expect_solid(text, 1, 1);
-    snprintf(text, sizeof text, "intersection() { %s translate([-1,1,-1]) cube([4,2,3]); }",
-             bowtie);
-    expect_solid(text, 0.5, 1);
-    snprintf(text, sizeof text, "difference() { translate([-1,1,-1]) cube([4,2,3]); %s }",
-             bowtie);
-    expect_solid(text, 23.5, 1);
+    expect_leaf_and_box(bowtie, "translate([-1,1,-1]) cube([4,2,3]);", 1, 0.5, 23.5);
 }
 
 TEST(curved_volumes_add_up)
