@@ -161,11 +161,10 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     mci_free(job->ctx, shell);
     if (problem[0] == '\0') {
         /* Where one shell meets itself at an edge, parts of it may lie inside others or
-         * face inward (pair_neighbours in validate.c): only winding numbers tell. */
-        /* A single shell enclosing no volume either folds onto itself (nothing is
-         * inside it) or crosses itself into lobes whose numbers cancel: its faces are
-         * intersected with each other, as for a shell found crossing itself, without
-         * testing (such leaves are rare). */
+         * face inward (pair_neighbours in validate.c): only winding numbers tell. A
+         * single shell enclosing no volume folds onto itself (nothing is inside it) or
+         * crosses itself into lobes whose numbers cancel: its faces are intersected with
+         * each other, as a shell found crossing itself, without a test (it is rare). */
         bool no_volume = report.components == 1 && report.volume_sign == 0;
         job->ptree->leaf_crossing[k] |= no_volume;
         job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0 ||
