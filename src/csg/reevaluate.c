@@ -258,6 +258,14 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
                 "volume is not the first result's", candidate->mesh.triangle_count);
         return MCSG_OK;
     }
+    /* Snapping can turn a sliver over: closed and oriented edge by edge, inside out as
+     * a whole (the volume bound above is wider than such a sliver). */
+    if (mci_triangles_volume_sign(candidate->mesh.vertices, candidate->mesh.triangles, NULL,
+                                  candidate->mesh.triangle_count, NULL) < 0) {
+        mci_log(r->ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: it is "
+                "inside out", candidate->mesh.triangle_count);
+        return MCSG_OK;
+    }
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
     if (s == MCSG_OK)
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
