@@ -235,13 +235,19 @@ static bool keeps_the_solid(const rounds *r, const mcsg_mesh *candidate)
 }
 
 /* Why a candidate is not kept, for --verbose. */
-static void log_refused(const mci_ctx *ctx, const round_state *candidate,
-                        const mcsg_output_check *check)
+static void log_refused(const mci_ctx *ctx, const round_state *candidate, const char *why)
+{
+    mci_log(ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: %s",
+            candidate->mesh.triangle_count, why);
+}
+
+/* The same for a candidate whose check failed. */
+static void log_check_refused(const mci_ctx *ctx, const round_state *candidate,
+                              const mcsg_output_check *check)
 {
     char what[512];
     mci_describe_output_check(check, what, sizeof what);
-    mci_log(ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: %s",
-            candidate->mesh.triangle_count, what[0] ? what : "more crossing triangles");
+    log_refused(ctx, candidate, what[0] ? what : "more crossing triangles");
 }
 
 /* Checks candidate; when it passes, it replaces the result (and is emptied). */
@@ -254,16 +260,14 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     if (candidate->mesh.triangle_count == 0)
         return MCSG_OK; /* a solid result is never kept empty */
     if (!keeps_the_solid(r, &candidate->mesh)) {
-        mci_log(r->ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: its "
-                "volume is not the first result's", candidate->mesh.triangle_count);
+        log_refused(r->ctx, candidate, "its volume is not the first result's");
         return MCSG_OK;
     }
     /* Snapping can turn a sliver over: closed and oriented edge by edge, inside out as
      * a whole (the volume bound above is wider than such a sliver). */
     if (mci_triangles_volume_sign(candidate->mesh.vertices, candidate->mesh.triangles, NULL,
                                   candidate->mesh.triangle_count, NULL) < 0) {
-        mci_log(r->ctx, MCSG_LOG_INFO, "a candidate of %zu triangles is not kept: it is "
-                "inside out", candidate->mesh.triangle_count);
+        log_refused(r->ctx, candidate, "it is inside out");
         return MCSG_OK;
     }
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
@@ -271,7 +275,7 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
                          err);
     if (s == MCSG_OK && !passes)
-        log_refused(r->ctx, candidate, &check);
+        log_check_refused(r->ctx, candidate, &check);
     if (s != MCSG_OK || !passes)
         return s;
     mci_mesh_free(r->ctx, r->out);
