@@ -8,6 +8,8 @@
  * (or from the third argument) and are printed, so a run can be repeated.
  *
  * usage: fuzz_csg SECONDS [DIR [FIRST_SEED]]; exit status 1 if anything failed.
+ *        With MCSG_FUZZ_LIST_BROKEN set, every tree whose output is reported broken by
+ *        rounding is printed (seed, family, the guarantee broken): the cases to study.
  *        fuzz_csg print SEED   prints the tree of one seed as a CSG file (imports relative
  *                              to tests/data/models).
  * The models are found through MCSG_TEST_DATA (tests/data), as under CTest.
@@ -92,6 +94,18 @@ static void print_broken(const broken_tally *b)
         printf("  %6ld %s\n", b->reason_count[k], b->reason[k]);
 }
 
+static void print_broken_case(const csg_tree_spec *t, bool with_provenance,
+                              const csg_result *r)
+{
+    const mcsg_output_check *c = &r->check;
+    printf("broken seed 0x%016" PRIx64 " family %s provenance %s: %zu welded, %zu crossing, "
+           "%zu zero-area, %zu open; %s\n", t->seed, csg_family_names[t->family],
+           with_provenance ? "yes" : "no", c->welded_nonmanifold_edges, c->crossing_pairs,
+           c->degenerate_triangles, c->open_edges,
+           r->reevaluation[0] ? r->reevaluation : "every round failed its check");
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
     double seconds = argc > 1 ? atof(argv[1]) : 60, start = csg_now();
@@ -107,6 +121,7 @@ int main(int argc, char **argv)
         return 0;
     }
     long trees = 0, failures = 0, leaves = 0, reported = 0;
+    bool list_broken = getenv("MCSG_FUZZ_LIST_BROKEN") != NULL;
     long self_intersecting[CSG_FAMILIES] = {0}, families[CSG_FAMILIES] = {0};
     if (!csg_load_models())
         fprintf(stderr, "fuzz_csg: models of tests/data/models missing (set MCSG_TEST_DATA to tests/data): "
@@ -128,6 +143,8 @@ int main(int argc, char **argv)
             reported += r.rounding_reported;
             if (r.rounding_reported)
                 tally_broken(&broken, &r);
+            if (r.rounding_reported && list_broken)
+                print_broken_case(&t, with_provenance, &r);
             continue;
         }
         failures++;
