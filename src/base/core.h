@@ -49,6 +49,12 @@ typedef struct mci_ctx {
     /* An evaluation of a rounded result again (csg/reevaluate.c): its rounding repair
      * looks for opposite twins after every change, which folds there need. */
     bool reevaluation_round;
+    /* In such a round: where the first evaluation's exact result touches itself (edge
+     * ends as output_check.h lists them). Parts of the round's result touching anywhere
+     * else are moved apart, though its own exact result touches there: rounding made that
+     * contact, and the round is judged against the first result's. */
+    const double *allowed_touching;
+    size_t allowed_touching_count;
     mci_pool *pool; /* worker threads: the options' (borrowed) or the call's own */
     bool owns_pool; /* started by mci_pool_start, stopped by mci_pool_stop */
 } mci_ctx;

@@ -502,6 +502,9 @@ static mcsg_status list_touching(eval_state *e, const rounded *r, mcsg_error *er
 
 static mci_exact_result touching_of(const eval_state *e)
 {
+    if (e->ctx.reevaluation_round)
+        return (mci_exact_result){NULL, 0, NULL, NULL, e->ctx.allowed_touching,
+                                  e->ctx.allowed_touching_count};
     return (mci_exact_result){NULL, 0, NULL, NULL, e->touching, e->touching_count};
 }
 

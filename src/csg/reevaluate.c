@@ -12,7 +12,11 @@
  * break a guarantee in turn where many nearly coincide; snapped to a coarser grid
  * (snap_round.c) they are one point. Each round tries its starting mesh snapped, the
  * snapped mesh evaluated again, and the starting mesh evaluated again; the first whose
- * check passes is kept, and otherwise the first result stays (with its report).
+ * check passes is kept, and otherwise the first result stays (with its report). A
+ * round starts from the last round's evaluation, unless that failed or is no mesh to
+ * start from (open, misoriented, inside out, or another solid): then from the first
+ * result, on the next grid. Every round's evaluation moves apart the parts that touch
+ * where the first result's exact result does not: rounding made that contact.
  */
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
@@ -34,9 +38,11 @@ static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 /* The context of one round: the caller's allocator, threads and pool, no log or
  * progress of its own (the round is a step of the caller's evaluation), and every
  * shell tested for crossings, which rounding may have made. */
-static mci_ctx round_context(const mci_ctx *ctx)
+static mci_ctx round_context(const mci_ctx *ctx, const mci_exact_result *exact)
 {
     mci_ctx inner = *ctx;
+    inner.allowed_touching = exact->touching;
+    inner.allowed_touching_count = exact->touching_count;
     inner.log = NULL;
     inner.progress = NULL;
     inner.check_self_intersections = 1;
@@ -66,11 +72,12 @@ mcsg_status mci_tree_of_one_mesh(const mcsg_options *opts, const mcsg_mesh *mesh
 
 /* mesh as the only leaf of a union, evaluated: *next, and its per-triangle faces of mesh
  * in *faces when faces is not NULL. */
-static mcsg_status evaluate_alone(const mci_ctx *ctx, const mcsg_mesh *mesh, mcsg_mesh *next,
+static mcsg_status evaluate_alone(const mci_ctx *ctx, const mci_exact_result *exact,
+                                  const mcsg_mesh *mesh, mcsg_mesh *next,
                                   mcsg_provenance **faces, mcsg_eval_stats *st,
                                   mcsg_error *err)
 {
-    mci_ctx inner = round_context(ctx);
+    mci_ctx inner = round_context(ctx, exact);
     mcsg_options opts;
     mcsg_tree *tree = NULL;
     mcsg_status s;
@@ -95,6 +102,8 @@ static void map_provenance(mcsg_provenance *faces, size_t n, const mcsg_provenan
 typedef struct round_state {
     mcsg_mesh mesh;          /* the last round's result (zero before the first) */
     mcsg_provenance *source; /* its triangles' sources in the tree, or NULL */
+    bool no_start;           /* refused as no round's start: open, misoriented, inside
+                                out, or not the first result's solid */
 } round_state;
 
 static void round_state_free(const mci_ctx *ctx, round_state *r)
@@ -107,13 +116,14 @@ static void round_state_free(const mci_ctx *ctx, round_state *r)
 /* One round from `from` (mesh and sources): *to, with its sources mapped back to the
  * tree's leaves. A round that fails for any reason but memory (a region whose winding
  * number no ray decides, a leaf refused) is logged and leaves *to empty. */
-static mcsg_status one_round(const mci_ctx *ctx, const mcsg_mesh *from,
+static mcsg_status one_round(const mci_ctx *ctx, const mci_exact_result *exact,
+                             const mcsg_mesh *from,
                              const mcsg_provenance *from_source, bool want_source,
                              round_state *to, mcsg_eval_stats *st, mcsg_error *err)
 {
     mcsg_error ignored;
-    mcsg_status s = evaluate_alone(ctx, from, &to->mesh, want_source ? &to->source : NULL, st,
-                                   &ignored);
+    mcsg_status s = evaluate_alone(ctx, exact, from, &to->mesh,
+                                   want_source ? &to->source : NULL, st, &ignored);
     if (s == MCSG_ERR_NOMEM)
         return mci_fail_nomem(err, "evaluating the rounded result again");
     if (s != MCSG_OK) {
@@ -259,6 +269,7 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     mcsg_status s;
     if (candidate->mesh.triangle_count == 0)
         return MCSG_OK; /* a solid result is never kept empty */
+    candidate->no_start = true;
     if (!keeps_the_solid(r, &candidate->mesh)) {
         log_refused(r->ctx, candidate, "its volume is not the first result's");
         return MCSG_OK;
@@ -271,9 +282,11 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
         return MCSG_OK;
     }
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
-    if (s == MCSG_OK)
+    if (s == MCSG_OK) {
+        candidate->no_start = check.open_edges > 0 || check.misoriented_edges > 0;
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
                          err);
+    }
     if (s == MCSG_OK && !passes)
         log_check_refused(r->ctx, candidate, &check);
     if (s != MCSG_OK || !passes)
@@ -303,7 +316,8 @@ static mcsg_status evaluate_round(rounds *r, const round_state *from,
                                   mcsg_error *err)
 {
     mcsg_eval_stats st;
-    mcsg_status s = one_round(r->ctx, &from->mesh, from->source, r->want_source, next, &st, err);
+    mcsg_status s =
+        one_round(r->ctx, exact, &from->mesh, from->source, r->want_source, next, &st, err);
     r->stats->rounding_reevaluations++;
     if (s == MCSG_OK && next->mesh.triangle_count > r->most_triangles) {
         mci_log(r->ctx, MCSG_LOG_INFO, "evaluating the rounded result again gave %zu "
@@ -313,20 +327,22 @@ static mcsg_status evaluate_round(rounds *r, const round_state *from,
     }
     if (s == MCSG_OK)
         s = keep_if_it_passes(r, exact, next, err);
+    if (s == MCSG_OK && next->no_start)
+        round_state_free(r->ctx, next);
     return s;
 }
 
 /* One round, each step kept if it passes: from snapped to the grid 2^e; when evaluate,
- * the snapped mesh evaluated alone and rounded, then from itself (candidates that
- * snapping loses). *next: the last evaluation, for the next round (empty when both
- * failed). */
+ * the snapped mesh evaluated alone and rounded, then, when evaluate_from, from itself
+ * (candidates that snapping loses). *next: the last evaluation, for the next round
+ * (empty when both failed). */
 static mcsg_status snap_and_evaluate(rounds *r, const round_state *from, int e, bool evaluate,
-                                     round_state *next, mcsg_error *err)
+                                     bool evaluate_from, round_state *next, mcsg_error *err)
 {
     double *ends = snap_touching(r->ctx, r->touching, r->touching_count, e);
     mci_exact_result snapped_exact = {NULL, 0, NULL, NULL, ends, r->touching_count};
     mci_exact_result exact = {NULL, 0, NULL, NULL, r->touching, r->touching_count};
-    round_state snapped = {{0}, NULL}, from_snapped = {{0}, NULL};
+    round_state snapped = {{0}, NULL, false}, from_snapped = {{0}, NULL, false};
     mcsg_status s = ends ? snap_round(r->ctx, &from->mesh, from->source, r->want_source, e,
                                       &snapped, err)
                          : mci_fail_nomem(err, "snapping the rounded result to a grid");
@@ -338,7 +354,7 @@ static mcsg_status snap_and_evaluate(rounds *r, const round_state *from, int e, 
         s = evaluate_round(r, &snapped, &snapped_exact, &from_snapped, err);
     if (s == MCSG_OK && r->kept)
         r->stats->rounding_snap_grid = ldexp(1.0, e);
-    if (s == MCSG_OK && !r->kept && evaluate)
+    if (s == MCSG_OK && !r->kept && evaluate && evaluate_from)
         s = evaluate_round(r, from, &exact, next, err);
     if (s == MCSG_OK && next->mesh.triangle_count == 0) {
         round_state_free(r->ctx, next);
@@ -360,15 +376,15 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
     rounds r = {ctx, out, provenance, stats, provenance && *provenance, false, SIZE_MAX,
                 size_of(out), ldexp(1.0, top - 48), touching, touching_count,
                 4 * out->triangle_count + 1000};
-    round_state last = {{0}, NULL}, next;
+    round_state last = {{0}, NULL, false}, next;
     mcsg_status s = MCSG_OK;
     for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
-        round_state first = {*out, r.want_source ? *provenance : NULL};
-        const round_state *from = round == 0 ? &first : &last;
-        if (round > 0 && last.mesh.triangle_count == 0)
-            break; /* the last evaluations failed */
+        round_state first = {*out, r.want_source ? *provenance : NULL, false};
+        /* Where the last round's evaluations failed, the next grid is tried on the first
+         * result: coarser, it may join what the finer one left apart. */
+        const round_state *from = last.mesh.triangle_count > 0 ? &last : &first;
         s = snap_and_evaluate(&r, from, top - snap_bits[round], round < REEVALUATION_ROUNDS,
-                              &next, err);
+                              round == 0 || from == &last, &next, err);
         round_state_free(ctx, &last);
         last = next;
     }

@@ -43,6 +43,17 @@ lacks "warning"
 run 0 check --self-intersections "$WORK/b5.off"
 contains "ok: no self-intersections"
 
+# Fuzz cases (grid family) where the rounds once ended with crossing triangles: a round
+# whose evaluation made parts touch where the exact result does not (moved apart there),
+# and a round whose evaluation is open (no start for the next round).
+for case in touching-in-a-round-4-leaves round-after-open-candidate-8-leaves; do
+    rm -f "$WORK/$case.off"
+    run 0 eval "$ROUNDING/$case.scad" -o "$WORK/$case.off" --check-crossings
+    lacks "warning"
+    run 0 check --self-intersections "$WORK/$case.off"
+    contains "ok: no self-intersections"
+done
+
 # The level-3 Menger sponge as exported: no round keeps every guarantee (surfaces of one
 # shell cross at an edge that the rounds cannot pair), so the first result is written,
 # with a warning and status 3.
