@@ -547,9 +547,11 @@ typedef struct mcsg_eval_stats {
     size_t touching_vertices_split;  /* vertex copies added where parts of the result
                                         touch along an edge or at a point, so that the
                                         output is edge- and vertex-manifold */
-    size_t rounding_separated_vertices; /* vertex copies moved by one unit in the last
-                                           place where rounding made parts touch along an
-                                           edge that the exact result keeps apart */
+    size_t rounding_separated_vertices; /* vertices moved by one unit in the last place
+                                           where rounding made parts touch along an edge
+                                           that the exact result keeps apart, or (when a
+                                           round's candidate is kept) made triangles
+                                           cross or touch */
     mcsg_output_check output_check; /* the result against its guarantees; a failure is
                                        also logged as a warning */
     size_t rounding_reevaluations;  /* evaluations of the rounded result (snapped or not)
@@ -598,7 +600,9 @@ typedef struct mcsg_eval_stats {
  * not be the intended set; see docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
- * doubles. Then the rounded mesh is snapped to a coarser grid and evaluated again, alone,
+ * doubles. Then, where triangles cross, their corners are moved by one unit in the last
+ * place where that mends the crossings; otherwise the rounded mesh is snapped to a
+ * coarser grid and evaluated again, alone,
  * by its winding number (up to four rounds, docs/robustness.md; the first candidate whose
  * check passes replaces the result, its provenance mapped back to the tree's leaves;
  * stats->rounding_reevaluations, rounding_snap_grid). When none does, the first

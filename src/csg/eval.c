@@ -934,7 +934,11 @@ static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenanc
                                     &e->stats, err);
     if (st == MCSG_OK)
         st = mci_progress(&e->ctx, "evaluate rounded result again", 1, err);
-    if (st == MCSG_OK && e->stats.rounding_reevaluation_kept)
+    if (st == MCSG_OK && e->stats.rounding_reevaluation_kept &&
+        e->stats.rounding_reevaluations == 0 && e->stats.rounding_snap_grid == 0)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "rounding to doubles made triangles cross; corners of "
+                "theirs moved by one unit in the last place keep the result's guarantees");
+    else if (st == MCSG_OK && e->stats.rounding_reevaluation_kept)
         mci_log(&e->ctx, MCSG_LOG_INFO, "rounding to doubles broke the result's guarantees; "
                 "the rounded result, snapped to a grid of spacing %g (0: not snapped) and "
                 "evaluated again by its winding number %zu times, keeps them",

@@ -20,6 +20,8 @@
  */
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
+#include "csg/separate_copies.h"
+#include "csg/self_intersect.h"
 #include "csg/snap_round.h"
 #include "mesh/validate.h"
 
@@ -367,6 +369,41 @@ static mcsg_status snap_and_evaluate(rounds *r, const round_state *from, int e, 
     return s;
 }
 
+/* The first candidate, nearest the exact result: where the first result's triangles
+ * cross or touch, their corners moved by one unit in the last place
+ * (separate_copies.c), when that mends every crossing pair. */
+static mcsg_status move_crossing_corners(rounds *r, mcsg_error *err)
+{
+    const mci_ctx *ctx = r->ctx;
+    mci_exact_result exact = {NULL, 0, NULL, NULL, r->touching, r->touching_count};
+    round_state moved = {{0}, NULL, false};
+    uint64_t *pairs = NULL;
+    size_t n = 0, count = 0, nv = r->out->vertex_count, nt = r->out->triangle_count;
+    mcsg_status s = mci_crossing_pairs(ctx, r->out, &pairs, &n, err);
+    if (s == MCSG_OK && n > 0)
+        s = mci_mesh_alloc(ctx, &moved.mesh, nv, nt, err);
+    if (s == MCSG_OK && n > 0) {
+        memcpy(moved.mesh.vertices, r->out->vertices, 3 * nv * sizeof(double));
+        memcpy(moved.mesh.triangles, r->out->triangles, 3 * nt * sizeof(uint32_t));
+        if (!mci_separate_crossing_corners(ctx, &moved.mesh, pairs, n, &count))
+            s = mci_fail_nomem(err, "moving the corners of crossing triangles");
+    }
+    if (s == MCSG_OK && count > 0 && r->want_source) {
+        moved.source = mci_malloc_array(ctx, nt + 1, sizeof *moved.source);
+        if (moved.source)
+            memcpy(moved.source, *r->provenance, nt * sizeof *moved.source);
+        else
+            s = mci_fail_nomem(err, "moving the corners of crossing triangles");
+    }
+    if (s == MCSG_OK && count > 0)
+        s = keep_if_it_passes(r, &exact, &moved, err);
+    if (s == MCSG_OK && r->kept)
+        r->stats->rounding_separated_vertices += count;
+    round_state_free(ctx, &moved);
+    mci_free(ctx, pairs);
+    return s;
+}
+
 mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
                                    size_t touching_count, mcsg_mesh *out,
                                    mcsg_provenance **provenance, mcsg_eval_stats *stats,
@@ -378,6 +415,8 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
                 4 * out->triangle_count + 1000};
     round_state last = {{0}, NULL, false}, next;
     mcsg_status s = MCSG_OK;
+    if (stats->output_check.crossing_pairs > 0)
+        s = move_crossing_corners(&r, err);
     for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
         round_state first = {*out, r.want_source ? *provenance : NULL, false};
         /* Where the last round's evaluations failed, the next grid is tried on the first

@@ -135,21 +135,9 @@ bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t)
     return false;
 }
 
-mcsg_status mcsg_mesh_self_intersections(const mcsg_mesh *mesh, const mcsg_options *opts,
-                                         size_t *pairs, uint32_t example[2], mcsg_error *err)
+/* The checks of mcsg_mesh_self_intersections on its arguments. */
+static mcsg_status check_arguments(const mcsg_mesh *mesh, mcsg_error *err)
 {
-    mci_ctx ctx;
-    mci_octree tree;
-    const mcsg_mesh *twice[2] = {mesh, mesh};
-    uint64_t *candidates = NULL;
-    size_t count = 0, n;
-    mcsg_status st;
-    if (!mesh || !pairs || (mesh->vertex_count && !mesh->vertices) ||
-        (mesh->triangle_count && !mesh->triangles))
-        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_mesh_self_intersections: NULL argument");
-    *pairs = 0;
-    if (example)
-        example[0] = example[1] = MCSG_NO_INDEX;
     if (mesh->triangle_count > UINT32_MAX / 2)
         return mci_fail(err, MCSG_ERR_LIMIT, "mesh too large to test for self-intersections");
     for (size_t i = 0; i < 3 * mesh->triangle_count; i++)
@@ -160,23 +148,67 @@ mcsg_status mcsg_mesh_self_intersections(const mcsg_mesh *mesh, const mcsg_optio
         if (!(mesh->vertices[i] - mesh->vertices[i] == 0))
             return mci_fail(err, MCSG_ERR_INVALID_MESH, "vertex %zu has a NaN or infinite "
                             "coordinate", i / 3);
-    if (mesh->triangle_count == 0)
-        return MCSG_OK;
-    mci_ctx_init(&ctx, opts);
-    st = mci_octree_build(&ctx, twice, 2, NULL, &tree, err);
+    return MCSG_OK;
+}
+
+/* The crossing pairs, counted (*count) and, when list is not NULL, listed (s << 32 | t,
+ * s < t, in the octree's order; *list allocated with ctx). */
+static mcsg_status find_crossings(const mci_ctx *ctx, const mcsg_mesh *mesh, size_t *count,
+                                  uint64_t **list, mcsg_error *err)
+{
+    mci_octree tree;
+    const mcsg_mesh *twice[2] = {mesh, mesh};
+    uint64_t *candidates = NULL;
+    size_t n = 0;
+    mcsg_status st = mci_octree_build(ctx, twice, 2, NULL, &tree, err);
+    *count = 0;
     if (st != MCSG_OK)
         return st;
-    st = mci_octree_candidate_pairs(&ctx, &tree, &candidates, &n, err);
+    st = mci_octree_candidate_pairs(ctx, &tree, &candidates, &n, err);
     for (size_t i = 0; st == MCSG_OK && i < n; i++) {
         uint32_t s = (uint32_t)(candidates[i] >> 32);
         uint32_t t = (uint32_t)candidates[i] - (uint32_t)mesh->triangle_count;
-        if (s >= t || !mci_triangles_cross(mesh, s, t))
-            continue;
-        if (count++ == 0 && example)
-            example[0] = s, example[1] = t;
+        if (s < t && mci_triangles_cross(mesh, s, t))
+            candidates[(*count)++] = (uint64_t)s << 32 | t; /* i >= *count: read already */
     }
-    mci_free(&ctx, candidates);
-    mci_octree_free(&ctx, &tree);
-    *pairs = count;
+    if (st == MCSG_OK && list)
+        *list = candidates;
+    else
+        mci_free(ctx, candidates);
+    mci_octree_free(ctx, &tree);
+    return st;
+}
+
+mcsg_status mci_crossing_pairs(const mci_ctx *ctx, const mcsg_mesh *mesh, uint64_t **pairs,
+                               size_t *n, mcsg_error *err)
+{
+    mcsg_status st = check_arguments(mesh, err);
+    *pairs = NULL;
+    *n = 0;
+    if (st != MCSG_OK || mesh->triangle_count == 0)
+        return st;
+    return find_crossings(ctx, mesh, n, pairs, err);
+}
+
+mcsg_status mcsg_mesh_self_intersections(const mcsg_mesh *mesh, const mcsg_options *opts,
+                                         size_t *pairs, uint32_t example[2], mcsg_error *err)
+{
+    mci_ctx ctx;
+    uint64_t *list = NULL;
+    mcsg_status st;
+    if (!mesh || !pairs || (mesh->vertex_count && !mesh->vertices) ||
+        (mesh->triangle_count && !mesh->triangles))
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_mesh_self_intersections: NULL argument");
+    *pairs = 0;
+    if (example)
+        example[0] = example[1] = MCSG_NO_INDEX;
+    st = check_arguments(mesh, err);
+    if (st != MCSG_OK || mesh->triangle_count == 0)
+        return st;
+    mci_ctx_init(&ctx, opts);
+    st = find_crossings(&ctx, mesh, pairs, example ? &list : NULL, err);
+    if (st == MCSG_OK && example && *pairs > 0)
+        example[0] = (uint32_t)(list[0] >> 32), example[1] = (uint32_t)list[0];
+    mci_free(&ctx, list);
     return st;
 }

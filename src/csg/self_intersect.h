@@ -12,4 +12,9 @@
  * when either has zero area. */
 bool mci_triangles_cross(const mcsg_mesh *m, uint32_t s, uint32_t t);
 
+/* The pairs of m's triangles that cross (the test of mcsg_mesh_self_intersections), as
+ * s << 32 | t with s < t: *pairs allocated with ctx (NULL when none), *n of them. */
+mcsg_status mci_crossing_pairs(const mci_ctx *ctx, const mcsg_mesh *m, uint64_t **pairs,
+                               size_t *n, mcsg_error *err);
+
 #endif

@@ -365,6 +365,17 @@ static void normal_sum(const separator *s, size_t first, size_t end, double n[3]
     }
 }
 
+/* Whether candidate c's triangles cross a triangle near them where it is now. */
+static bool crosses_here(separator *s, uint32_t c, int (*before)[2])
+{
+    size_t first = mci_find_key(s->incident, s->nincident, c), end = first;
+    while (end < s->nincident && s->incident[end].key == c)
+        end++;
+    for (size_t i = first; i < end; i++)
+        turns(s->m, s->incident[i].ref, before[i - first]);
+    return !move_is_valid(s, first, end, (const int(*)[2])before, c);
+}
+
 /* Move candidate c to the first valid neighbouring double; false if none is. */
 static bool try_move(separator *s, uint32_t c, int (*before)[2])
 {
@@ -439,6 +450,47 @@ static bool separate_round(const mci_ctx *ctx, mcsg_mesh *m, const mci_exact_res
         for (size_t c = 0; ok && c < s.ncandidates; c++)
             result->moved += try_move(&s, (uint32_t)c, before);
     }
+    mci_free(ctx, before);
+    free_separator(&s);
+    return ok;
+}
+
+/* The corners of the crossing triangles, each once. */
+static bool crossing_candidates(separator *s, const uint64_t *pairs, size_t n)
+{
+    const mcsg_mesh *m = s->m;
+    s->candidate = mci_malloc_array(s->ctx, 6 * n + 1, sizeof *s->candidate);
+    s->slot = mci_malloc_array(s->ctx, m->vertex_count + 1, sizeof *s->slot);
+    if (!s->candidate || !s->slot)
+        return false;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        s->slot[v] = NONE;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            add_candidate(s, m->triangles[3 * (size_t)(pairs[i] >> 32) + k]);
+            add_candidate(s, m->triangles[3 * (size_t)(uint32_t)pairs[i] + k]);
+        }
+    return true;
+}
+
+bool mci_separate_crossing_corners(const mci_ctx *ctx, mcsg_mesh *m, const uint64_t *pairs,
+                                   size_t n, size_t *moved)
+{
+    separator s;
+    int (*before)[2] = NULL;
+    bool ok;
+    memset(&s, 0, sizeof s);
+    s.ctx = ctx;
+    s.m = m;
+    *moved = 0;
+    if (n == 0)
+        return true;
+    ok = crossing_candidates(&s, pairs, n) && find_incident(&s) && find_near(&s) &&
+         index_coordinates(&s) &&
+         (before = mci_malloc_array(ctx, most_incident(&s) + 1, sizeof *before));
+    for (size_t c = 0; ok && c < s.ncandidates; c++)
+        if (crosses_here(&s, (uint32_t)c, before))
+            *moved += try_move(&s, (uint32_t)c, before);
     mci_free(ctx, before);
     free_separator(&s);
     return ok;

@@ -22,4 +22,13 @@ typedef struct mci_copy_separation {
 bool mci_separate_welded_copies(const mci_ctx *ctx, mcsg_mesh *m, const mci_exact_result *exact,
                                 mci_copy_separation *result);
 
+/* Where rounding made triangles cross or touch (pairs: s << 32 | t, from
+ * mci_crossing_pairs): each corner of those triangles whose triangles cross a triangle
+ * near them is moved, as a copy above, to the first neighbouring double where its
+ * triangles keep their orientation and cross nothing; *moved counts the moves. m is
+ * closed and oriented, allocated with ctx. Returns false only when out of memory (m
+ * valid, possibly with some vertices moved). */
+bool mci_separate_crossing_corners(const mci_ctx *ctx, mcsg_mesh *m, const uint64_t *pairs,
+                                   size_t n, size_t *moved);
+
 #endif
