@@ -254,6 +254,38 @@ TEST(slivers_get_inside_points)
     CHECK(inside_point_found(c, b, a));
 }
 
+/* A triangle in z = 0 whose corners (lines meeting the plane) all round to the same
+ * double, (1, 1, 0): (1 + q, 1 + q), (1 + 3q, 1 + q), (1 + q, 1 + 3q), q = 2^-55, a
+ * quarter of the spacing of doubles there. A region made only of such pieces
+ * (re-evaluated rounded results, where many exact points nearly coincide) was left
+ * undecided. */
+TEST(tiny_triangles_get_inside_points)
+{
+    static const double top[3] = {1, 1, 1}, to0[3] = {1 + 0x1p-52, 1 + 0x1p-52, -7},
+                        to1[3] = {1 + 3 * 0x1p-52, 1 + 0x1p-52, -7},
+                        to2[3] = {1 + 0x1p-52, 1 + 3 * 0x1p-52, -7};
+    static const double pa[3] = {0, 0, 0}, pb[3] = {1, 0, 0}, pc[3] = {0, 1, 0};
+    const double *far[3] = {to0, to1, to2};
+    mci_plane plane;
+    mci_point corner[3], out;
+    double ends[2][3];
+    bool found = false;
+    mci_plane_init(&plane, pa, pb, pc);
+    for (int i = 0; i < 3; i++)
+        CHECK(mci_point_lpi(&corner[i], top, far[i], &plane));
+    for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS && !found; attempt++) {
+        int turns[3];
+        if (!mci_point_inside_triangle(corner, &plane, attempt, ends, &out))
+            continue;
+        for (int i = 0; i < 3; i++)
+            turns[i] = mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], &out, 2);
+        CHECK_MSG(turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2],
+                  "attempt %d: the point is not strictly inside", attempt);
+        found = true;
+    }
+    CHECK(found);
+}
+
 TEST(box_overlaps_match_every_pair)
 {
     mci_ctx ctx;
@@ -299,5 +331,6 @@ int main(void)
     RUN(box_overlaps_match_every_pair);
     RUN(windings_on_both_sides_of_a_face);
     RUN(slivers_get_inside_points);
+    RUN(tiny_triangles_get_inside_points);
     return test_summary();
 }

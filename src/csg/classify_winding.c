@@ -168,6 +168,75 @@ static bool point_inside_sliver(const mci_point c[3], double x[3][3],
     return sliver_bisect(&q, -64 * big * 0x1p-52, 64 * big * 0x1p-52);
 }
 
+/* a + b as a double and the rounding error of that sum. */
+static double sum_error(double a, double b, double *error)
+{
+    double s = a + b, bb = s - a;
+    *error = (a - (s - bb)) + (b - bb);
+    return s;
+}
+
+/* The centroid of c's corners to about twice the precision of doubles: hi + lo per
+ * coordinate (mci_point_dd_values). False when those values are not at hand. */
+static bool centroid_dd(const mci_point c[3], double hi[3], double lo[3])
+{
+    double v[3][3][3];
+    for (int i = 0; i < 3; i++)
+        if (!mci_point_dd_values(&c[i], v[i]))
+            return false;
+    for (int k = 0; k < 3; k++) {
+        double e1, e2, s = sum_error(v[0][k][0], v[1][k][0], &e1);
+        double r, low = e1 + v[0][k][1] + v[1][k][1] + v[2][k][1];
+        s = sum_error(s, v[2][k][0], &e2);
+        low += e2;
+        hi[k] = s / 3;
+        r = fma(-3, hi[k], s); /* exact: s - 3 hi */
+        lo[k] = (r + low) / 3;
+    }
+    return true;
+}
+
+/* A point strictly inside a triangle whose corners are all within a few units in the
+ * last place of each other (no line through doubles near them is known to pierce it):
+ * the line from ends[0], the double nearest its centroid moved just off the plane,
+ * through the centroid (known to about twice the precision of doubles), to ends[1],
+ * a power of two times as far on the other side. Rounding ends[1] then moves the
+ * point where the line meets the plane by about 2^-52 of the distance from ends[0] to
+ * the centroid, a tiny fraction of a unit. */
+static bool point_inside_tiny(const mci_point c[3], const mci_plane *plane, double ends[2][3],
+                              mci_point *out)
+{
+    double hi[3], lo[3], d[3], big = 0, reach = 0, scale;
+    int sign, axis = mci_plane_projection_axis(plane, &sign), s0, turn;
+    if (axis < 0 || !centroid_dd(c, hi, lo))
+        return false;
+    for (int k = 0; k < 3; k++)
+        big = fmax(big, fabs(hi[k]));
+    if (!isfinite(big) || big == 0)
+        return false;
+    memcpy(ends[0], hi, sizeof hi);
+    for (int step = 0; (s0 = mci_orient3d_vertex(ends[0], plane)) == 0; step++) {
+        if (step == 64)
+            return false;
+        ends[0][axis] += ldexp(1.0, ilogb(big) - 52);
+    }
+    for (int k = 0; k < 3; k++) {
+        d[k] = (hi[k] - ends[0][k]) + lo[k];
+        reach = fmax(reach, fabs(d[k]));
+    }
+    if (!(reach > 0))
+        return false;
+    scale = ldexp(1.0, ilogb(4 * (big + 1)) - ilogb(reach));
+    for (int k = 0; k < 3; k++)
+        ends[1][k] = ends[0][k] + scale * d[k];
+    if (mci_orient3d_vertex(ends[1], plane) != -s0 ||
+        !mci_point_lpi(out, ends[0], ends[1], plane))
+        return false;
+    turn = mci_orient2d_projected(&c[0], &c[1], out, axis);
+    return turn != 0 && mci_orient2d_projected(&c[1], &c[2], out, axis) == turn &&
+           mci_orient2d_projected(&c[2], &c[0], out, axis) == turn;
+}
+
 /* See classify_leaf.h. */
 bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int attempt,
                                 double ends[2][3], mci_point *out)
@@ -185,6 +254,8 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
         for (int v = 0; v < 3; v++)
             size = fmax(size, fabs(x[v][k] - x[(v + 1) % 3][k]));
     }
+    if (!(size > 0) && attempt == MCI_INSIDE_ATTEMPTS - 1) /* corners on one double */
+        return point_inside_tiny(c, plane, ends, out);
     if (!(norm > 0) || !(size > 0) || !isfinite(norm) || !isfinite(size))
         return false;
     for (int k = 0; k < 3; k++) {
@@ -201,7 +272,8 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
         turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
     if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
         return true;
-    return attempt == MCI_INSIDE_ATTEMPTS - 1 && point_inside_sliver(c, x, plane, ends, out);
+    return attempt == MCI_INSIDE_ATTEMPTS - 1 && (point_inside_sliver(c, x, plane, ends, out) ||
+                                                  point_inside_tiny(c, plane, ends, out));
 }
 
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],
