@@ -14,8 +14,9 @@
  * snapped mesh evaluated again, and the starting mesh evaluated again; the first whose
  * check passes is kept, and otherwise the first result stays (with its report). A
  * round starts from the last round's evaluation, unless that failed or is no mesh to
- * start from (open, misoriented, inside out, or another solid): then from the first
- * result, on the next grid. Every round's evaluation moves apart the parts that touch
+ * start from (open, misoriented, inside out, another solid, or with no fewer defects
+ * than the first result: rounds that built on such a candidate wandered off, their
+ * crossings growing round by round): then from the first result, on the next grid. Every round's evaluation moves apart the parts that touch
  * where the first result's exact result does not: rounding made that contact.
  */
 #include "csg/reevaluate.h"
@@ -105,7 +106,8 @@ typedef struct round_state {
     mcsg_mesh mesh;          /* the last round's result (zero before the first) */
     mcsg_provenance *source; /* its triangles' sources in the tree, or NULL */
     bool no_start;           /* refused as no round's start: open, misoriented, inside
-                                out, or not the first result's solid */
+                                out, not the first result's solid, or with no fewer
+                                defects than the first result */
 } round_state;
 
 static void round_state_free(const mci_ctx *ctx, round_state *r)
@@ -232,6 +234,7 @@ typedef struct rounds {
     const double *touching;
     size_t touching_count;
     size_t most_triangles; /* a round's evaluated mesh beyond this is abandoned */
+    size_t first_defects;  /* what the first result's check counts (defects()) */
 } rounds;
 
 /* Whether the candidate's volume is the first result's within what moving its surface
@@ -244,6 +247,13 @@ static bool keeps_the_solid(const rounds *r, const mcsg_mesh *candidate)
     double bound = (r->first.area + c.area) * r->moved +
                    0x1p-40 * (r->first.magnitude + c.magnitude);
     return fabs(c.volume - r->first.volume) <= bound;
+}
+
+/* Everything a check counts broken, crossing pairs included where counted. */
+static size_t defects(const mcsg_output_check *c)
+{
+    return c->open_edges + c->misoriented_edges + c->index_nonmanifold_edges +
+           c->welded_nonmanifold_edges + c->degenerate_triangles + c->crossing_pairs;
 }
 
 /* Why a candidate is not kept, for --verbose. */
@@ -285,7 +295,8 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     }
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
     if (s == MCSG_OK) {
-        candidate->no_start = check.open_edges > 0 || check.misoriented_edges > 0;
+        candidate->no_start = check.open_edges > 0 || check.misoriented_edges > 0 ||
+                              defects(&check) >= r->first_defects;
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
                          err);
     }
@@ -412,7 +423,7 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
     int top = mci_snap_exponent(out, 0);
     rounds r = {ctx, out, provenance, stats, provenance && *provenance, false, SIZE_MAX,
                 size_of(out), ldexp(1.0, top - 48), touching, touching_count,
-                4 * out->triangle_count + 1000};
+                4 * out->triangle_count + 1000, defects(&stats->output_check)};
     round_state last = {{0}, NULL, false}, next;
     mcsg_status s = MCSG_OK;
     if (stats->output_check.crossing_pairs > 0)
