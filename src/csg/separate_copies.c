@@ -430,27 +430,41 @@ static void free_separator(separator *s)
     mci_free(ctx, s->moved);
 }
 
+static void start_separator(separator *s, const mci_ctx *ctx, mcsg_mesh *m)
+{
+    memset(s, 0, sizeof *s);
+    s->ctx = ctx;
+    s->m = m;
+}
+
+/* The candidates' triangles and what lies near them, then their moves (with
+ * only_crossing, of those whose triangles cross something where they are); *moved
+ * counts the moves. */
+static bool move_candidates(separator *s, bool only_crossing, size_t *moved)
+{
+    int (*before)[2] = NULL;
+    bool ok = find_incident(s) && find_near(s) && index_coordinates(s) &&
+              (before = mci_malloc_array(s->ctx, most_incident(s) + 1, sizeof *before));
+    for (size_t c = 0; ok && c < s->ncandidates; c++)
+        if (!only_crossing || crosses_here(s, (uint32_t)c, before))
+            *moved += try_move(s, (uint32_t)c, before);
+    mci_free(s->ctx, before);
+    return ok;
+}
+
 /* One round: the bad edges now, the candidates, and their moves. */
 static bool separate_round(const mci_ctx *ctx, mcsg_mesh *m, const mci_exact_result *exact,
                            int round, mci_copy_separation *result)
 {
     separator s;
-    int (*before)[2] = NULL;
     bool ok;
-    memset(&s, 0, sizeof s);
-    s.ctx = ctx;
-    s.m = m;
+    start_separator(&s, ctx, m);
     s.canon = mci_malloc_array(ctx, m->vertex_count + 1, sizeof *s.canon);
     ok = s.canon && mci_welded_overfull_edges(ctx, m, exact, s.canon, &s.bad, &s.nbad);
     if (round == 0)
         result->edges = s.nbad;
-    if (ok && s.nbad > 0 && (ok = choose_candidates(&s, round)) && s.ncandidates > 0) {
-        ok = find_incident(&s) && find_near(&s) && index_coordinates(&s) &&
-             (before = mci_malloc_array(ctx, most_incident(&s) + 1, sizeof *before));
-        for (size_t c = 0; ok && c < s.ncandidates; c++)
-            result->moved += try_move(&s, (uint32_t)c, before);
-    }
-    mci_free(ctx, before);
+    if (ok && s.nbad > 0 && (ok = choose_candidates(&s, round)) && s.ncandidates > 0)
+        ok = move_candidates(&s, false, &result->moved);
     free_separator(&s);
     return ok;
 }
@@ -477,21 +491,12 @@ bool mci_separate_crossing_corners(const mci_ctx *ctx, mcsg_mesh *m, const uint6
                                    size_t n, size_t *moved)
 {
     separator s;
-    int (*before)[2] = NULL;
     bool ok;
-    memset(&s, 0, sizeof s);
-    s.ctx = ctx;
-    s.m = m;
     *moved = 0;
     if (n == 0)
         return true;
-    ok = crossing_candidates(&s, pairs, n) && find_incident(&s) && find_near(&s) &&
-         index_coordinates(&s) &&
-         (before = mci_malloc_array(ctx, most_incident(&s) + 1, sizeof *before));
-    for (size_t c = 0; ok && c < s.ncandidates; c++)
-        if (crosses_here(&s, (uint32_t)c, before))
-            *moved += try_move(&s, (uint32_t)c, before);
-    mci_free(ctx, before);
+    start_separator(&s, ctx, m);
+    ok = crossing_candidates(&s, pairs, n) && move_candidates(&s, true, moved);
     free_separator(&s);
     return ok;
 }
