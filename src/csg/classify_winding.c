@@ -272,8 +272,9 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
         turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
     if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
         return true;
-    return attempt == MCI_INSIDE_ATTEMPTS - 1 && (point_inside_sliver(c, x, plane, ends, out) ||
-                                                  point_inside_tiny(c, plane, ends, out));
+    if (attempt != MCI_INSIDE_ATTEMPTS - 1)
+        return false;
+    return point_inside_sliver(c, x, plane, ends, out) || point_inside_tiny(c, plane, ends, out);
 }
 
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],

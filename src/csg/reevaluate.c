@@ -16,8 +16,10 @@
  * round starts from the last round's evaluation, unless that failed or is no mesh to
  * start from (open, misoriented, inside out, another solid, or with no fewer defects
  * than the first result: rounds that built on such a candidate wandered off, their
- * crossings growing round by round): then from the first result, on the next grid. Every round's evaluation moves apart the parts that touch
- * where the first result's exact result does not: rounding made that contact.
+ * crossings growing round by round): then from the first result, on the next grid.
+ * Every round's evaluation moves apart the parts that touch where the first result's
+ * exact result does not: rounding made that contact. Before any round, where the first
+ * result's triangles cross, moving their corners by one unit is tried.
  */
 #include "csg/reevaluate.h"
 #include "csg/output_check.h"
@@ -430,8 +432,9 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
         s = move_crossing_corners(&r, err);
     for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
         round_state first = {*out, r.want_source ? *provenance : NULL, false};
-        /* Where the last round's evaluations failed, the next grid is tried on the first
-         * result: coarser, it may join what the finer one left apart. */
+        /* Where the last round left no start (its evaluations failed or were refused as
+         * starts), the next grid is tried on the first result: coarser, it may join what
+         * the finer one left apart. */
         const round_state *from = last.mesh.triangle_count > 0 ? &last : &first;
         s = snap_and_evaluate(&r, from, top - snap_bits[round], round < REEVALUATION_ROUNDS,
                               round == 0 || from == &last, &next, err);
