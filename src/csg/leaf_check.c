@@ -11,14 +11,14 @@
  * (mci_ptree.leaf_winding). A leaf that breaks the contract is named in a one-line
  * message (its label says which file or primitive it came from, and where in the CSG
  * text) with the first offending edge, triangle or vertex; nothing is evaluated.
- * Shells crossing themselves are looked for only when the options ask (that costs an
- * intersection pass of its own), in primitives where a surface of one shell enters
- * another's wedge at an edge (mci_edge_mates.entering_edges), or when evaluation stops
- * on an internal consistency check; the primitives with one are marked
+ * Every primitive's shells are tested for crossing themselves (csg/shell_crossing.c,
+ * exact, a small part of an evaluation; with the options' check_self_intersections, the
+ * test that counts every crossing pair instead); the primitives with one are marked
  * (mci_ptree.leaf_crossing) and evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
+#include "csg/shell_crossing.h"
 #include "mesh/validate.h"
 #include "mesh/zero_area.h"
 
@@ -113,85 +113,122 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
     return MCSG_OK;
 }
 
-/* Leaf k's report and shells (per triangle, in shell[]), after removing its zero-area
- * triangles if they are its only problem (*mesh: the mesh checked; *shell reallocated). */
+/* Leaf k's report, shells (per triangle, in shell[]) and half-edge twins (twin[]), after
+ * removing its zero-area triangles if they are its only problem (*shell and *twin
+ * reallocated then). */
 static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_report *report,
-                                uint32_t **shell, mcsg_error *err)
+                                uint32_t **shell, uint32_t **twin, mcsg_error *err)
 {
     mci_edge_mates *mates = &job->ptree->leaf_mates[k];
-    size_t removed;
+    size_t removed, n;
     mcsg_status st = mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell,
-                                           mates, err);
+                                           *twin, mates, err);
     if (st != MCSG_OK || !only_zero_area(report))
         return st;
     if ((st = remove_zero_area(job, k, &removed, err)) != MCSG_OK || removed == 0)
         return st;
     mci_free(job->ctx, *shell);
+    mci_free(job->ctx, *twin);
     mci_edge_mates_free(job->ctx, mates);
-    *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
-                              sizeof **shell);
-    if (!*shell)
+    n = job->ptree->leaf_mesh[k]->triangle_count;
+    *shell = mci_malloc_array(job->ctx, n + 1, sizeof **shell);
+    *twin = mci_malloc_array(job->ctx, n + 1, 3 * sizeof **twin);
+    if (!*shell || !*twin)
         return mci_fail_nomem(err, "checking the leaves");
-    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, mates, err);
+    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, *twin,
+                                 mates, err);
+}
+
+/* Marks leaf k (leaf_crossing, leaf_winding) when a shell of it crosses itself: the fast
+ * exact test of csg/shell_crossing.c. */
+static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint32_t *twin,
+                                 mcsg_error *err)
+{
+    mci_ptree *t = job->ptree;
+    mci_shell_crossing_stats stats;
+    uint32_t example[2];
+    bool crosses;
+    mcsg_status st = mci_find_shell_crossing(job->ctx, t->leaf_mesh[k], t->leaf_shell[k], twin,
+                                             &crosses, example, &stats, err);
+    mci_log(job->ctx, MCSG_LOG_DEBUG, "leaf %u: tested for crossing itself: %zu of %zu triangles "
+            "in %zu patches proven apart, %zu pairs tested in a grid of %zu entries",
+            t->leaf_source[k], stats.proven_triangles, t->leaf_mesh[k]->triangle_count,
+            stats.proven_patches, stats.pairs_tested, stats.grid_entries);
+    if (st != MCSG_OK || !crosses)
+        return st;
+    t->leaf_crossing[k] = t->leaf_winding[k] = 1;
+    mci_log(job->ctx, MCSG_LOG_INFO, "leaf %u%s%s: a shell crosses itself (e.g. triangles %u "
+            "and %u): its solid is where its winding number is positive, and its faces are "
+            "intersected with each other", t->leaf_source[k],
+            mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
+            mcsg_tree_node_label(job->tree, t->leaf_source[k]), example[0], example[1]);
+    return MCSG_OK;
+}
+
+/* The leaf's shells and kind from a report without problems: leaf_winding where only
+ * winding numbers tell, leaf_crossing where its faces must be intersected with each
+ * other. */
+static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_check_report *report,
+                             const uint32_t *twin, mcsg_error *err)
+{
+    mci_ptree *t = job->ptree;
+    /* Where one shell meets itself at an edge, parts of it may lie inside others or face
+     * inward (pair_neighbours in validate.c): only winding numbers tell. A single shell
+     * enclosing no volume folds onto itself (nothing is inside it) or crosses itself into
+     * lobes whose numbers cancel: its faces are intersected with each other without a
+     * test. */
+    bool no_volume = report->components == 1 && report->volume_sign == 0;
+    t->leaf_crossing[k] |= no_volume;
+    t->leaf_winding[k] = report->components > 1 || report->volume_sign < 0 ||
+                         t->leaf_mates[k].count > 0 || no_volume;
+    /* A leaf where one surface of a shell enters another's wedge at an edge (a part nested
+     * in another and joined to it there) often overlaps itself in their common faces
+     * too: such leaves, rare in clean input, are always tested; every leaf when the
+     * options ask. */
+    if (t->leaf_crossing[k] ||
+        (!job->ctx->check_self_intersections && t->leaf_mates[k].entering_edges == 0))
+        return MCSG_OK;
+    return find_crossing(job, k, twin, err);
 }
 
 static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
 {
     leaf_check_job *job = user;
-    const mcsg_mesh *m;
     mcsg_node_id node = job->ptree->leaf_source[k];
     const char *label = mcsg_tree_node_label(job->tree, node);
     mcsg_check_report report;
     char problem[400];
-    uint32_t *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
-                                       sizeof *shell);
-    mcsg_status st = shell ? check_shells(job, k, &report, &shell, err)
-                           : mci_fail_nomem(err, "checking the leaves");
-    if (st != MCSG_OK) {
-        mci_free(job->ctx, shell);
-        return st;
-    }
-    m = job->ptree->leaf_mesh[k];
-    describe_problem(m, &report, problem, sizeof problem);
-    if (problem[0] == '\0' && report.components > 1) {
-        job->ptree->leaf_shell[k] = shell;
-        job->ptree->leaf_shells[k] = (uint32_t)report.components;
-        shell = NULL;
+    size_t n = job->ptree->leaf_mesh[k]->triangle_count;
+    uint32_t *shell = mci_malloc_array(job->ctx, n + 1, sizeof *shell);
+    uint32_t *twin = mci_malloc_array(job->ctx, n + 1, 3 * sizeof *twin);
+    mcsg_status st = shell && twin ? check_shells(job, k, &report, &shell, &twin, err)
+                                   : mci_fail_nomem(err, "checking the leaves");
+    if (st == MCSG_OK) {
+        describe_problem(job->ptree->leaf_mesh[k], &report, problem, sizeof problem);
+        if (problem[0] == '\0' && report.components > 1) {
+            job->ptree->leaf_shell[k] = shell;
+            job->ptree->leaf_shells[k] = (uint32_t)report.components;
+            shell = NULL;
+        }
+        if (problem[0] == '\0')
+            st = mark_kind(job, k, &report, twin, err);
+        else
+            st = mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
+                          label[0] ? ", " : "", label, problem);
     }
     mci_free(job->ctx, shell);
-    if (problem[0] == '\0') {
-        /* Where one shell meets itself at an edge, parts of it may lie inside others or
-         * face inward (pair_neighbours in validate.c): only winding numbers tell. A
-         * single shell enclosing no volume folds onto itself (nothing is inside it) or
-         * crosses itself into lobes whose numbers cancel: its faces are intersected with
-         * each other, as a shell found crossing itself, without a test (it is rare). */
-        bool no_volume = report.components == 1 && report.volume_sign == 0;
-        job->ptree->leaf_crossing[k] |= no_volume;
-        job->ptree->leaf_winding[k] = report.components > 1 || report.volume_sign < 0 ||
-                                      job->ptree->leaf_mates[k].count > 0 || no_volume;
-        return MCSG_OK;
-    }
-    return mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
-                    label[0] ? ", " : "", label, problem);
+    mci_free(job->ctx, twin);
+    return st;
 }
 
 static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
-                               bool whole, bool only_entering, size_t *count, mcsg_error *err);
+                               bool whole, size_t *count, mcsg_error *err);
 
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
 {
     leaf_check_job job = {tree, ptree, ctx};
-    mcsg_status st = mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
-    size_t marked;
-    if (st == MCSG_OK && ctx->check_self_intersections)
-        st = mci_mark_crossing_leaves(ctx, tree, ptree, &marked, err);
-    /* A leaf where one surface of a shell enters another's wedge at an edge (a part
-     * nested in another and joined to it there) often overlaps itself in their common
-     * faces too: such leaves, rare in clean input, are always tested. */
-    else if (st == MCSG_OK)
-        st = scan_leaves(ctx, tree, ptree, false, true, &marked, err);
-    return st;
+    return mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
 }
 
 /* The crossing pairs of leaf k's mesh, within each of its shells (shells may cross each
@@ -240,7 +277,7 @@ static mcsg_status shell_self_intersections(const mci_ctx *ctx, const mci_ptree 
  * counted in *count; with `whole`, the first leaf any two of whose triangles cross
  * (shells touching each other too) is an INVALID_MESH error instead. */
 static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
-                               bool whole, bool only_entering, size_t *count, mcsg_error *err)
+                               bool whole, size_t *count, mcsg_error *err)
 {
     mcsg_options opts;
     memset(&opts, 0, sizeof opts);
@@ -255,8 +292,6 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
         size_t pairs;
         uint32_t example[2];
         mcsg_status st;
-        if (only_entering && ptree->leaf_mates[k].entering_edges == 0)
-            continue;
         st = shell_self_intersections(ctx, ptree, k, whole, &opts, &pairs, example, err);
         if (st != MCSG_OK)
             return st;
@@ -275,7 +310,7 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                      mci_ptree *ptree, size_t *marked, mcsg_error *err)
 {
-    return scan_leaves(ctx, tree, ptree, false, false, marked, err);
+    return scan_leaves(ctx, tree, ptree, false, marked, err);
 }
 
 mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree,
@@ -288,7 +323,7 @@ mcsg_status mci_explain_internal_error(const mci_ctx *ctx, const mcsg_tree *tree
         saved = *err;
     /* Every pair that meets, shells against each other too: the leaf whose surfaces
      * cross or touch is the likeliest cause, and naming it helps more than a bug report. */
-    st = scan_leaves(ctx, tree, ptree, true, false, &count, &probe);
+    st = scan_leaves(ctx, tree, ptree, true, &count, &probe);
     if (st == MCSG_ERR_INVALID_MESH) {
         if (err)
             *err = probe;

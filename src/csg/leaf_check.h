@@ -9,9 +9,10 @@
  * meeting itself at an edge with more than two triangles, and encloses some volume if
  * it has one shell; otherwise MCSG_ERR_INVALID_MESH naming the first such leaf (lowest
  * primitive number) and its first problem. Sets ptree->leaf_winding for the primitives
- * with several shells or a negative volume, and numbers their shells; with
- * ctx->check_self_intersections, marks those with a shell crossing itself
- * (mci_mark_crossing_leaves). */
+ * with several shells or a negative volume, and numbers their shells; marks those with
+ * a shell crossing itself (leaf_crossing, by csg/shell_crossing.c), testing every
+ * primitive with ctx->check_self_intersections, otherwise those where a surface of a
+ * shell enters another's wedge at an edge. */
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err);
 

@@ -17,7 +17,7 @@ static mcsg_status count_shells(const mci_ctx *ctx, const mcsg_mesh *out, mcsg_r
     mcsg_check_report report;
     uint32_t *shell = mci_malloc_array(ctx, out->triangle_count + 1, sizeof *shell);
     uint32_t *which = mci_malloc_array(ctx, out->triangle_count + 1, sizeof *which);
-    mcsg_status s = shell && which ? mci_mesh_check_shells(ctx, out, &report, shell, NULL, err)
+    mcsg_status s = shell && which ? mci_mesh_check_shells(ctx, out, &report, shell, NULL, NULL, err)
                                    : mci_fail_nomem(err, "counting the result's shells");
     st->shells_out = s == MCSG_OK ? report.components : 0;
     for (uint32_t k = 0; s == MCSG_OK && st->shells_out > 1 && k < st->shells_out; k++) {

@@ -21,7 +21,8 @@
 typedef struct edge_use {
     uint64_t key;  /* (min vertex << 32) | max vertex, canonical ids */
     uint32_t tri;  /* triangle using the edge */
-    uint32_t forward; /* 1 if the triangle runs from min to max */
+    unsigned forward : 1; /* 1 if the triangle runs from min to max */
+    unsigned corner : 2;  /* the edge runs from the triangle's corner `corner` to the next */
 } edge_use;
 
 typedef struct check_state {
@@ -33,6 +34,7 @@ typedef struct check_state {
     uint32_t *parent;   /* union-find over triangles */
     mci_edge_mates *mates; /* optional output: pairs by angle where a shell meets itself */
     size_t mates_room;
+    uint32_t *twin;     /* optional output: per half-edge, the other use of a manifold edge */
 } check_state;
 
 static uint64_t hash_mix(uint64_t h)
@@ -273,6 +275,7 @@ static size_t collect_edges(const check_state *s, edge_use *edges)
             edges[n].key = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
             edges[n].tri = (uint32_t)t;
             edges[n].forward = a < b;
+            edges[n].corner = (unsigned)k;
             n++;
         }
     }
@@ -436,6 +439,12 @@ static void join_shells(check_state *s, const edge_use *group, size_t n, size_t 
 {
     if (n == 2) { /* nearly every edge */
         unite(s->parent, group[0].tri, group[1].tri);
+        if (s->twin && forward == 1) {
+            s->twin[3 * (size_t)group[0].tri + group[0].corner] =
+                3 * group[1].tri + group[1].corner;
+            s->twin[3 * (size_t)group[1].tri + group[1].corner] =
+                3 * group[0].tri + group[0].corner;
+        }
         return;
     }
     for (size_t i = 1; i < n && 2 * forward != n; i++)
@@ -700,7 +709,7 @@ mcsg_status mcsg_mesh_check(const mcsg_mesh *mesh, const mcsg_options *opts,
 mcsg_status mci_mesh_check(const mci_ctx *ctx, const mcsg_mesh *mesh,
                            mcsg_check_report *report, mcsg_error *err)
 {
-    return mci_mesh_check_shells(ctx, mesh, report, NULL, NULL, err);
+    return mci_mesh_check_shells(ctx, mesh, report, NULL, NULL, NULL, err);
 }
 
 /* shell[t] from the union-find roots: dense numbers in order of first triangles. */
@@ -722,7 +731,7 @@ static void number_shells(const check_state *s, uint32_t *shell)
 
 mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
                                   mcsg_check_report *report, uint32_t *shell,
-                                  mci_edge_mates *mates, mcsg_error *err)
+                                  uint32_t *twin, mci_edge_mates *mates, mcsg_error *err)
 {
     const mci_ctx ctx = *ctx_in;
     check_state s;
@@ -733,6 +742,9 @@ mcsg_status mci_mesh_check_shells(const mci_ctx *ctx_in, const mcsg_mesh *mesh,
     s.mesh = mesh;
     s.report = report;
     s.mates = mates;
+    s.twin = twin;
+    for (size_t h = 0; twin && h < 3 * mesh->triangle_count; h++)
+        twin[h] = MCI_NONE;
     if (mates)
         memset(mates, 0, sizeof *mates);
     s.canon = mci_malloc_array(&ctx, mesh->vertex_count, sizeof *s.canon);

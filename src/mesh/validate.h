@@ -51,9 +51,12 @@ bool mci_edge_mates_has(const mci_edge_mates *mates, uint32_t t, uint32_t u);
  * only; others get UINT32_MAX). With one component `shell` is left as it is. At edges
  * of more than two triangles the shells are joined by the k-th use each way. `mates`
  * (optional) receives the angle pairs where a shell meets itself (allocated with ctx:
- * free with mci_edge_mates_free; empty on error). */
+ * free with mci_edge_mates_free; empty on error). `twin` (optional, 3 per triangle)
+ * receives each half-edge's other use, half-edge 3 t + k running from triangle t's
+ * corner k to the next: for an edge of exactly two triangles running opposite ways
+ * (vertices identified by coordinates), MCI_NONE for every other. */
 mcsg_status mci_mesh_check_shells(const mci_ctx *ctx, const mcsg_mesh *mesh,
                                   mcsg_check_report *report, uint32_t *shell,
-                                  mci_edge_mates *mates, mcsg_error *err);
+                                  uint32_t *twin, mci_edge_mates *mates, mcsg_error *err);
 
 #endif

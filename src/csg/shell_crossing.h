@@ -1,0 +1,32 @@
+/*
+ * Whether a shell of a mesh crosses itself, decided exactly and fast enough to run on
+ * every leaf (csg/shell_crossing.c): most pairs of neighbouring triangles are proven
+ * apart a patch at a time, and only the rest are tested one by one.
+ */
+#ifndef MESHCSG_CSG_SHELL_CROSSING_H
+#define MESHCSG_CSG_SHELL_CROSSING_H
+
+#include "base/core.h"
+
+/* What the test did, for the log and the tests. */
+typedef struct mci_shell_crossing_stats {
+    size_t patches;          /* connected parts facing one way along one axis */
+    size_t proven_patches;   /* of more than one triangle, proven not to cross themselves */
+    size_t proven_triangles; /* triangles in those */
+    size_t boundary_edges;   /* patch boundary edges examined */
+    size_t grid_entries;     /* (cell, triangle) entries of the grid */
+    size_t pairs_tested;     /* pairs decided by the exact triangle-triangle test */
+} mci_shell_crossing_stats;
+
+/* Whether two triangles of one shell of m cross or meet other than in the vertices and
+ * edge they share (the rules of mci_triangles_cross, vertices identified by
+ * coordinates): *crosses, and the first pair found in example[2] (triangle indices,
+ * MCI_NONE when none). shell (optional) gives each triangle's shell (pairs of different
+ * shells are not tested); twin (from mci_mesh_check_shells, 3 per triangle) each
+ * half-edge's other use. stats is optional. */
+mcsg_status mci_find_shell_crossing(const mci_ctx *ctx, const mcsg_mesh *m,
+                                    const uint32_t *shell, const uint32_t *twin,
+                                    bool *crosses, uint32_t example[2],
+                                    mci_shell_crossing_stats *stats, mcsg_error *err);
+
+#endif
