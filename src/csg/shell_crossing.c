@@ -22,7 +22,6 @@
  * patch are skipped whole.
  */
 #include "csg/shell_crossing.h"
-#include "base/sort.h"
 #include "csg/self_intersect.h"
 #include "exact/kernel.h"
 #include "exact/predicates.h"
@@ -494,14 +493,15 @@ static bool prove_patch(test_state *s, uint32_t p, bool *nomem)
     return boundary_is_simple(s, n) && pinches_keep_apart(s, n) && winding_at_most_one(s, n);
 }
 
-/* The grid: cell edge h, origin lo; a coordinate's cell along one axis. */
+/* The grid: cell edge h, origin lo; a coordinate's cell along one axis (by the
+ * reciprocal: any monotone rounding will do, the same everywhere). */
 typedef struct grid {
-    double lo[3], h;
+    double lo[3], h, per_h;
 } grid;
 
 static uint32_t cell_of(const grid *g, double x, int k)
 {
-    return (uint32_t)((x - g->lo[k]) / g->h);
+    return (uint32_t)((x - g->lo[k]) * g->per_h);
 }
 
 static uint32_t cell_hash(uint32_t x, uint32_t y, uint32_t z)
@@ -533,7 +533,7 @@ static void triangle_box(const mcsg_mesh *m, uint32_t t, double box[6])
     }
 }
 
-/* The grid's cell size: about one and a half times a triangle's mean extent, and
+/* The grid's cell size: about four times a triangle's mean extent, and
  * coarser while the triangles would fill more than `limit` (cell, triangle) entries. */
 static size_t choose_grid(const test_state *s, const double *box, size_t limit, grid *g)
 {
@@ -550,12 +550,13 @@ static size_t choose_grid(const test_state *s, const double *box, size_t limit, 
         }
         extent += e / (double)n;
     }
-    g->h = 1.5 * extent;
+    g->h = 4 * extent;
     for (int k = 0; k < 3; k++) /* at most 2^20 cells along an axis: they fit the hash */
         g->h = fmax(g->h, (hi[k] - g->lo[k]) * 0x1.00001p-20);
     if (!(g->h > 0))
         g->h = 1;
     for (int tries = 0; tries < 64; tries++, g->h *= 2) {
+        g->per_h = 1 / g->h;
         entries = 0;
         for (size_t t = 0; t < n && entries <= limit; t++) {
             size_t cells = 1;
@@ -583,14 +584,15 @@ static bool boxes_meet(const double *a, const double *b)
     return true;
 }
 
-/* Whether the pair must be tested in the cell with this hash: where the lowest corner
- * of their boxes' common part lies (each pair is tested in one cell). */
-static bool pair_belongs_here(const grid *g, const double *a, const double *b, uint32_t hash)
+/* Whether the pair must be tested in this bucket: the one of the cell where the lowest
+ * corner of their boxes' common part lies (each pair is tested in one bucket). */
+static bool pair_belongs_here(const grid *g, const double *a, const double *b,
+                              uint32_t bucket, uint32_t mask)
 {
     uint32_t c[3];
     for (int k = 0; k < 3; k++)
         c[k] = cell_of(g, max2(a[k], b[k]), k);
-    return cell_hash(c[0], c[1], c[2]) == hash;
+    return (cell_hash(c[0], c[1], c[2]) & mask) == bucket;
 }
 
 static bool needs_test(const test_state *s, uint32_t t, uint32_t u)
@@ -626,25 +628,32 @@ static bool apart(const mcsg_mesh *m, uint32_t t, uint32_t u)
     return off_plane(m, t, u) || off_plane(m, u, t);
 }
 
-/* Tests the pairs of one run of entries (one cell hash); true when a pair crosses. */
-static bool test_run(test_state *s, const grid *g, const double *box, const uint64_t *run,
-                     size_t n, uint32_t example[2])
+/* The grid's (cell, triangle) entries, bucketed by cell hash (several cells may share a
+ * bucket): bucket b's triangles are tri[start[b] .. start[b + 1]), in increasing order. */
+typedef struct buckets {
+    uint32_t mask;
+    uint32_t *start, *tri;
+} buckets;
+
+/* Tests the pairs of bucket b; true when a pair crosses. */
+static bool test_bucket(test_state *s, const grid *g, const double *box, const buckets *k,
+                        uint32_t b, uint32_t example[2])
 {
-    uint32_t hash = (uint32_t)(run[0] >> 32), first = (uint32_t)run[0];
-    size_t i = 1;
-    while (i < n && s->patch[(uint32_t)run[i]] == s->patch[first])
+    const uint32_t *run = k->tri + k->start[b];
+    size_t n = k->start[b + 1] - k->start[b], i = 1;
+    while (i < n && s->patch[run[i]] == s->patch[run[0]])
         i++;
-    if (i == n && s->proven[s->patch[first]])
+    if (i == n && s->proven[s->patch[run[0]]])
         return false; /* inside one proven patch */
     for (i = 0; i < n; i++) {
-        uint32_t t = (uint32_t)run[i];
+        uint32_t t = run[i];
         if (i > 0 && run[i] == run[i - 1])
             continue;
         for (size_t j = i + 1; j < n; j++) {
-            uint32_t u = (uint32_t)run[j];
+            uint32_t u = run[j];
             if (run[j] == run[j - 1] || !needs_test(s, t, u) ||
                 !boxes_meet(box + 6 * (size_t)t, box + 6 * (size_t)u) ||
-                !pair_belongs_here(g, box + 6 * (size_t)t, box + 6 * (size_t)u, hash))
+                !pair_belongs_here(g, box + 6 * (size_t)t, box + 6 * (size_t)u, b, k->mask))
                 continue;
             s->stats.pairs_tested++;
             if (!apart(s->m, t, u) && mci_triangles_cross(s->m, t, u)) {
@@ -656,19 +665,39 @@ static bool test_run(test_state *s, const grid *g, const double *box, const uint
     return false;
 }
 
-static void fill_entries(const test_state *s, const grid *g, const double *box, uint64_t *out)
+/* The buckets of the count entries: each triangle's cells' buckets listed in turn
+ * (bucket_of), counted, and the triangles placed (a counting sort, stable). */
+static void fill_buckets(const test_state *s, const grid *g, const double *box,
+                         uint32_t *bucket_of, buckets *k)
 {
-    size_t n = 0;
+    size_t e = 0;
     for (uint32_t t = 0; t < s->m->triangle_count; t++) {
         uint32_t lo[3], hi[3];
-        for (int k = 0; k < 3; k++)
-            lo[k] = cell_of(g, box[6 * (size_t)t + k], k),
-            hi[k] = cell_of(g, box[6 * (size_t)t + k + 3], k);
+        for (int a = 0; a < 3; a++)
+            lo[a] = cell_of(g, box[6 * (size_t)t + a], a),
+            hi[a] = cell_of(g, box[6 * (size_t)t + a + 3], a);
         for (uint32_t x = lo[0]; x <= hi[0]; x++)
             for (uint32_t y = lo[1]; y <= hi[1]; y++)
-                for (uint32_t z = lo[2]; z <= hi[2]; z++)
-                    out[n++] = (uint64_t)cell_hash(x, y, z) << 32 | t;
+                for (uint32_t z = lo[2]; z <= hi[2]; z++) {
+                    uint32_t b = cell_hash(x, y, z) & k->mask;
+                    bucket_of[e++] = b;
+                    k->start[b + 1]++;
+                }
     }
+    for (uint32_t b = 0; b <= k->mask; b++)
+        k->start[b + 1] += k->start[b];
+    e = 0;
+    for (uint32_t t = 0; t < s->m->triangle_count; t++) {
+        size_t cells = 1;
+        for (int a = 0; a < 3; a++)
+            cells *= 1 + (size_t)(cell_of(g, box[6 * (size_t)t + a + 3], a) -
+                                  cell_of(g, box[6 * (size_t)t + a], a));
+        for (size_t c = 0; c < cells; c++)
+            k->tri[k->start[bucket_of[e++]]++] = t;
+    }
+    for (uint32_t b = k->mask + 1; b > 0; b--) /* start[b] was advanced to start[b + 1] */
+        k->start[b] = k->start[b - 1];
+    k->start[0] = 0;
 }
 
 /* Every pair that no proven patch covers, through the grid. */
@@ -677,34 +706,34 @@ static mcsg_status test_remaining_pairs(test_state *s, bool *crosses, uint32_t e
 {
     size_t n = s->m->triangle_count, count;
     double *box = mci_malloc_array(s->ctx, n, 6 * sizeof *box);
-    uint64_t *entries = NULL;
+    uint32_t *bucket_of = NULL;
+    buckets k = {1, NULL, NULL};
     grid g;
-    if (!box)
-        return mci_fail_nomem(err, "testing the leaves for self-intersections");
-    for (uint32_t t = 0; t < n; t++)
-        triangle_box(s->m, t, box + 6 * (size_t)t);
-    count = choose_grid(s, box, 8 * n + 1024, &g);
-    entries = mci_malloc_array(s->ctx, count, sizeof *entries);
-    if (!entries) {
-        mci_free(s->ctx, box);
-        return mci_fail_nomem(err, "testing the leaves for self-intersections");
+    mcsg_status st = MCSG_OK;
+    if (box) {
+        for (uint32_t t = 0; t < n; t++)
+            triangle_box(s->m, t, box + 6 * (size_t)t);
+        count = choose_grid(s, box, 8 * n + 1024, &g);
+        while (k.mask < count && k.mask < UINT32_MAX / 4)
+            k.mask = 2 * k.mask + 1;
+        bucket_of = mci_malloc_array(s->ctx, count, sizeof *bucket_of);
+        k.tri = mci_malloc_array(s->ctx, count, sizeof *k.tri);
+        k.start = mci_calloc_array(s->ctx, (size_t)k.mask + 2, sizeof *k.start);
     }
-    fill_entries(s, &g, box, entries);
-    s->stats.grid_entries = count;
-    if (!mci_radix_sort_u64(s->ctx, entries, count)) {
-        mci_free(s->ctx, box);
-        mci_free(s->ctx, entries);
-        return mci_fail_nomem(err, "testing the leaves for self-intersections");
-    }
-    for (size_t a = 0, b; a < count && !*crosses; a = b) {
-        for (b = a + 1; b < count && entries[b] >> 32 == entries[a] >> 32; b++)
-            ;
-        if (b - a > 1)
-            *crosses = test_run(s, &g, box, entries + a, b - a, example);
+    if (!box || !bucket_of || !k.tri || !k.start) {
+        st = mci_fail_nomem(err, "testing the leaves for self-intersections");
+    } else {
+        fill_buckets(s, &g, box, bucket_of, &k);
+        s->stats.grid_entries = count;
+        for (uint32_t b = 0; b <= k.mask && !*crosses; b++)
+            if (k.start[b + 1] - k.start[b] > 1)
+                *crosses = test_bucket(s, &g, box, &k, b, example);
     }
     mci_free(s->ctx, box);
-    mci_free(s->ctx, entries);
-    return MCSG_OK;
+    mci_free(s->ctx, bucket_of);
+    mci_free(s->ctx, k.tri);
+    mci_free(s->ctx, k.start);
+    return st;
 }
 
 static void free_state(test_state *s)
