@@ -11,10 +11,12 @@
  * (mci_ptree.leaf_winding). A leaf that breaks the contract is named in a one-line
  * message (its label says which file or primitive it came from, and where in the CSG
  * text) with the first offending edge, triangle or vertex; nothing is evaluated.
- * Every primitive's shells are tested for crossing themselves (csg/shell_crossing.c,
- * exact, a small part of an evaluation; with the options' check_self_intersections, the
- * test that counts every crossing pair instead); the primitives with one are marked
- * (mci_ptree.leaf_crossing) and evaluated with their faces intersected with each other.
+ * Shells crossing themselves are looked for (csg/shell_crossing.c, exact, about a third
+ * of an evaluation on scanned models) when the options ask, in primitives where a
+ * surface of one shell enters another's wedge at an edge (mci_edge_mates.entering_edges),
+ * and, by the test that counts every pair, when evaluation stops on an internal
+ * consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
+ * evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
