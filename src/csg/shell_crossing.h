@@ -1,7 +1,7 @@
 /*
- * Whether a shell of a mesh crosses itself, decided exactly and fast enough to run on
- * every leaf (csg/shell_crossing.c): most pairs of neighbouring triangles are proven
- * apart a patch at a time, and only the rest are tested one by one.
+ * Whether a shell of a mesh crosses itself, decided exactly (csg/shell_crossing.c): most
+ * pairs of neighbouring triangles are proven apart a patch at a time, and only the rest
+ * are tested one by one.
  */
 #ifndef MESHCSG_CSG_SHELL_CROSSING_H
 #define MESHCSG_CSG_SHELL_CROSSING_H
