@@ -22,7 +22,9 @@
  * its winding number exceeds 1/2; the tree's booleans then say whether the result must
  * contain it, and the output's winding number must be exactly that 0 or 1. Points where
  * any winding number is not within 1e-3 of an integer are too close to a surface for
- * double precision and are skipped; at least half of all points must be checked.
+ * double precision and are skipped, as are points within 2^-40 of the scene's scale of
+ * the output's surface (rounding moved it by about a unit in the last place there); at
+ * least half of all points must be checked.
  *
  * Besides: mcsg_eval returns MCSG_OK; the output is a valid closed, oriented,
  * edge-manifold mesh (mcsg_mesh_check) or empty, manifold by vertex index too; its
@@ -862,6 +864,28 @@ static double winding(const mcsg_mesh *m, const box *b, const double p[3])
 
 static bool near_integer(double w) { return fabs(w - nearbyint(w)) < NEAR_INTEGER; }
 
+static double distance_to_plane(const double *a, const double *b, const double *c,
+                                const double p[3]);
+
+/* Whether p lies within `reach` of a triangle of m (its plane, inside the triangle's box
+ * grown by reach): rounding to doubles moves the output's vertices by about a unit in the
+ * last place, so which side such a point is on says nothing about the evaluation. */
+static bool near_surface(const mcsg_mesh *m, const double p[3], double reach)
+{
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const double *v[3];
+        bool in_box = true;
+        for (int c = 0; c < 3; c++)
+            v[c] = m->vertices + 3 * (size_t)m->triangles[3 * t + (size_t)c];
+        for (int k = 0; k < 3 && in_box; k++)
+            in_box = p[k] >= fmin(v[0][k], fmin(v[1][k], v[2][k])) - reach &&
+                     p[k] <= fmax(v[0][k], fmax(v[1][k], v[2][k])) + reach;
+        if (in_box && distance_to_plane(v[0], v[1], v[2], p) <= reach)
+            return true;
+    }
+    return false;
+}
+
 static void cross(const double u[3], const double v[3], double out[3])
 {
     out[0] = u[1] * v[2] - u[2] * v[1];
@@ -875,6 +899,18 @@ static double dot(const double u[3], const double v[3])
 }
 
 static double norm(const double u[3]) { return sqrt(dot(u, u)); }
+
+/* Distance from p to the plane of abc (infinite when abc has no area in double). */
+static double distance_to_plane(const double *a, const double *b, const double *c,
+                                const double p[3])
+{
+    double u[3], v[3], n[3], w[3], len;
+    for (int k = 0; k < 3; k++)
+        u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = p[k] - a[k];
+    cross(u, v, n);
+    len = norm(n);
+    return len > 0 ? fabs(dot(n, w)) / len : INFINITY;
+}
 
 static void sub(const double *u, const double *v, double out[3])
 {
@@ -1288,7 +1324,7 @@ static bool check_points(const tree_facts *f, const tree_facts *claim, uint64_t 
         if (!q.clear)
             continue;
         w_out = winding(out, &outbox, p);
-        if (!near_integer(w_out))
+        if (!near_integer(w_out) || near_surface(out, p, 0x1p-40 * scale))
             continue;
         r->checked++;
         r->inside += expect;
