@@ -1,7 +1,7 @@
 /*
  * Whether a shell of a mesh crosses itself (mci_find_shell_crossing), exactly, at about
- * a third of an evaluation's cost on scanned models (the octree over every nearby pair
- * that it replaces cost two evaluations).
+ * a third of an evaluation's cost on scanned models (testing every nearby pair through
+ * the octree, as mcsg_mesh_self_intersections does, costs about two evaluations).
  *
  * Each triangle faces one way along one axis: the axis of a nonzero component of its
  * normal (the largest in floating point) and that component's exact sign (the
