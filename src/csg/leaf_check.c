@@ -115,49 +115,55 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
     return MCSG_OK;
 }
 
-/* Leaf k's report, shells (per triangle, in shell[]) and half-edge twins (twin[]), after
- * removing its zero-area triangles if they are its only problem (*shell and *twin
- * reallocated then). */
+/* Leaf k's report and shells (per triangle, in shell[]), after removing its zero-area
+ * triangles if they are its only problem (*shell reallocated then). */
 static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_report *report,
-                                uint32_t **shell, uint32_t **twin, mcsg_error *err)
+                                uint32_t **shell, mcsg_error *err)
 {
     mci_edge_mates *mates = &job->ptree->leaf_mates[k];
-    size_t removed, n;
+    size_t removed;
     mcsg_status st = mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell,
-                                           *twin, mates, err);
+                                           NULL, mates, err);
     if (st != MCSG_OK || !only_zero_area(report))
         return st;
     if ((st = remove_zero_area(job, k, &removed, err)) != MCSG_OK || removed == 0)
         return st;
     mci_free(job->ctx, *shell);
-    mci_free(job->ctx, *twin);
     mci_edge_mates_free(job->ctx, mates);
-    n = job->ptree->leaf_mesh[k]->triangle_count;
-    *shell = mci_malloc_array(job->ctx, n + 1, sizeof **shell);
-    *twin = mci_malloc_array(job->ctx, n + 1, 3 * sizeof **twin);
-    if (!*shell || !*twin)
+    *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
+                              sizeof **shell);
+    if (!*shell)
         return mci_fail_nomem(err, "checking the leaves");
-    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, *twin,
+    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, NULL,
                                  mates, err);
 }
 
 /* Marks leaf k (leaf_crossing, leaf_winding) when a shell of it crosses itself: the fast
- * exact test of csg/shell_crossing.c. */
-static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint32_t *twin,
-                                 mcsg_error *err)
+ * exact test of csg/shell_crossing.c, on the half-edge twins of a second pass of the
+ * mesh check (only the leaves tested pay for them). */
+static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error *err)
 {
     mci_ptree *t = job->ptree;
+    const mcsg_mesh *m = t->leaf_mesh[k];
     mci_shell_crossing_stats stats;
+    mcsg_check_report report;
     uint32_t example[2];
-    bool crosses;
-    mcsg_status st = mci_find_shell_crossing(job->ctx, t->leaf_mesh[k], t->leaf_shell[k], twin,
-                                             &crosses, example, &stats, err);
+    bool crosses = false;
+    uint32_t *twin = mci_malloc_array(job->ctx, m->triangle_count + 1, 3 * sizeof *twin);
+    mcsg_status st = twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
+                          : mci_fail_nomem(err, "checking the leaves");
+    if (st == MCSG_OK)
+        st = mci_find_shell_crossing(job->ctx, m, t->leaf_shell[k], twin, &crosses, example,
+                                     &stats, err);
+    mci_free(job->ctx, twin);
+    if (st != MCSG_OK)
+        return st;
     mci_log(job->ctx, MCSG_LOG_DEBUG, "leaf %u: tested for crossing itself: %zu of %zu triangles "
             "in %zu patches proven apart, %zu pairs tested in a grid of %zu entries",
-            t->leaf_source[k], stats.proven_triangles, t->leaf_mesh[k]->triangle_count,
+            t->leaf_source[k], stats.proven_triangles, m->triangle_count,
             stats.proven_patches, stats.pairs_tested, stats.grid_entries);
-    if (st != MCSG_OK || !crosses)
-        return st;
+    if (!crosses)
+        return MCSG_OK;
     t->leaf_crossing[k] = t->leaf_winding[k] = 1;
     mci_log(job->ctx, MCSG_LOG_INFO, "leaf %u%s%s: a shell crosses itself (e.g. triangles %u "
             "and %u): its solid is where its winding number is positive, and its faces are "
@@ -171,7 +177,7 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint
  * winding numbers tell, leaf_crossing where its faces must be intersected with each
  * other. */
 static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_check_report *report,
-                             const uint32_t *twin, mcsg_error *err)
+                             mcsg_error *err)
 {
     mci_ptree *t = job->ptree;
     /* Where one shell meets itself at an edge, parts of it may lie inside others or face
@@ -190,7 +196,7 @@ static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_che
     if (t->leaf_crossing[k] ||
         (!job->ctx->check_self_intersections && t->leaf_mates[k].entering_edges == 0))
         return MCSG_OK;
-    return find_crossing(job, k, twin, err);
+    return find_crossing(job, k, err);
 }
 
 static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
@@ -200,11 +206,10 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     const char *label = mcsg_tree_node_label(job->tree, node);
     mcsg_check_report report;
     char problem[400];
-    size_t n = job->ptree->leaf_mesh[k]->triangle_count;
-    uint32_t *shell = mci_malloc_array(job->ctx, n + 1, sizeof *shell);
-    uint32_t *twin = mci_malloc_array(job->ctx, n + 1, 3 * sizeof *twin);
-    mcsg_status st = shell && twin ? check_shells(job, k, &report, &shell, &twin, err)
-                                   : mci_fail_nomem(err, "checking the leaves");
+    uint32_t *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
+                                       sizeof *shell);
+    mcsg_status st = shell ? check_shells(job, k, &report, &shell, err)
+                           : mci_fail_nomem(err, "checking the leaves");
     if (st == MCSG_OK) {
         describe_problem(job->ptree->leaf_mesh[k], &report, problem, sizeof problem);
         if (problem[0] == '\0' && report.components > 1) {
@@ -213,13 +218,12 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
             shell = NULL;
         }
         if (problem[0] == '\0')
-            st = mark_kind(job, k, &report, twin, err);
+            st = mark_kind(job, k, &report, err);
         else
             st = mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
                           label[0] ? ", " : "", label, problem);
     }
     mci_free(job->ctx, shell);
-    mci_free(job->ctx, twin);
     return st;
 }
 
