@@ -135,11 +135,14 @@ def drill_plate(ms, n, radius=0.3, segments=24):
 
 
 # Exact volumes and shells of the generated scenes that reference.tsv does not list.
-def menger_sponge(level, digits=None):
+def menger_sponge(level, digits=None, leaf_matrices=False):
     """OpenSCAD's example024 (a Menger sponge of side 100 at `level`, turned to stand on a
     corner, its lower half cut away) as the CSG text OpenSCAD's .csg export writes:
     numbers with `digits` significant digits (6: the export, where faces meant to be
-    coplanar are ~1e-5 apart), or every double exactly (None)."""
+    coplanar are ~1e-5 apart), or every double exactly (None). With `leaf_matrices` each
+    cube carries the product of the matrices above it (as meshcsg's reader composes them,
+    written exactly), so nothing groups the turned cubes: each is turned and rounded on
+    its own, as in a tree whose leaves were transformed one by one."""
     fmt = (lambda x: '%.*g' % (digits, x)) if digits else (lambda x: repr(float(x)))
     side = 100.0
     a, b = math.radians(45), math.atan(1 / math.sqrt(2))
@@ -151,33 +154,54 @@ def menger_sponge(level, digits=None):
              [[0, 0, 1], [0, 1, 0], [-1, 0, 0]]]
     out = []
 
-    def matrix(m, t=(0, 0, 0)):
-        rows = ['[%s, %s, %s, %s]' % (fmt(m[i][0]), fmt(m[i][1]), fmt(m[i][2]), fmt(t[i]))
-                for i in range(3)]
-        return 'multmatrix([%s, [0, 0, 0, 1]])' % ', '.join(rows)
+    def as_rows(m, t=(0, 0, 0), f=fmt):
+        return [[float(f(m[i][j])) for j in range(3)] + [float(f(t[i]))] for i in range(3)]
 
-    def negative(size, level_left, indent):
+    def compose(p, o):  # p after o, in the order of modules.c compose()
+        return [[p[r][0] * o[0][c] + p[r][1] * o[1][c] + p[r][2] * o[2][c] +
+                 (p[r][3] if c == 3 else 0.0) for c in range(4)] for r in range(3)]
+
+    def multmatrix(rows, f=fmt):
+        text = ['[%s, %s, %s, %s]' % tuple(f(x) for x in rows[i]) for i in range(3)]
+        return 'multmatrix([%s, [0, 0, 0, 1]])' % ', '.join(text)
+
+    def open_block(indent, rows, above):
+        if leaf_matrices:
+            return compose(above, rows)
+        out.append('%s%s {' % (indent, multmatrix(rows)))
+        return above
+
+    def close_block(indent):
+        if not leaf_matrices:
+            out.append('%s}' % indent)
+
+    def cube(indent, size, above):
+        text = 'cube(size = [%s, %s, %s], center = true);' % tuple(fmt(x) for x in size)
+        prefix = multmatrix(above, repr) + ' ' if leaf_matrices else ''
+        out.append(indent + prefix + text)
+
+    def negative(size, level_left, indent, above):
         l = size / 3
-        out.append('%scube(size = [%s, %s, %s], center = true);' % (
-            indent, fmt(side * 1.1), fmt(l), fmt(l)))
+        cube(indent, (side * 1.1, l, l), above)
         if level_left > 1:
             for i in (-1, 0, 1):
                 for j in (-1, 0, 1):
                     if i or j:
-                        out.append('%s%s {' % (indent, matrix(turns[0], (0, i * l, j * l))))
-                        negative(l, level_left - 1, indent + '  ')
-                        out.append('%s}' % indent)
+                        inner = open_block(indent, as_rows(turns[0], (0, i * l, j * l)), above)
+                        negative(l, level_left - 1, indent + '  ', inner)
+                        close_block(indent)
 
+    identity = as_rows(turns[0])
     out.append('difference() {')
-    out.append('  %s {' % matrix(rot))
+    turned = open_block('  ', as_rows(rot), identity)
     out.append('    difference() {')
-    out.append('      cube(size = [%s, %s, %s], center = true);' % ((fmt(side),) * 3))
+    cube('      ', (side,) * 3, turned)
     for t in turns:
-        out.append('      %s {' % matrix(t))
-        negative(side, level, '        ')
-        out.append('      }')
+        inner = open_block('      ', as_rows(t), turned)
+        negative(side, level, '        ', inner)
+        close_block('      ')
     out.append('    }')
-    out.append('  }')
+    close_block('  ')
     out.append('  translate([0, 0, %s]) cube(size = [%s, %s, %s], center = true);' % (
         fmt(-side), fmt(2 * side), fmt(2 * side), fmt(2 * side)))
     out.append('}')

@@ -573,6 +573,15 @@ typedef struct mcsg_eval_stats {
     double seconds_triangulate; /* tessellating the split faces */
     double seconds_classify;    /* regions, labels and selection */
     double seconds_assemble;    /* welding and rounding the output */
+    size_t frames_evaluated;    /* groups under a transform that turns space, evaluated in
+                                   their own coordinates before the rest (.scad input;
+                                   docs/robustness.md) */
+    double seconds_frames;      /* those evaluations (in seconds_total; the other fields
+                                   describe the last evaluation, the root's) */
+    int frames_flattened;       /* 1 when the frames' result broke a guarantee (or their
+                                   evaluation failed) and the tree evaluated with each
+                                   leaf turned on its own, which broke fewer, was
+                                   returned instead (the fields above are its) */
     double seconds_total;
 } mcsg_eval_stats;
 

@@ -9,6 +9,7 @@
  * comparison tests them and not only the grid. (12,000 meshes of other seeds agreed.)
  */
 #include "testlib.h"
+#include "csg/frames.h"
 #include "csg/self_intersect.h"
 #include "csg/shell_crossing.h"
 #include "mesh/validate.h"
@@ -204,6 +205,54 @@ TEST(agrees_with_every_pair_on_random_meshes)
               triangles_apart);
 }
 
+/* A turned mesh tested with the boxes of the mesh before the turn, grown by
+ * mci_turn_margin, gives the answer of its own boxes. Meshes snapped to a coarse grid
+ * (triangles coplanar and touching everywhere), turned by six-digit matrices: rounding
+ * the turn makes some of them cross, by units in the last place. */
+TEST(turned_meshes_tested_with_boxes_before_the_turn)
+{
+    uint64_t rng = 0x7e57ab1e;
+    size_t crossing = 0, apart = 0;
+    mci_ctx ctx;
+    mci_ctx_init(&ctx, NULL);
+    for (int trial = 0; trial < 200; trial++) {
+        mcsg_mesh own, turned;
+        mcsg_check_report report;
+        mcsg_error err;
+        uint32_t ex[2], *twin;
+        double a = uniform(&rng) * 6.283, b = uniform(&rng) * 6.283, margin;
+        double m[12] = {cos(a), -sin(a), 0, 150, sin(a) * cos(b), cos(a) * cos(b), -sin(b),
+                        -20, sin(a) * sin(b), cos(a) * sin(b), cos(b), 3};
+        bool plain, boxed;
+        mci_crossing_boxes boxes;
+        for (int i = 0; i < 12; i++) /* six decimals, as an export might write them */
+            m[i] = round(m[i] * 1e6) / 1e6;
+        random_shape(&rng, &own);
+        push_vertices(&own, &rng, test_random_int(&rng, 0, 2), 0.05);
+        snap(&own, 0.125);
+        CHECK_OK(mcsg_mesh_copy(&own, NULL, &turned, &err), &err);
+        mcsg_mesh_transform(&turned, m);
+        margin = mci_turn_margin(m, &own);
+        CHECK(margin > 0 && margin < 1e-9);
+        twin = malloc((3 * turned.triangle_count + 1) * sizeof *twin);
+        CHECK_OK(mci_mesh_check_shells(&ctx, &turned, &report, NULL, twin, NULL, &err), &err);
+        boxes.mesh = &own;
+        boxes.margin = margin;
+        CHECK_OK(mci_find_shell_crossing(&ctx, &turned, NULL, twin, &plain, ex, NULL, &err),
+                 &err);
+        CHECK_OK(mci_find_shell_crossing_boxed(&ctx, &turned, NULL, twin, &boxes, &boxed, ex,
+                                               NULL, &err), &err);
+        CHECK_MSG(plain == boxed, "trial %d: %d with the turned mesh's boxes, %d with the "
+                  "boxes before the turn", trial, plain, boxed);
+        crossing += plain;
+        apart += !plain;
+        free(twin);
+        mcsg_mesh_free(&own, NULL);
+        mcsg_mesh_free(&turned, NULL);
+    }
+    CHECK_MSG(crossing >= 20 && apart >= 20, "%zu crossing, %zu apart", crossing, apart);
+}
+
 /* Known cases: a clean sphere is proven patch by patch; a vertex pushed through its
  * opposite side, or a shell touching itself in a vertex it does not share, crosses. */
 TEST(known_cases)
@@ -261,6 +310,7 @@ TEST(allocation_failures)
 int main(void)
 {
     RUN(agrees_with_every_pair_on_random_meshes);
+    RUN(turned_meshes_tested_with_boxes_before_the_turn);
     RUN(known_cases);
     RUN(allocation_failures);
     return test_summary();

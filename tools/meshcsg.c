@@ -574,6 +574,15 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
            s->faces, s->faces_min, s->faces_max);
     if (read_seconds >= 0)
         printf("  read input       %8.3f s\n", read_seconds);
+    if (s->frames_evaluated && !s->frames_flattened)
+        printf("  frames           %8.3f s  (%zu groups under a turning transform evaluated "
+               "in their own coordinates first; the lines below are the last evaluation's, "
+               "with their results as leaves)\n", s->seconds_frames, s->frames_evaluated);
+    else if (s->frames_evaluated)
+        printf("  frames           %8.3f s  (%zu groups under a turning transform evaluated "
+               "in their own coordinates first broke a guarantee; the lines below are the "
+               "evaluation of the tree with each leaf turned on its own, which broke fewer)\n",
+               s->seconds_frames, s->frames_evaluated);
     printf("  positive tree    %8.3f s\n", s->seconds_tree);
     printf("  input check      %8.3f s\n", s->seconds_check);
     printf("  octree           %8.3f s  (%zu cells)\n", x->seconds_octree, x->cells);

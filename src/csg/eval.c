@@ -76,6 +76,8 @@
  */
 #include "base/parallel.h"
 #include "csg/classify.h"
+#include "csg/frames.h"
+#include "mesh/tree.h"
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
 #include "csg/output_check.h"
@@ -951,6 +953,19 @@ static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenanc
 
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
                       mcsg_provenance **provenance, mcsg_eval_stats *stats, mcsg_error *err)
+{
+    if (tree && out && mci_tree_frame_count(tree) > 0) {
+        memset(out, 0, sizeof *out);
+        if (provenance)
+            *provenance = NULL;
+        return mci_eval_frames(tree, opts, out, provenance, stats, err);
+    }
+    return mci_eval_flattened(tree, opts, out, provenance, stats, err);
+}
+
+mcsg_status mci_eval_flattened(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
+                               mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                               mcsg_error *err)
 {
     eval_state e;
     double t0 = mci_seconds_now();

@@ -19,6 +19,8 @@
  * evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
+
+#include "mesh/tree.h"
 #include "base/parallel.h"
 #include "csg/shell_crossing.h"
 #include "mesh/validate.h"
@@ -138,11 +140,26 @@ static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_
                                  mates, err);
 }
 
+/* Boxes from the leaf's mesh before it was turned (a frame's result), while the leaf is
+ * that mesh turned, triangle for triangle (no zero-area triangle removed). */
+static const mci_crossing_boxes *crossing_boxes(const leaf_check_job *job, size_t k,
+                                                mci_crossing_boxes *boxes)
+{
+    mcsg_node_id node = job->ptree->leaf_source[k];
+    const mcsg_mesh *own = mcsg_tree_leaf_mesh(job->tree, node);
+    boxes->mesh = mci_tree_crossing_boxes(job->tree, node, &boxes->margin);
+    if (!boxes->mesh || job->ptree->leaf_mesh[k] != own ||
+        boxes->mesh->triangle_count != own->triangle_count)
+        return NULL;
+    return boxes;
+}
+
 /* Marks leaf k (leaf_crossing, leaf_winding) when a shell of it crosses itself: the fast
  * exact test of csg/shell_crossing.c, on the half-edge twins of a second pass of the
  * mesh check (only the leaves tested pay for them). */
 static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error *err)
 {
+    mci_crossing_boxes boxes;
     mci_ptree *t = job->ptree;
     const mcsg_mesh *m = t->leaf_mesh[k];
     mci_shell_crossing_stats stats;
@@ -153,8 +170,9 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error
     mcsg_status st = twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
                           : mci_fail_nomem(err, "checking the leaves");
     if (st == MCSG_OK)
-        st = mci_find_shell_crossing(job->ctx, m, t->leaf_shell[k], twin, &crosses, example,
-                                     &stats, err);
+        st = mci_find_shell_crossing_boxed(job->ctx, m, t->leaf_shell[k], twin,
+                                           crossing_boxes(job, k, &boxes), &crosses, example,
+                                           &stats, err);
     mci_free(job->ctx, twin);
     if (st != MCSG_OK)
         return st;
@@ -194,7 +212,8 @@ static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_che
      * too: such leaves, rare in clean input, are always tested; every leaf when the
      * options ask. */
     if (t->leaf_crossing[k] ||
-        (!job->ctx->check_self_intersections && t->leaf_mates[k].entering_edges == 0))
+        (!job->ctx->check_self_intersections && t->leaf_mates[k].entering_edges == 0 &&
+         !mci_tree_tests_crossing(job->tree, t->leaf_source[k])))
         return MCSG_OK;
     return find_crossing(job, k, err);
 }

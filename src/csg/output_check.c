@@ -359,3 +359,9 @@ void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *c)
     mci_log(ctx, MCSG_LOG_WARNING, "the result breaks its guarantees after rounding to "
             "doubles: %s", what);
 }
+
+size_t mci_output_check_defects(const mcsg_output_check *c)
+{
+    return c->open_edges + c->misoriented_edges + c->index_nonmanifold_edges +
+           c->welded_nonmanifold_edges + c->degenerate_triangles + c->crossing_pairs;
+}

@@ -58,4 +58,7 @@ void mci_describe_output_check(const mcsg_output_check *check, char *what, size_
 /* One warning line naming what the check found broken, if anything. */
 void mci_log_output_check(const mci_ctx *ctx, const mcsg_output_check *check);
 
+/* Everything a check counts broken, crossing pairs included where counted. */
+size_t mci_output_check_defects(const mcsg_output_check *c);
+
 #endif

@@ -251,13 +251,6 @@ static bool keeps_the_solid(const rounds *r, const mcsg_mesh *candidate)
     return fabs(c.volume - r->first.volume) <= bound;
 }
 
-/* Everything a check counts broken, crossing pairs included where counted. */
-static size_t defects(const mcsg_output_check *c)
-{
-    return c->open_edges + c->misoriented_edges + c->index_nonmanifold_edges +
-           c->welded_nonmanifold_edges + c->degenerate_triangles + c->crossing_pairs;
-}
-
 /* Why a candidate is not kept, for --verbose. */
 static void log_refused(const mci_ctx *ctx, const round_state *candidate, const char *why)
 {
@@ -298,7 +291,7 @@ static mcsg_status keep_if_it_passes(rounds *r, const mci_exact_result *exact,
     s = mci_check_output(r->ctx, &candidate->mesh, exact, &check, err);
     if (s == MCSG_OK) {
         candidate->no_start = check.open_edges > 0 || check.misoriented_edges > 0 ||
-                              defects(&check) >= r->first_defects;
+                              mci_output_check_defects(&check) >= r->first_defects;
         s = round_passes(r->ctx, r->out, &r->first_pairs, &candidate->mesh, &check, &passes,
                          err);
     }
@@ -425,7 +418,7 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
     int top = mci_snap_exponent(out, 0);
     rounds r = {ctx, out, provenance, stats, provenance && *provenance, false, SIZE_MAX,
                 size_of(out), ldexp(1.0, top - 48), touching, touching_count,
-                4 * out->triangle_count + 1000, defects(&stats->output_check)};
+                4 * out->triangle_count + 1000, mci_output_check_defects(&stats->output_check)};
     round_state last = {{0}, NULL, false}, next;
     mcsg_status s = MCSG_OK;
     if (stats->output_check.crossing_pairs > 0)

@@ -702,9 +702,20 @@ static void fill_buckets(const test_state *s, const grid *g, const double *box,
     k->start[0] = 0;
 }
 
+/* Triangle t's box in the other mesh, grown by the margin (rounded outward: a whole unit
+ * in the last place beyond the rounded sum). */
+static void grown_box(const mci_crossing_boxes *b, uint32_t t, double box[6])
+{
+    triangle_box(b->mesh, t, box);
+    for (int k = 0; k < 3; k++) {
+        box[k] = nextafter(box[k] - b->margin, -INFINITY);
+        box[k + 3] = nextafter(box[k + 3] + b->margin, INFINITY);
+    }
+}
+
 /* Every pair that no proven patch covers, through the grid. */
-static mcsg_status test_remaining_pairs(test_state *s, bool *crosses, uint32_t example[2],
-                                        mcsg_error *err)
+static mcsg_status test_remaining_pairs(test_state *s, const mci_crossing_boxes *boxes,
+                                        bool *crosses, uint32_t example[2], mcsg_error *err)
 {
     size_t n = s->m->triangle_count, count;
     double *box = mci_malloc_array(s->ctx, n, 6 * sizeof *box);
@@ -713,8 +724,12 @@ static mcsg_status test_remaining_pairs(test_state *s, bool *crosses, uint32_t e
     grid g;
     mcsg_status st = MCSG_OK;
     if (box) {
-        for (uint32_t t = 0; t < n; t++)
-            triangle_box(s->m, t, box + 6 * (size_t)t);
+        for (uint32_t t = 0; t < n; t++) {
+            if (boxes)
+                grown_box(boxes, t, box + 6 * (size_t)t);
+            else
+                triangle_box(s->m, t, box + 6 * (size_t)t);
+        }
         count = choose_grid(s, box, 8 * n + 1024, &g);
         while (k.mask < count && k.mask < UINT32_MAX / 4)
             k.mask = 2 * k.mask + 1;
@@ -798,6 +813,16 @@ mcsg_status mci_find_shell_crossing(const mci_ctx *ctx, const mcsg_mesh *m,
                                     bool *crosses, uint32_t example[2],
                                     mci_shell_crossing_stats *stats, mcsg_error *err)
 {
+    return mci_find_shell_crossing_boxed(ctx, m, shell, twin, NULL, crosses, example, stats,
+                                         err);
+}
+
+mcsg_status mci_find_shell_crossing_boxed(const mci_ctx *ctx, const mcsg_mesh *m,
+                                          const uint32_t *shell, const uint32_t *twin,
+                                          const mci_crossing_boxes *boxes, bool *crosses,
+                                          uint32_t example[2],
+                                          mci_shell_crossing_stats *stats, mcsg_error *err)
+{
     test_state s;
     size_t n = m->triangle_count;
     mcsg_status st;
@@ -821,7 +846,7 @@ mcsg_status mci_find_shell_crossing(const mci_ctx *ctx, const mcsg_mesh *m,
     else
         st = prove_patches(&s, err);
     if (st == MCSG_OK)
-        st = test_remaining_pairs(&s, crosses, example, err);
+        st = test_remaining_pairs(&s, boxes, crosses, example, err);
     if (stats)
         *stats = s.stats;
     free_state(&s);

@@ -29,4 +29,21 @@ mcsg_status mci_find_shell_crossing(const mci_ctx *ctx, const mcsg_mesh *m,
                                     bool *crosses, uint32_t example[2],
                                     mci_shell_crossing_stats *stats, mcsg_error *err);
 
+/* Where pairs may meet, for a mesh that is another one moved by a map rounded vertex by
+ * vertex (a frame's turned result, csg/frames.c): triangle t of m can meet triangle u
+ * only if the boxes of t and u in `mesh` (same triangles, other coordinates), each grown
+ * by `margin`, meet. Tight boxes where m's are not (long thin triangles turned off the
+ * axes have large boxes). */
+typedef struct mci_crossing_boxes {
+    const mcsg_mesh *mesh;
+    double margin;
+} mci_crossing_boxes;
+
+/* mci_find_shell_crossing with the pairs' boxes from `boxes` (NULL: m's own). */
+mcsg_status mci_find_shell_crossing_boxed(const mci_ctx *ctx, const mcsg_mesh *m,
+                                          const uint32_t *shell, const uint32_t *twin,
+                                          const mci_crossing_boxes *boxes, bool *crosses,
+                                          uint32_t example[2],
+                                          mci_shell_crossing_stats *stats, mcsg_error *err);
+
 #endif

@@ -11,11 +11,16 @@
 
 typedef struct tree_node {
     mcsg_mesh mesh;      /* leaves only; zeroed for operations */
+    mcsg_mesh local;     /* leaves inside a frame: the mesh in that frame; else zeroed */
+    double *frame;       /* owned: this node's subtree is a frame (mesh/tree.h), or NULL */
     char *label;         /* owned copy, or NULL for "" */
     size_t first_child;  /* index into mcsg_tree.children */
     uint32_t child_count;
     uint8_t kind;        /* mcsg_node_kind */
     uint8_t has_parent;
+    uint8_t tests_crossing; /* leaves: always tested for crossing themselves */
+    const mcsg_mesh *box_mesh; /* leaves: borrowed, for that test's boxes (tree.h) */
+    double box_margin;
 } tree_node;
 
 struct mcsg_tree {
@@ -25,6 +30,7 @@ struct mcsg_tree {
     mcsg_node_id *children;
     size_t children_len, children_cap;
     size_t leaf_count;
+    size_t frame_count;
     mcsg_node_id root; /* MCSG_NO_NODE: the last node added */
 };
 
@@ -65,6 +71,8 @@ void mcsg_tree_free(mcsg_tree *tree)
     ctx = tree->ctx;
     for (size_t i = 0; i < tree->node_count; i++) {
         mci_mesh_free(&ctx, &tree->nodes[i].mesh);
+        mci_mesh_free(&ctx, &tree->nodes[i].local);
+        mci_free(&ctx, tree->nodes[i].frame);
         mci_free(&ctx, tree->nodes[i].label);
     }
     mci_free(&ctx, tree->nodes);
@@ -327,4 +335,90 @@ const mcsg_mesh *mcsg_tree_leaf_mesh(const mcsg_tree *tree, mcsg_node_id node)
 {
     const tree_node *n = find_node(tree, node);
     return (n && n->kind == MCSG_NODE_LEAF) ? &n->mesh : NULL;
+}
+
+size_t mci_tree_frame_count(const mcsg_tree *tree) { return tree->frame_count; }
+
+const double *mci_tree_frame(const mcsg_tree *tree, mcsg_node_id node)
+{
+    const tree_node *n = find_node(tree, node);
+    return n ? n->frame : NULL;
+}
+
+const mcsg_mesh *mci_tree_leaf_local(const mcsg_tree *tree, mcsg_node_id node)
+{
+    const tree_node *n = find_node(tree, node);
+    return (n && n->kind == MCSG_NODE_LEAF && n->local.vertices) ? &n->local : NULL;
+}
+
+void mci_tree_set_local(mcsg_tree *tree, mcsg_node_id leaf, mcsg_mesh *local)
+{
+    tree_node *n = &tree->nodes[leaf];
+    mci_mesh_free(&tree->ctx, &n->local);
+    n->local = *local;
+    memset(local, 0, sizeof *local);
+}
+
+void mci_tree_close_frame(mcsg_tree *tree, mcsg_node_id leaf, const double *matrix)
+{
+    tree_node *n = &tree->nodes[leaf];
+    if (matrix && n->local.vertices)
+        mcsg_mesh_transform(&n->local, matrix);
+    else
+        mci_mesh_free(&tree->ctx, &n->local);
+}
+
+/* (a after b) as row-major 3x4 matrices: apply b first. */
+static void compose_after(const double a[12], const double b[12], double out[12])
+{
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 4; c++) {
+            double sum = a[4 * r] * b[c] + a[4 * r + 1] * b[4 + c] + a[4 * r + 2] * b[8 + c];
+            out[4 * r + c] = c == 3 ? sum + a[4 * r + 3] : sum;
+        }
+    }
+}
+
+mcsg_status mci_tree_set_frame(mcsg_tree *tree, mcsg_node_id node, const double matrix[12],
+                               mcsg_error *err)
+{
+    tree_node *n = &tree->nodes[node];
+    if (n->frame) {
+        double inner[12];
+        memcpy(inner, n->frame, sizeof inner);
+        compose_after(matrix, inner, n->frame);
+        return MCSG_OK;
+    }
+    n->frame = mci_malloc(&tree->ctx, 12 * sizeof *n->frame);
+    if (!n->frame)
+        return mci_fail_nomem(err, "marking a frame in a CSG tree");
+    memcpy(n->frame, matrix, 12 * sizeof *n->frame);
+    tree->frame_count++;
+    return MCSG_OK;
+}
+
+void mci_tree_set_tests_crossing(mcsg_tree *tree, mcsg_node_id leaf)
+{
+    tree->nodes[leaf].tests_crossing = 1;
+}
+
+void mci_tree_set_crossing_boxes(mcsg_tree *tree, mcsg_node_id leaf, const mcsg_mesh *mesh,
+                                 double margin)
+{
+    tree->nodes[leaf].box_mesh = mesh;
+    tree->nodes[leaf].box_margin = margin;
+}
+
+const mcsg_mesh *mci_tree_crossing_boxes(const mcsg_tree *tree, mcsg_node_id leaf,
+                                         double *margin)
+{
+    const tree_node *n = find_node(tree, leaf);
+    *margin = n ? n->box_margin : 0;
+    return n ? n->box_mesh : NULL;
+}
+
+bool mci_tree_tests_crossing(const mcsg_tree *tree, mcsg_node_id leaf)
+{
+    const tree_node *n = find_node(tree, leaf);
+    return n && n->tests_crossing;
 }

@@ -351,6 +351,37 @@ static mcsg_status at_call(const scad_context *sc, const call_args *ca, mcsg_sta
 
 /* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
  * an empty mesh or a flattening transform gives the empty set instead. */
+/* The leaf's mesh in the coordinates of its innermost frame (mesh/tree.h), made from the
+ * untransformed mesh when a frame is open; else left empty. */
+static mcsg_status frame_local_mesh(const mci_ctx *ctx, const scad_transform *t,
+                                    const mcsg_mesh *mesh, mcsg_mesh *local, mcsg_error *err)
+{
+    mcsg_status st;
+    memset(local, 0, sizeof *local);
+    if (!t->in_frame)
+        return MCSG_OK;
+    st = mci_mesh_alloc(ctx, local, mesh->vertex_count, mesh->triangle_count, err);
+    if (st != MCSG_OK)
+        return st;
+    memcpy(local->vertices, mesh->vertices, mesh->vertex_count * 3 * sizeof(double));
+    memcpy(local->triangles, mesh->triangles, mesh->triangle_count * 3 * sizeof(uint32_t));
+    if (!is_identity(t->rel))
+        mcsg_mesh_transform(local, t->rel);
+    return MCSG_OK;
+}
+
+/* Add the transformed leaf, and its local mesh inside a frame (both taken). */
+static mcsg_status add_framed_leaf(scad_context *sc, const call_args *ca, mcsg_mesh *mesh,
+                                   mcsg_mesh *local, const char *label, mcsg_node_id *node,
+                                   mcsg_error *err)
+{
+    mcsg_status st = mci_tree_add_leaf_owned(sc->tree, mesh, label, node, err);
+    if (st == MCSG_OK && local->vertices)
+        mci_tree_set_local(sc->tree, *node, local);
+    mci_mesh_free(sc->ev.ctx, local);
+    return at_call(sc, ca, st, err);
+}
+
 static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_transform *t,
                             mcsg_mesh *mesh, mci_buf *label, mcsg_node_id *node,
                             mcsg_error *err)
@@ -366,11 +397,18 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
         return mci_fail_nomem(err, "reading CSG text");
     }
     if (!empty) {
+        mcsg_mesh local;
+        st = frame_local_mesh(ctx, t, mesh, &local, err);
+        if (st != MCSG_OK) {
+            mci_mesh_free(ctx, mesh);
+            return st;
+        }
         if (!is_identity(t->m))
             mcsg_mesh_transform(mesh, t->m);
         for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
             if (!isfinite(mesh->vertices[i])) {
                 mci_mesh_free(ctx, mesh);
+                mci_mesh_free(ctx, &local);
                 return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err,
                                     MCSG_ERR_PARSE, "%.*s: vertex %zu is not finite%s",
                                     call_len, (const char *)label->data, i / 3,
@@ -378,9 +416,7 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
                                     : " after the transforms above it");
             }
         }
-        return at_call(sc, ca, mci_tree_add_leaf_owned(sc->tree, mesh,
-                                                        (const char *)label->data, node, err),
-                       err);
+        return add_framed_leaf(sc, ca, mesh, &local, (const char *)label->data, node, err);
     }
     if (!t->degenerate)
         scad_warn_at(ctx, sc->name, ca->stmt->line, ca->stmt->col, "%s() is empty",
@@ -824,6 +860,18 @@ static void compose(const double p[12], const double o[12], double out[12])
     }
 }
 
+/* Whether a linear map can tilt a plane off the axes' directions: some row has two
+ * non-zero entries (a scaling along the axes, with the axes permuted or mirrored, keeps
+ * axis-aligned planes coincident after rounding, as each coordinate is rounded alone). */
+static bool turns_space(const double m[12])
+{
+    for (int r = 0; r < 3; r++) {
+        if ((m[4 * r] != 0) + (m[4 * r + 1] != 0) + (m[4 * r + 2] != 0) > 1)
+            return true;
+    }
+    return false;
+}
+
 static double determinant(const double m[12])
 {
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
@@ -848,6 +896,16 @@ static mcsg_status child_transform(scad_context *sc, const call_args *ca,
     if (st != MCSG_OK)
         return st;
     compose(parent->m, own, child->m);
+    child->in_frame = parent->in_frame;
+    child->opens_frame = turns_space(own);
+    if (child->opens_frame) {
+        static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+        compose(parent->rel, own, child->frame_rel);
+        memcpy(child->rel, identity, sizeof identity);
+        child->in_frame = true;
+    } else {
+        compose(parent->rel, own, child->rel);
+    }
     child->degenerate = parent->degenerate || determinant(own) == 0 ||
                         determinant(child->m) == 0;
     if (child->degenerate && !parent->degenerate)

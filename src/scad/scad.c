@@ -15,6 +15,7 @@
  *    the transforms and the file itself unite their children implicitly: no node for a
  *    single child, a union node for several, the empty set (a childless union) for none.
  */
+#include "mesh/tree.h"
 #include "scad/scad.h"
 
 #include <string.h>
@@ -41,6 +42,8 @@ typedef struct walker {
     uint32_t *seen_in_scope; /* var -> serial of the last scope that assigned it */
     uint32_t *last_assign;   /* var -> that scope's last assignment to it */
     uint32_t scope_serial;
+    mcsg_node_id *pending; /* nodes still to visit when counting a frame's leaves */
+    uint32_t pending_cap;
 } walker;
 
 /* Make room for one more element; false on allocation failure. */
@@ -183,6 +186,62 @@ static mcsg_status frame_label(const walker *w, const walk_frame *f, mci_buf *la
     return ok ? MCSG_OK : MCSG_ERR_NOMEM;
 }
 
+/* Up to two leaves of the subtree at `node` (a frame counts as two): *leaves and the
+ * first one found. */
+static mcsg_status first_leaves(walker *w, mcsg_node_id node, size_t *leaves,
+                                mcsg_node_id *leaf, mcsg_error *err)
+{
+    const mcsg_tree *tree = w->sc->tree;
+    uint32_t len = 0;
+    *leaves = 0;
+    *leaf = MCSG_NO_NODE;
+    w->pending[len++] = node; /* room for one: made by the caller */
+    while (len > 0 && *leaves < 2) {
+        mcsg_node_id n = w->pending[--len];
+        size_t children = mcsg_tree_child_count(tree, n);
+        if (mcsg_tree_node_kind(tree, n) == MCSG_NODE_LEAF) {
+            *leaves += 1;
+            *leaf = *leaf == MCSG_NO_NODE ? n : *leaf;
+            continue;
+        }
+        if (mci_tree_frame(tree, n) && n != node) {
+            *leaves += 2;
+            continue;
+        }
+        for (size_t i = 0; i < children; i++) {
+            void *data = w->pending;
+            if (!room(w->sc->ev.ctx, &data, &w->pending_cap, len, sizeof *w->pending))
+                return mci_fail_nomem(err, "reading CSG text");
+            w->pending = data;
+            w->pending[len++] = mcsg_tree_child(tree, n, i);
+        }
+    }
+    return MCSG_OK;
+}
+
+/* A transform that turns space is done with its children (mesh/tree.h): two or more
+ * leaves under it make its node a frame; a lone leaf is simply transformed, its local
+ * mesh moved into the enclosing frame (if any). */
+static mcsg_status close_frame(walker *w, const scad_transform *t,
+                               const scad_transform *parent, mcsg_node_id node,
+                               mcsg_error *err)
+{
+    void *data = w->pending;
+    size_t leaves;
+    mcsg_node_id leaf;
+    mcsg_status st;
+    if (!room(w->sc->ev.ctx, &data, &w->pending_cap, 0, sizeof *w->pending))
+        return mci_fail_nomem(err, "reading CSG text");
+    w->pending = data;
+    st = first_leaves(w, node, &leaves, &leaf, err);
+    if (st != MCSG_OK || leaves == 0)
+        return st;
+    if (leaves >= 2)
+        return mci_tree_set_frame(w->sc->tree, node, t->frame_rel, err);
+    mci_tree_close_frame(w->sc->tree, leaf, parent->in_frame ? t->frame_rel : NULL);
+    return MCSG_OK;
+}
+
 /* A scope is done: combine its results into one node for the enclosing scope. */
 static mcsg_status exit_frame(walker *w, mcsg_error *err)
 {
@@ -211,6 +270,11 @@ static mcsg_status exit_frame(walker *w, mcsg_error *err)
     w->result_len = f.results;
     scad_unbind_to(&w->sc->ev, f.bindings);
     w->sc->ev.heap_len = f.heap;
+    if (f.own_transform && w->transforms[f.transform].opens_frame)
+        st = close_frame(w, &w->transforms[f.transform],
+                         &w->transforms[w->frames[w->frame_len - 1].transform], node, err);
+    if (st != MCSG_OK)
+        return st;
     if (f.own_transform)
         w->transform_len--;
     return push_result(w, node, err);
@@ -252,7 +316,9 @@ static mcsg_status bind_defaults(scad_eval *ev, mcsg_error *err)
 
 static mcsg_status walk(scad_context *sc, mcsg_error *err)
 {
-    static const scad_transform identity = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}, false};
+    static const scad_transform identity = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {0}, false, false, false};
     const mci_ctx *ctx = sc->ev.ctx;
     walker w;
     mcsg_status st;
@@ -277,6 +343,7 @@ static mcsg_status walk(scad_context *sc, mcsg_error *err)
     mci_free(ctx, w.results);
     mci_free(ctx, w.seen_in_scope);
     mci_free(ctx, w.last_assign);
+    mci_free(ctx, w.pending);
     return st;
 }
 

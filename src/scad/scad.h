@@ -199,10 +199,16 @@ bool scad_format_value(const scad_eval *ev, const scad_value *v, mci_buf *buf);
 /* ---------------------------------------------------------------------------------- */
 /* Module instantiation (modules.c), driven by the walk in scad.c */
 
-/* An affine map (row-major 3x4) with a flag for maps that flatten everything. */
+/* An affine map (row-major 3x4) with a flag for maps that flatten everything, and where
+ * it stands among frames (mesh/tree.h): a transform that turns space opens a frame for
+ * its children; `rel` maps into the innermost open frame (equal to m when none is). */
 typedef struct scad_transform {
     double m[12];
+    double rel[12];
+    double frame_rel[12]; /* when opens_frame: the new frame into the enclosing one */
     bool degenerate;
+    bool in_frame;        /* some frame is open */
+    bool opens_frame;
 } scad_transform;
 
 /* Meshes of import() calls read ahead of the walk (prefetch.c). */
