@@ -43,6 +43,7 @@
  * A failing case is shrunk (a subtree as the whole tree, a child removed, an operation
  * replaced by one of its children) while it still fails, and printed as a CSG file.
  */
+#define _POSIX_C_SOURCE 200809L /* open_memstream */
 #include "csg_fuzz.h"
 #include "testlib.h"
 
@@ -318,19 +319,21 @@ static void export_frame_init(uint64_t *rng, export_frame *f)
     f->style = test_random_int(rng, 0, 2);
 }
 
-/* A local placement (rotation `turn`, translation t) composed with the frame, every entry
- * written with six digits. */
-static void export_place(const export_frame *f, const double turn[9], const double t[3],
-                         double m[12])
+/* A local placement (rotation `turn`, translation t) composed with the frame (unless the
+ * frame is written around the tree), every entry written with six digits. */
+static void export_place(const export_frame *f, bool framed, const double turn[9],
+                         const double t[3], double m[12])
 {
+    static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double *r = framed ? identity : f->r;
     for (int row = 0; row < 3; row++) {
-        double moved = f->offset[row];
+        double moved = framed ? 0 : f->offset[row];
         for (int col = 0; col < 3; col++) {
             double e = 0;
             for (int k = 0; k < 3; k++)
-                e += f->r[3 * row + k] * turn[3 * k + col];
+                e += r[3 * row + k] * turn[3 * k + col];
             m[4 * row + col] = six_digits(e);
-            moved += f->r[3 * row + col] * t[col];
+            moved += r[3 * row + col] * t[col];
         }
         m[4 * row + 3] = six_digits(moved);
     }
@@ -351,7 +354,8 @@ static void export_group_centre(const export_frame *f, int leaf, double t[3])
     t[2] = 0;
 }
 
-static void export_leaf(uint64_t *rng, const export_frame *f, int index, csg_leaf_spec *l)
+static void export_leaf(uint64_t *rng, const export_frame *f, bool framed, int index,
+                        csg_leaf_spec *l)
 {
     static const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     double turn[9], t[3] = {0, 0, 0}, centre[3], side = 100.0 / 3;
@@ -393,15 +397,30 @@ static void export_leaf(uint64_t *rng, const export_frame *f, int index, csg_lea
     export_group_centre(f, index, centre);
     for (int k = 0; k < 3; k++)
         t[k] += centre[k];
-    export_place(f, turn, t, l->m);
+    export_place(f, framed, turn, t, l->m);
+}
+
+/* The frame as one six-digit matrix, for the multmatrix written around the tree. */
+static void export_frame_matrix(const export_frame *f, double m[12])
+{
+    for (int row = 0; row < 3; row++) {
+        for (int col = 0; col < 3; col++)
+            m[4 * row + col] = six_digits(f->r[3 * row + col]);
+        m[4 * row + 3] = six_digits(f->offset[row]);
+    }
 }
 
 static void random_leaves(csg_tree_spec *t, uint64_t *rng)
 {
     int model_leaf = -1, tilt = test_random_int(rng, 0, 1);
     export_frame frame;
-    if (t->family == CSG_EXPORT)
+    if (t->family == CSG_EXPORT) {
         export_frame_init(rng, &frame);
+        /* a bit of the seed, not a draw: the other half's trees stay as they were */
+        t->framed = (t->seed >> 7) & 1;
+        if (t->framed)
+            export_frame_matrix(&frame, t->frame);
+    }
     if (t->family == CSG_FREE && models_loaded && test_random_int(rng, 0, 2) == 0)
         model_leaf = test_random_int(rng, 0, t->leaf_count - 1);
     for (int i = 0; i < t->leaf_count; i++) {
@@ -414,7 +433,7 @@ static void random_leaves(csg_tree_spec *t, uint64_t *rng)
         } else if (t->family == CSG_TILTED) {
             tilted_leaf(rng, l, tilt);
         } else if (t->family == CSG_EXPORT) {
-            export_leaf(rng, &frame, i, l);
+            export_leaf(rng, &frame, t->framed, i, l);
         } else if (i == model_leaf) {
             csg_free_leaf(rng, l);
             place_model(rng, l);
@@ -769,6 +788,20 @@ static void print_node(FILE *f, const csg_tree_spec *t, int node, int depth)
     fputs("}\n", f);
 }
 
+/* The tree, inside its frame's multmatrix when it has one. */
+static void print_tree(FILE *f, const csg_tree_spec *t)
+{
+    if (t->framed) {
+        const double *m = t->frame;
+        fprintf(f, "multmatrix([[%.17g, %.17g, %.17g, %.17g], [%.17g, %.17g, %.17g, %.17g], "
+                   "[%.17g, %.17g, %.17g, %.17g], [0, 0, 0, 1]]) {\n",
+                m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], m[9], m[10], m[11]);
+    }
+    print_node(f, t, t->root, t->framed ? 1 : 0);
+    if (t->framed)
+        fputs("}\n", f);
+}
+
 const char *const csg_family_names[CSG_FAMILIES] = {"free",   "grid",   "tilted",
                                                     "export", "shells", "folds"};
 
@@ -778,7 +811,7 @@ void csg_print_case(FILE *f, const csg_tree_spec *t, bool with_provenance)
             "%d leaves\n", t->seed, csg_family_names[t->family],
             touching_allowed(t) ? "yes" : "no", with_provenance ? "yes" : "no",
             csg_reachable_leaves(t));
-    print_node(f, t, t->root, 0);
+    print_tree(f, t);
 }
 
 bool csg_read_header(const char *text, uint64_t *seed, bool *touching, bool *with_provenance,
@@ -1431,12 +1464,34 @@ bool csg_check_tree(const mcsg_tree *tree, const mcsg_tree *claim, uint64_t seed
     return ok;
 }
 
+/* A framed tree as the CSG reader makes it from the tree's text. */
+static mcsg_status read_framed_tree(const csg_tree_spec *t, mcsg_tree **out, csg_result *r)
+{
+    char *text = NULL;
+    size_t size = 0;
+    mcsg_error err;
+    mcsg_status st = MCSG_ERR_NOMEM;
+    FILE *f = open_memstream(&text, &size);
+    if (f) {
+        print_tree(f, t);
+        fclose(f);
+        st = mcsg_scad_read_memory(text, size, "framed tree", NULL, NULL, out, &err);
+    }
+    free(text);
+    if (st != MCSG_OK)
+        fail(r, "reading the framed tree: %s", f ? err.message : "out of memory");
+    return st;
+}
+
 static mcsg_status build_tree(const csg_tree_spec *t, mcsg_tree **out, csg_result *r)
 {
     mcsg_node_id id[CSG_MAX_NODES];
     bool reach[CSG_MAX_NODES];
     mcsg_error err;
-    mcsg_status st = mcsg_tree_create(NULL, out, &err);
+    mcsg_status st;
+    if (t->framed)
+        return read_framed_tree(t, out, r);
+    st = mcsg_tree_create(NULL, out, &err);
     reachable(t, reach);
     for (int i = 0; i < t->node_count && st == MCSG_OK; i++) {
         const csg_node_spec *n = &t->nodes[i];

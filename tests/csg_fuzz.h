@@ -87,6 +87,12 @@ typedef struct csg_tree_spec {
     int leaf_count, node_count, root;
     csg_leaf_spec leaves[CSG_MAX_LEAVES];
     csg_node_spec nodes[CSG_MAX_NODES];
+    /* Export family, half of the seeds: the shared turn and offset as one multmatrix
+     * around the whole tree, as OpenSCAD's export nests it (the leaves' matrices are
+     * their own placements); the tree is then built by reading its CSG text, so that
+     * the turned group is evaluated in its own frame. */
+    bool framed;
+    double frame[12];
 } csg_tree_spec;
 
 typedef struct csg_result {

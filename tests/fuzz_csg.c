@@ -123,6 +123,7 @@ int main(int argc, char **argv)
     long trees = 0, failures = 0, leaves = 0, reported = 0;
     bool list_broken = getenv("MCSG_FUZZ_LIST_BROKEN") != NULL;
     long self_intersecting[CSG_FAMILIES] = {0}, families[CSG_FAMILIES] = {0};
+    long framed[2] = {0, 0}, framed_broken[2] = {0, 0}; /* export trees not framed, framed */
     if (!csg_load_models())
         fprintf(stderr, "fuzz_csg: models of tests/data/models missing (set MCSG_TEST_DATA to tests/data): "
                 "free trees use primitives only\n");
@@ -137,10 +138,12 @@ int main(int argc, char **argv)
         csg_random_tree(&t, seed);
         trees++;
         families[t.family]++;
+        framed[t.framed] += t.family == CSG_EXPORT;
         leaves += t.leaf_count;
         if (csg_run_case(&t, NULL, with_provenance, &r)) {
             self_intersecting[t.family] += r.self_intersecting;
             reported += r.rounding_reported;
+            framed_broken[t.framed] += t.family == CSG_EXPORT && r.rounding_reported;
             if (r.rounding_reported)
                 tally_broken(&broken, &r);
             if (r.rounding_reported && list_broken)
@@ -160,6 +163,9 @@ int main(int argc, char **argv)
     for (int k = 0; k < CSG_FAMILIES; k++)
         printf("%s%ld %s", k ? ", " : "", self_intersecting[k], csg_family_names[k]);
     printf("; %ld reported broken by rounding\n", reported);
+    printf("export trees: %ld with their turn written around the tree (a frame), %ld reported "
+           "broken; %ld with it in every leaf, %ld broken\n", framed[1], framed_broken[1],
+           framed[0], framed_broken[0]);
     print_broken(&broken);
     csg_free_models();
     return failures ? 1 : 0;
