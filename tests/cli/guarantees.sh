@@ -82,6 +82,15 @@ contains "edges of more than two triangles once vertices are welded by coordinat
 run 1 check "$WORK/m3.off"
 contains "non-manifold edges"
 
+# A turned group whose own evaluation, once turned, breaks a guarantee: the tree with each
+# leaf turned on its own is evaluated too and, clean, is the result.
+rm -f "$WORK/f5.off"
+run 0 eval "$ROUNDING/frame-worse-than-flattened-5-leaves.scad" -o "$WORK/f5.off" --stats
+lacks "warning"
+contains "which broke fewer"
+run 0 check "$WORK/f5.off"
+contains "1 component"
+
 printf 'union() { cube(1); translate([1, 1, 0]) cube(1); }\n' > "$WORK/touching.scad"
 run 0 eval "$WORK/touching.scad" -o "$WORK/touching.off" --check-crossings
 lacks "warning"
