@@ -11,7 +11,11 @@
 
 #include "base/sort.h"
 #include "csg/output_check.h"
+#include "csg/self_intersect.h"
+#include "csg/separate_copies.h"
+#include "csg/shell_crossing.h"
 #include "mesh/tree.h"
+#include "mesh/validate.h"
 
 #include <math.h>
 #include <string.h>
@@ -86,6 +90,8 @@ typedef struct frame_result {
     mcsg_mesh own;               /* the same in the frame's own coordinates */
     double margin;               /* how far apart in `own` its triangles may be and still
                                     meet once turned (mci_turn_margin), or -1 */
+    bool clean;                  /* proven not to cross itself once turned */
+    size_t mended;               /* corners moved to mend crossings the turn made */
     mcsg_provenance *provenance; /* per triangle: a leaf of the original tree and its face */
 } frame_result;
 
@@ -102,9 +108,10 @@ typedef struct frames {
     mcsg_node_id *stack;
     frame_result *results;
     size_t frame_count;
-    mcsg_eval_stats inner;   /* the frames' evaluations, summed where it makes sense */
+    double frame_seconds;    /* the frames' evaluations, turns and mending */
     held_log log;            /* what the frames' path logs */
     mcsg_options held;       /* f->opts with that log */
+    mci_ctx held_ctx;        /* the same as a context, for this file's own lines */
 } frames;
 
 static mcsg_status alloc_state(frames *f, mcsg_error *err)
@@ -194,10 +201,14 @@ static mcsg_status add_leaf_for(frames *f, mcsg_tree *sub, mcsg_node_id n, bool 
     if (st != MCSG_OK)
         return st;
     f->map[n] = id;
+    if (mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF && mesh->triangle_count)
+        mci_tree_set_made(sub, id);
     /* Turned and rounded, a frame's result may cross itself where two of its triangles
      * came within a unit in the last place of each other (a thin triangle folded over
-     * its neighbour): evaluated as a clean leaf, it could come out wrong */
-    if (mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF && mesh->triangle_count) {
+     * its neighbour), unless mend_turned proved it clean: evaluated as a clean leaf, it
+     * could come out wrong */
+    if (mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF && mesh->triangle_count &&
+        !f->results[f->slot[n]].clean) {
         const frame_result *r = &f->results[f->slot[n]];
         mci_tree_set_tests_crossing(sub, id);
         if (r->margin >= 0) /* boxes where the result lies along the axes, tight */
@@ -261,14 +272,6 @@ static void map_provenance(const frames *f, mcsg_provenance *p, size_t n)
     }
 }
 
-static void add_inner_stats(mcsg_eval_stats *sum, const mcsg_eval_stats *s)
-{
-    sum->primitives += s->primitives;
-    sum->faces += s->faces;
-    sum->seconds_total += s->seconds_total;
-    sum->rounding_reevaluations += s->rounding_reevaluations;
-}
-
 /* Whether the map's linear part has an inverse whose infinity norm is provably at most
  * *bound: X, the inverse by cofactors in doubles, bounds it by ||X|| / (1 - r) where r
  * bounds ||I - X M|| (computed, plus what rounding the products can hide), when r < 1/2.
@@ -330,13 +333,62 @@ double mci_turn_margin(const double m[12], const mcsg_mesh *own)
     return isfinite(error * inverse) ? 2 * error * inverse * (1 + 0x1p-40) : -1;
 }
 
+/* The turned result's crossing pairs (boxes before the turn where a margin is proven). */
+static mcsg_status turned_crossings(frames *f, const frame_result *r, const uint32_t *twin,
+                                    uint64_t **pairs, size_t *count, mcsg_error *err)
+{
+    mci_crossing_boxes boxes = {&r->own, r->margin};
+    return mci_list_shell_crossings(&f->ctx, &r->mesh, twin, r->margin >= 0 ? &boxes : NULL,
+                                    pairs, count, err);
+}
+
+/* The pairs that still cross, of those listed. */
+static size_t still_crossing(const mcsg_mesh *m, const uint64_t *pairs, size_t count)
+{
+    size_t left = 0;
+    for (size_t i = 0; i < count; i++)
+        left += mci_triangles_cross(m, (uint32_t)(pairs[i] >> 32), (uint32_t)pairs[i]);
+    return left;
+}
+
+/* Turning rounds every vertex on its own, which can fold a triangle thinner than a unit
+ * in the last place over its neighbour: the crossing pairs are listed and their corners
+ * moved by a unit in the last place where that mends them (as for the output's rounding,
+ * separate_copies.h). A corner moves only where its triangles cross nothing near them,
+ * so only the listed pairs can still cross; r->clean when none does (else the mesh is a
+ * leaf that crosses itself, evaluated by its winding number). */
+static mcsg_status mend_turned(frames *f, frame_result *r, mcsg_error *err)
+{
+    mcsg_check_report report;
+    uint64_t *pairs = NULL;
+    size_t count = 0;
+    uint32_t *twin = mci_malloc_array(&f->ctx, r->mesh.triangle_count + 1, 3 * sizeof *twin);
+    mcsg_status st = twin ? mci_mesh_check_shells(&f->ctx, &r->mesh, &report, NULL, twin, NULL,
+                                                  err)
+                          : mci_fail_nomem(err, "evaluating frames");
+    if (st == MCSG_OK)
+        st = turned_crossings(f, r, twin, &pairs, &count, err);
+    if (st == MCSG_OK && count > 0 &&
+        !mci_separate_crossing_corners(&f->ctx, &r->mesh, pairs, count, &r->mended))
+        st = mci_fail_nomem(err, "evaluating frames");
+    r->clean = st == MCSG_OK && (count == 0 || still_crossing(&r->mesh, pairs, count) == 0);
+    if (st == MCSG_OK && count > 0)
+        mci_log(&f->held_ctx, MCSG_LOG_INFO, "turning a group's result made %zu pairs of its "
+                "triangles cross; %zu corners moved by a unit in the last place %s", count,
+                r->mended, r->clean ? "mend them" : "do not mend them all: it is evaluated "
+                "as a mesh that crosses itself");
+    mci_free(&f->ctx, pairs);
+    mci_free(&f->ctx, twin);
+    return st;
+}
+
 /* Evaluate one frame and keep its result, turned into the enclosing frame. */
 static mcsg_status evaluate_frame(frames *f, mcsg_node_id node, mcsg_error *err)
 {
     frame_result *r = &f->results[f->slot[node]];
     const char *label = mcsg_tree_node_label(f->tree, node);
+    double t0 = mci_seconds_now();
     mcsg_tree *sub = NULL;
-    mcsg_eval_stats stats;
     mci_buf prefix = {0};
     mcsg_status st = build_tree(f, node, false, &sub, err);
     if (st == MCSG_OK && !mci_buf_printf(&f->ctx, &prefix, "%s, in its own coordinates: ",
@@ -344,19 +396,20 @@ static mcsg_status evaluate_frame(frames *f, mcsg_node_id node, mcsg_error *err)
         st = mci_fail_nomem(err, "evaluating frames");
     f->log.prefix = (const char *)prefix.data;
     if (st == MCSG_OK)
-        st = mcsg_eval(sub, &f->held, &r->mesh, &r->provenance, &stats, err);
+        st = mcsg_eval(sub, &f->held, &r->mesh, &r->provenance, NULL, err);
     f->log.prefix = NULL;
     mci_buf_free(&f->ctx, &prefix);
     if (st == MCSG_OK) {
-        add_inner_stats(&f->inner, &stats);
         map_provenance(f, r->provenance, r->mesh.triangle_count);
         st = mcsg_mesh_copy(&r->mesh, f->opts, &r->own, err);
     }
     if (st == MCSG_OK) {
         r->margin = mci_turn_margin(mci_tree_frame(f->tree, node), &r->own);
         mcsg_mesh_transform(&r->mesh, mci_tree_frame(f->tree, node));
+        st = mend_turned(f, r, err);
     }
     mcsg_tree_free(sub);
+    f->frame_seconds += mci_seconds_now() - t0;
     return st;
 }
 
@@ -392,8 +445,8 @@ static mcsg_status evaluate_all(frames *f, mcsg_mesh *out, mcsg_provenance **pro
     if (st == MCSG_OK) {
         map_provenance(f, own, out->triangle_count);
         stats->frames_evaluated = f->frame_count;
-        stats->seconds_frames = f->inner.seconds_total;
-        stats->seconds_total += f->inner.seconds_total;
+        stats->seconds_frames = f->frame_seconds;
+        stats->seconds_total += f->frame_seconds;
         if (provenance)
             *provenance = own;
         else
@@ -491,6 +544,7 @@ mcsg_status mci_eval_frames(const mcsg_tree *tree, const mcsg_options *opts, mcs
     mci_ctx_init(&f.ctx, opts);
     f.log.outer = &f.ctx;
     f.held = holding(opts, &f.log);
+    mci_ctx_init(&f.held_ctx, &f.held);
     stats = stats ? stats : &own_stats;
     st = alloc_state(&f, err);
     if (st == MCSG_OK)

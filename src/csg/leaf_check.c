@@ -108,7 +108,8 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
     t->leaf_face_of[k] = face_of;
     t->leaf_mesh[k] = copy;
     *removed = res.removed;
-    mci_log(job->ctx, MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
+    mci_log(job->ctx, mci_tree_is_made(job->tree, t->leaf_source[k]) ? MCSG_LOG_INFO
+            : MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
             "(they bound nothing), %zu triangle%s added by splitting neighbours at their "
             "corners to keep the surface closed", t->leaf_source[k],
             mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",

@@ -24,6 +24,7 @@
  * the grid over every triangle is most of the cost.
  */
 #include "csg/shell_crossing.h"
+#include "base/sort.h"
 #include "csg/self_intersect.h"
 #include "exact/kernel.h"
 #include "exact/predicates.h"
@@ -66,6 +67,10 @@ typedef struct test_state {
     uint8_t *pinch;        /* per segment: its end is a pinch (boundary_is_simple) */
     size_t seg_room;
     mci_shell_crossing_stats stats;
+    bool collect;          /* list every crossing pair, not only the first */
+    bool nomem;            /* the list could not grow */
+    uint64_t *found;       /* when collecting: the pairs, s << 32 | t with s < t */
+    size_t found_count, found_cap;
 } test_state;
 
 static const double *corner(const mcsg_mesh *m, uint32_t t, uint32_t k)
@@ -637,7 +642,25 @@ typedef struct buckets {
     uint32_t *start, *tri;
 } buckets;
 
-/* Tests the pairs of bucket b; true when a pair crosses. */
+/* Adds the pair to the list; false when out of memory (then the test stops). */
+static bool keep_pair(test_state *s, uint32_t t, uint32_t u)
+{
+    if (s->found_count == s->found_cap) {
+        size_t cap = s->found_cap ? 2 * s->found_cap : 64;
+        uint64_t *grown = mci_realloc_array(s->ctx, s->found, cap, sizeof *grown);
+        if (!grown) {
+            s->nomem = true;
+            return false;
+        }
+        s->found = grown;
+        s->found_cap = cap;
+    }
+    s->found[s->found_count++] = t < u ? (uint64_t)t << 32 | u : (uint64_t)u << 32 | t;
+    return true;
+}
+
+/* Tests the pairs of bucket b; true when a pair crosses (when collecting: only when the
+ * list could not grow; the pairs are in s->found). */
 static bool test_bucket(test_state *s, const grid *g, const double *box, const buckets *k,
                         uint32_t b, uint32_t example[2])
 {
@@ -658,10 +681,12 @@ static bool test_bucket(test_state *s, const grid *g, const double *box, const b
                 !pair_belongs_here(g, box + 6 * (size_t)t, box + 6 * (size_t)u, b, k->mask))
                 continue;
             s->stats.pairs_tested++;
-            if (!apart(s->m, t, u) && mci_triangles_cross(s->m, t, u)) {
+            if (apart(s->m, t, u) || !mci_triangles_cross(s->m, t, u))
+                continue;
+            if (example[0] == MCI_NONE)
                 example[0] = t, example[1] = u;
+            if (!s->collect || !keep_pair(s, t, u))
                 return true;
-            }
         }
     }
     return false;
@@ -745,6 +770,9 @@ static mcsg_status test_remaining_pairs(test_state *s, const mci_crossing_boxes 
         for (uint32_t b = 0; b <= k.mask && !*crosses; b++)
             if (k.start[b + 1] - k.start[b] > 1)
                 *crosses = test_bucket(s, &g, box, &k, b, example);
+        *crosses = *crosses || s->found_count > 0;
+        if (s->nomem)
+            st = mci_fail_nomem(err, "listing the pairs of triangles that cross");
     }
     mci_free(s->ctx, box);
     mci_free(s->ctx, bucket_of);
@@ -817,6 +845,35 @@ mcsg_status mci_find_shell_crossing(const mci_ctx *ctx, const mcsg_mesh *m,
                                          err);
 }
 
+static mcsg_status run_test(test_state *s, const mcsg_mesh *m, const uint32_t *shell,
+                            const uint32_t *twin, const mci_crossing_boxes *boxes,
+                            bool *crosses, uint32_t example[2],
+                            mci_shell_crossing_stats *stats, mcsg_error *err);
+
+mcsg_status mci_list_shell_crossings(const mci_ctx *ctx, const mcsg_mesh *m,
+                                     const uint32_t *twin, const mci_crossing_boxes *boxes,
+                                     uint64_t **pairs, size_t *count, mcsg_error *err)
+{
+    test_state s;
+    bool crosses;
+    uint32_t example[2];
+    mcsg_status st;
+    memset(&s, 0, sizeof s);
+    s.ctx = ctx;
+    s.collect = true;
+    st = run_test(&s, m, NULL, twin, boxes, &crosses, example, NULL, err);
+    *pairs = NULL;
+    *count = 0;
+    if (st == MCSG_OK && s.found_count) {
+        mci_sort_u64(s.found, s.found_count);
+        *pairs = s.found;
+        *count = s.found_count;
+        s.found = NULL;
+    }
+    mci_free(ctx, s.found);
+    return st;
+}
+
 mcsg_status mci_find_shell_crossing_boxed(const mci_ctx *ctx, const mcsg_mesh *m,
                                           const uint32_t *shell, const uint32_t *twin,
                                           const mci_crossing_boxes *boxes, bool *crosses,
@@ -824,31 +881,43 @@ mcsg_status mci_find_shell_crossing_boxed(const mci_ctx *ctx, const mcsg_mesh *m
                                           mci_shell_crossing_stats *stats, mcsg_error *err)
 {
     test_state s;
+    memset(&s, 0, sizeof s);
+    s.ctx = ctx;
+    return run_test(&s, m, shell, twin, boxes, crosses, example, stats, err);
+}
+
+/* The test on s (zeroed but for ctx and collect). */
+static mcsg_status run_test(test_state *s, const mcsg_mesh *m, const uint32_t *shell,
+                            const uint32_t *twin, const mci_crossing_boxes *boxes,
+                            bool *crosses, uint32_t example[2],
+                            mci_shell_crossing_stats *stats, mcsg_error *err)
+{
+    const mci_ctx *ctx = s->ctx;
     size_t n = m->triangle_count;
     mcsg_status st;
-    memset(&s, 0, sizeof s);
     *crosses = false;
     example[0] = example[1] = MCI_NONE;
     if (n == 0)
         return MCSG_OK;
     if (n > UINT32_MAX / 3)
         return mci_fail(err, MCSG_ERR_LIMIT, "mesh too large to test for self-intersections");
-    s.ctx = ctx, s.m = m, s.shell = shell, s.twin = twin;
-    s.facing = mci_malloc_array(ctx, n, 1);
-    s.patch = mci_malloc_array(ctx, n, sizeof *s.patch);
-    s.by_patch = mci_malloc_array(ctx, n, sizeof *s.by_patch);
-    s.patch_first = mci_malloc_array(ctx, n, sizeof *s.patch_first);
-    s.patch_size = mci_malloc_array(ctx, n, sizeof *s.patch_size);
-    s.proven = mci_malloc_array(ctx, n, 1);
-    s.seg_of = mci_malloc_array(ctx, n, 3 * sizeof *s.seg_of);
-    if (!s.facing || !s.patch || !s.by_patch || !s.patch_first || !s.patch_size || !s.proven || !s.seg_of)
+    s->m = m, s->shell = shell, s->twin = twin;
+    s->facing = mci_malloc_array(ctx, n, 1);
+    s->patch = mci_malloc_array(ctx, n, sizeof *s->patch);
+    s->by_patch = mci_malloc_array(ctx, n, sizeof *s->by_patch);
+    s->patch_first = mci_malloc_array(ctx, n, sizeof *s->patch_first);
+    s->patch_size = mci_malloc_array(ctx, n, sizeof *s->patch_size);
+    s->proven = mci_malloc_array(ctx, n, 1);
+    s->seg_of = mci_malloc_array(ctx, n, 3 * sizeof *s->seg_of);
+    if (!s->facing || !s->patch || !s->by_patch || !s->patch_first || !s->patch_size ||
+        !s->proven || !s->seg_of)
         st = mci_fail_nomem(err, "testing the leaves for self-intersections");
     else
-        st = prove_patches(&s, err);
+        st = prove_patches(s, err);
     if (st == MCSG_OK)
-        st = test_remaining_pairs(&s, boxes, crosses, example, err);
+        st = test_remaining_pairs(s, boxes, crosses, example, err);
     if (stats)
-        *stats = s.stats;
-    free_state(&s);
+        *stats = s->stats;
+    free_state(s);
     return st;
 }

@@ -46,4 +46,11 @@ mcsg_status mci_find_shell_crossing_boxed(const mci_ctx *ctx, const mcsg_mesh *m
                                           uint32_t example[2],
                                           mci_shell_crossing_stats *stats, mcsg_error *err);
 
+/* Every pair of m's triangles that cross (rules as above; one shell or several, all
+ * tested), with the boxes of `boxes` (NULL: m's own): *pairs (s << 32 | t, s < t,
+ * sorted; allocated with ctx, NULL when none), *count of them. */
+mcsg_status mci_list_shell_crossings(const mci_ctx *ctx, const mcsg_mesh *m,
+                                     const uint32_t *twin, const mci_crossing_boxes *boxes,
+                                     uint64_t **pairs, size_t *count, mcsg_error *err);
+
 #endif

@@ -19,6 +19,7 @@ typedef struct tree_node {
     uint8_t kind;        /* mcsg_node_kind */
     uint8_t has_parent;
     uint8_t tests_crossing; /* leaves: always tested for crossing themselves */
+    uint8_t made;           /* leaves: made by the library (tree.h) */
     const mcsg_mesh *box_mesh; /* leaves: borrowed, for that test's boxes (tree.h) */
     double box_margin;
 } tree_node;
@@ -415,6 +416,14 @@ const mcsg_mesh *mci_tree_crossing_boxes(const mcsg_tree *tree, mcsg_node_id lea
     const tree_node *n = find_node(tree, leaf);
     *margin = n ? n->box_margin : 0;
     return n ? n->box_mesh : NULL;
+}
+
+void mci_tree_set_made(mcsg_tree *tree, mcsg_node_id leaf) { tree->nodes[leaf].made = 1; }
+
+bool mci_tree_is_made(const mcsg_tree *tree, mcsg_node_id leaf)
+{
+    const tree_node *n = find_node(tree, leaf);
+    return n && n->made;
 }
 
 bool mci_tree_tests_crossing(const mcsg_tree *tree, mcsg_node_id leaf)

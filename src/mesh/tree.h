@@ -53,6 +53,11 @@ void mci_tree_set_crossing_boxes(mcsg_tree *tree, mcsg_node_id leaf, const mcsg_
 const mcsg_mesh *mci_tree_crossing_boxes(const mcsg_tree *tree, mcsg_node_id leaf,
                                          double *margin);
 
+/* A leaf the library made (a frame's turned result): what rounding left in it, such as
+ * triangles of zero area, is logged as information, not as a warning about the input. */
+void mci_tree_set_made(mcsg_tree *tree, mcsg_node_id leaf);
+bool mci_tree_is_made(const mcsg_tree *tree, mcsg_node_id leaf);
+
 /* The resolved options the tree was created with. */
 const mci_ctx *mci_tree_ctx(const mcsg_tree *tree);
 

@@ -1,6 +1,6 @@
 // Shrunk by removing leaves from fuzz seed 0x933f38573a86f08f (export family, its turn
-// written around the tree): the turned group's own evaluation breaks a guarantee once
-// turned; the tree with every leaf turned on its own does not.
+// written around the tree): turning the group's result makes 12 pairs of its triangles
+// cross; moving 2 corners by a unit in the last place mends them.
 multmatrix([[0.25881900000000002, 0.96592599999999995, 0, 1000], [-5.9145899999999996e-17, 1.5848100000000001e-17, -1, -2000], [-0.96592599999999995, 0.25881900000000002, 6.1232300000000004e-17, 500], [0, 0, 0, 1]]) {
   union() {
     union() {
