@@ -9,6 +9,7 @@
  */
 #include "testlib.h"
 
+#include "csg/frames.h"
 #include "mesh/tree.h"
 
 #include <math.h>
@@ -269,6 +270,28 @@ TEST(frames_keep_coplanar_faces_coplanar)
     free_outcome(&o);
 }
 
+/* The margin of a turn: 2 (error bound of each rounded coordinate) times the norm of the
+ * inverse; none for a map that flattens space. */
+TEST(turn_margins)
+{
+    double unit[3] = {1, -1, 1};
+    uint32_t tri[3] = {0, 0, 0};
+    mcsg_mesh point = {unit, tri, 1, 1};
+    const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    const double half[12] = {0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0};
+    const double flat[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0};
+    const double turn[12] = {0.866025, -0.5, 0, 100, 0.5, 0.866025, 0, 0, 0, 0, 1, 0};
+    double m = mci_turn_margin(identity, &point);
+    CHECK(m >= 2 * 0x1p-51 && m <= 2 * 0x1p-50 * 1.01);
+    /* halving: errors of half the size, an inverse twice as large */
+    CHECK(fabs(mci_turn_margin(half, &point) - m) <= 1e-3 * m);
+    CHECK(mci_turn_margin(flat, &point) == -1);
+    /* the move of 100 dominates the error of the first row (about 100 ulps of 1), and
+     * the inverse's norm is cos 30 + sin 30 = 1.366 */
+    m = mci_turn_margin(turn, &point);
+    CHECK_MSG(m > 1.36 * 100 * 2 * 0x1p-51 && m < 1.37 * 102 * 2 * 0x1p-50, "margin %g", m);
+}
+
 /* A leaf that breaks the input contract inside a frame is named as anywhere else. */
 TEST(frames_report_bad_leaves)
 {
@@ -322,6 +345,7 @@ int main(void)
     RUN(frames_marked_by_the_reader);
     RUN(frames_evaluate_turned_groups);
     RUN(frames_keep_coplanar_faces_coplanar);
+    RUN(turn_margins);
     RUN(frames_report_bad_leaves);
     RUN(frames_survive_allocation_failures);
     return test_summary();

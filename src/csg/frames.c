@@ -125,8 +125,8 @@ static mcsg_status alloc_state(frames *f, mcsg_error *err)
     f->order = mci_malloc_array(&f->ctx, n, sizeof *f->order);
     f->stack = mci_malloc_array(&f->ctx, n, sizeof *f->stack);
     f->results = mci_calloc_array(&f->ctx, mci_tree_frame_count(f->tree), sizeof *f->results);
-    if (!f->slot || !f->map || !f->source || !f->source_frame || !f->list || !f->order || !f->stack ||
-        !f->results)
+    if (!f->slot || !f->map || !f->source || !f->source_frame || !f->list || !f->order ||
+        !f->stack || !f->results)
         return mci_fail_nomem(err, "evaluating frames");
     return MCSG_OK;
 }
@@ -287,12 +287,13 @@ static bool inverse_norm_bound(const double m[12], double *bound)
     det = a[0][0] * x[0][0] + a[0][1] * x[1][0] + a[0][2] * x[2][0];
     if (!(fabs(det) > 0x1p-500) || !isfinite(det))
         return false;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            x[i][j] /= det;
     for (int i = 0; i < 3; i++) {
         double row_x = 0, row_m = 0, row_r = 0;
         for (int j = 0; j < 3; j++) {
-            double xm = x[i][0] / det * a[0][j] + x[i][1] / det * a[1][j] +
-                        x[i][2] / det * a[2][j];
-            x[i][j] /= det;
+            double xm = x[i][0] * a[0][j] + x[i][1] * a[1][j] + x[i][2] * a[2][j];
             row_x += fabs(x[i][j]);
             row_m += fabs(a[i][j]);
             row_r += fabs((i == j ? 1.0 : 0.0) - xm);
