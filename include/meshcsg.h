@@ -433,7 +433,10 @@ const mcsg_mesh *mcsg_tree_leaf_mesh(const mcsg_tree *tree, mcsg_node_id node);
  * import errors with the mesh reader's status. Warnings (e.g. unknown arguments, which
  * OpenSCAD ignores) go to the log. The empty set (an empty group, cube(0), ...) is a
  * union node without children. Leaves and operations carry labels such as
- * "sphere(r=5, $fn=32) at part.scad:3:5". */
+ * "sphere(r=5, $fn=32) at part.scad:3:5". Every leaf's mesh is transformed by all the
+ * transforms above it; a transform that turns space (a row of its matrix with two
+ * non-zero entries) over two or more leaves also marks its group as a frame, which
+ * mcsg_eval evaluates in the group's own coordinates (docs/csg-language.md). */
 mcsg_status mcsg_scad_read(const char *path, const mcsg_options *opts, mcsg_tree **out,
                            mcsg_error *err);
 
@@ -619,6 +622,9 @@ typedef struct mcsg_eval_stats {
  * rounding_reevaluations, rounding_snap_grid). When none does, the first
  * result is still returned with MCSG_OK, the failure is logged as a warning, and
  * mcsg_output_check_failed tells it.
+ * A tree read from CSG text can hold frames: a group under a transform that turns space
+ * is evaluated first in its own coordinates and its result turned as one mesh (see
+ * mcsg_scad_read and docs/robustness.md; stats->frames_evaluated).
  * *out receives the mesh (release with mcsg_mesh_free); if `provenance` is non-NULL it
  * receives one entry per output triangle (release with mcsg_free); stats may be NULL. */
 mcsg_status mcsg_eval(const mcsg_tree *tree, const mcsg_options *opts, mcsg_mesh *out,
