@@ -77,7 +77,6 @@
 #include "base/parallel.h"
 #include "csg/classify.h"
 #include "csg/frames.h"
-#include "mesh/tree.h"
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
 #include "csg/output_check.h"
@@ -86,6 +85,7 @@
 #include "csg/separate_copies.h"
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
+#include "mesh/tree.h"
 #include <stdlib.h>
 #include <string.h>
 

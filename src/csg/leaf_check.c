@@ -19,10 +19,9 @@
  * evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
-
-#include "mesh/tree.h"
 #include "base/parallel.h"
 #include "csg/shell_crossing.h"
+#include "mesh/tree.h"
 #include "mesh/validate.h"
 #include "mesh/zero_area.h"
 

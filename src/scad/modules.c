@@ -349,8 +349,6 @@ static mcsg_status at_call(const scad_context *sc, const call_args *ca, mcsg_sta
                         ca->module, message);
 }
 
-/* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
- * an empty mesh or a flattening transform gives the empty set instead. */
 /* The leaf's mesh in the coordinates of its innermost frame (mesh/tree.h), made from the
  * untransformed mesh when a frame is open; else left empty. */
 static mcsg_status frame_local_mesh(const mci_ctx *ctx, const scad_transform *t,
@@ -382,6 +380,8 @@ static mcsg_status add_framed_leaf(scad_context *sc, const call_args *ca, mcsg_m
     return at_call(sc, ca, st, err);
 }
 
+/* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
+ * an empty mesh or a flattening transform gives the empty set instead. */
 static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_transform *t,
                             mcsg_mesh *mesh, mci_buf *label, mcsg_node_id *node,
                             mcsg_error *err)
