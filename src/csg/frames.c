@@ -177,22 +177,21 @@ static size_t collect(frames *f, mcsg_node_id top, bool whole)
 static mcsg_status add_leaf_for(frames *f, mcsg_tree *sub, mcsg_node_id n, bool in_frame,
                                 mcsg_error *err)
 {
+    bool stand_in = mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF;
+    const frame_result *r = stand_in ? &f->results[f->slot[n]] : NULL;
+    const mcsg_mesh *local = stand_in ? NULL : mci_tree_leaf_local(f->tree, n);
+    const mcsg_mesh *mesh = stand_in ? &r->mesh
+                            : (in_frame && local) ? local : mcsg_tree_leaf_mesh(f->tree, n);
     const char *label = mcsg_tree_node_label(f->tree, n);
-    const mcsg_mesh *mesh;
     mci_buf result_label = {0};
     mcsg_node_id id;
     mcsg_status st;
-    if (mcsg_tree_node_kind(f->tree, n) == MCSG_NODE_LEAF) {
-        const mcsg_mesh *local = mci_tree_leaf_local(f->tree, n);
-        mesh = (in_frame && local) ? local : mcsg_tree_leaf_mesh(f->tree, n);
-    } else {
-        mesh = &f->results[f->slot[n]].mesh;
-        /* messages about this leaf must not pass it off as the user's own */
-        if (!mci_buf_printf(&f->ctx, &result_label, "the turned result of %s", label[0] ? label
-                            : "a group"))
-            return mci_fail_nomem(err, "evaluating frames");
+    /* messages about a stand-in must not pass it off as the user's own leaf */
+    if (stand_in && !mci_buf_printf(&f->ctx, &result_label, "the turned result of %s",
+                                    label[0] ? label : "a group"))
+        return mci_fail_nomem(err, "evaluating frames");
+    if (stand_in)
         label = (const char *)result_label.data;
-    }
     if (mesh->triangle_count == 0)
         st = mcsg_tree_add_op(sub, MCSG_NODE_UNION, NULL, 0, label, &id, err);
     else
@@ -201,21 +200,20 @@ static mcsg_status add_leaf_for(frames *f, mcsg_tree *sub, mcsg_node_id n, bool 
     if (st != MCSG_OK)
         return st;
     f->map[n] = id;
-    if (mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF && mesh->triangle_count)
-        mci_tree_set_made(sub, id);
+    f->source[id] = stand_in ? MCSG_NO_NODE : n;
+    f->source_frame[id] = stand_in ? f->slot[n] : 0;
+    if (!stand_in || mesh->triangle_count == 0)
+        return MCSG_OK;
+    mci_tree_set_made(sub, id);
     /* Turned and rounded, a frame's result may cross itself where two of its triangles
      * came within a unit in the last place of each other (a thin triangle folded over
      * its neighbour), unless mend_turned proved it clean: evaluated as a clean leaf, it
      * could come out wrong */
-    if (mcsg_tree_node_kind(f->tree, n) != MCSG_NODE_LEAF && mesh->triangle_count &&
-        !f->results[f->slot[n]].clean) {
-        const frame_result *r = &f->results[f->slot[n]];
+    if (!r->clean) {
         mci_tree_set_tests_crossing(sub, id);
         if (r->margin >= 0) /* boxes where the result lies along the axes, tight */
             mci_tree_set_crossing_boxes(sub, id, &r->own, r->margin);
     }
-    f->source[id] = mcsg_tree_node_kind(f->tree, n) == MCSG_NODE_LEAF ? n : MCSG_NO_NODE;
-    f->source_frame[id] = f->source[id] == MCSG_NO_NODE ? f->slot[n] : 0;
     return MCSG_OK;
 }
 
