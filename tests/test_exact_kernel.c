@@ -1197,6 +1197,67 @@ TEST(lpi_equal_by_projection)
     CHECK(cases > 10000 && equal > cases / 2); /* the rule's shapes were there */
 }
 
+/* A random vertex on a coarse grid (so that midpoints and sums are exact). */
+static void grid_vertex(double v[3])
+{
+    for (int k = 0; k < 3; k++)
+        v[k] = rng_int(-32, 32) / 4.0;
+}
+
+/* mci_compare_coord and mci_compare_lex of a and b against the exact stage; true when
+ * the points are equal. */
+static bool check_against_exact(const mci_point *a, const mci_point *b, int i)
+{
+    int lex = 0;
+    for (int axis = 0; axis < 3; axis++) {
+        int got = mci_compare_coord(a, b, axis), ref = mci_compare_coord_exact(a, b, axis);
+        CHECK_MSG(got == ref, "case %d axis %d: %d, exact %d", i, axis, got, ref);
+        if (lex == 0)
+            lex = ref;
+    }
+    CHECK_MSG(mci_compare_lex(a, b) == lex, "case %d: lex %d, exact %d", i,
+              mci_compare_lex(a, b), lex);
+    return lex == 0;
+}
+
+/* Two triangles whose edges PQ and RS cross at their midpoint X: the LPI of PQ with RS's
+ * plane and the LPI of RS with PQ's plane are both X (mci_compare_coord's rule of
+ * crossing lines), and the LPIs of one line with two triangles of one plane (the
+ * rule of the same line and plane). After one end is moved by one ulp (the lines no
+ * longer meet, or the planes differ) the rules must not apply: every answer is checked
+ * against the exact stage. */
+TEST(lpi_equal_by_lines)
+{
+    long cases = 0, equal = 0;
+    for (int i = 0; i < 20000; i++) {
+        double x[3], d1[3], d2[3], p[3], q[3], r[3], s[3], ca[3], cb[3], cb2[3];
+        int moved = rng_int(0, 2), same_line = rng_int(0, 1);
+        mci_plane plane_a, plane_b, plane_b2;
+        mci_point a, b;
+        grid_vertex(x), grid_vertex(d1), grid_vertex(d2), grid_vertex(ca), grid_vertex(cb);
+        for (int k = 0; k < 3; k++) {
+            p[k] = x[k] - d1[k], q[k] = x[k] + d1[k];
+            r[k] = x[k] - d2[k], s[k] = x[k] + d2[k];
+            cb2[k] = r[k] + s[k] - cb[k]; /* R S CB CB2: a parallelogram, one plane */
+        }
+        if (moved == 1)
+            q[rng_int(0, 2)] = mci_next_up(q[rng_int(0, 2)]);
+        else if (moved == 2)
+            cb2[rng_int(0, 2)] = mci_next_down(cb2[rng_int(0, 2)]);
+        mci_plane_init(&plane_a, p, q, ca);
+        mci_plane_init(&plane_b, r, s, cb);
+        mci_plane_init(&plane_b2, s, cb2, r);
+        if (!mci_point_lpi(&a, p, q, &plane_b))
+            continue;
+        if (same_line ? !mci_point_lpi(&b, q, p, &plane_b2) : !mci_point_lpi(&b, r, s, &plane_a))
+            continue;
+        equal += check_against_exact(&a, &b, i);
+        cases++;
+    }
+    printf("lpi equal by lines: %ld pairs, %ld equal\n", cases, equal);
+    CHECK(cases > 10000 && equal > cases / 3); /* the rules' shapes were there */
+}
+
 int main(void)
 {
     const char *seed = getenv("MCSG_TEST_SEED");
@@ -1208,6 +1269,7 @@ int main(void)
     RUN(bit_range);
     RUN(vertex_orient3d_shapes);
     RUN(lpi_equal_by_projection);
+    RUN(lpi_equal_by_lines);
     RUN(reference_sanity);
     RUN(kernel_adversarial);
     RUN(kernel_near_parallel);

@@ -962,10 +962,18 @@ int mci_orient3d_vertices(const double *a, const double *b, const double *c, con
 {
     int s = mci_orient3d_vertices_filtered(a, b, c, d);
     mci_plane plane;
+    mci_point p;
+    if (s != MCI_UNCERTAIN)
+        return s;
+    /* orient3d_vertex_beyond_filter's stages, the plane built only for the last */
+    if (coplanar_by_coordinates(a, b, c, d))
+        return 0;
+    s = mci_orient3d_vertices_dd(a, b, c, d);
     if (s != MCI_UNCERTAIN)
         return s;
     mci_plane_init(&plane, a, b, c);
-    return orient3d_vertex_beyond_filter(d, &plane);
+    mci_point_explicit(&p, d);
+    return mci_orient3d_exact(&p, &plane);
 }
 
 /* For a and b in one plane with the axis u -> v: whether they are on the same side of
@@ -1266,9 +1274,40 @@ static bool equal_by_projection(const mci_point *a, const mci_point *b, int axis
     return false;
 }
 
-/* The box test first: it decides most comparisons of distinct points and never returns 0
- * (its error bound is positive), so the definitional equalities may follow it. */
-int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
+/* Whether input vertex x lies on the plane through v[0..2] (three vertices that span
+ * one: they define a point that exists). */
+static bool on_plane_of(const double *const v[3], const double *x)
+{
+    return same_coordinates(x, v[0]) || same_coordinates(x, v[1]) ||
+           same_coordinates(x, v[2]) || mci_orient3d_vertices(v[0], v[1], v[2], x) == 0;
+}
+
+/* Whether LPIs a and b are one point by their definitions, decided on input vertices
+ * (exact predicates far cheaper than comparing the points' coordinates exactly):
+ * - the same line and the same plane;
+ * - crossing lines: a's line lies in b's plane, b's in a's, and the two lines are
+ *   coplanar. They cannot be parallel (b's line lies in a's plane, which a's line
+ *   crosses), so they meet, and their common point is on both lines and both planes:
+ *   it is a and it is b.
+ * Where two triangles' edges meet exactly (boxes, grids, symmetric models), the point
+ * is reached both ways, and such pairs were most of the exact comparisons of a Menger
+ * sponge. False says nothing. */
+static bool equal_by_lines(const mci_point *a, const mci_point *b)
+{
+    const double *const *pa = a->v + 2, *const *pb = b->v + 2;
+    if (a->kind != MCI_POINT_LPI || b->kind != MCI_POINT_LPI)
+        return false;
+    if ((same_coordinates(a->v[0], b->v[0]) && same_coordinates(a->v[1], b->v[1])) ||
+        (same_coordinates(a->v[0], b->v[1]) && same_coordinates(a->v[1], b->v[0])))
+        return on_plane_of(pa, pb[0]) && on_plane_of(pa, pb[1]) && on_plane_of(pa, pb[2]);
+    return on_plane_of(pb, a->v[0]) && on_plane_of(pb, a->v[1]) &&
+           on_plane_of(pa, b->v[0]) && on_plane_of(pa, b->v[1]) &&
+           mci_orient3d_vertices(a->v[0], a->v[1], b->v[0], b->v[1]) == 0;
+}
+
+/* mci_compare_coord; *same set when a and b are proven one point (every coordinate
+ * then compares equal). */
+static int compare_coord(const mci_point *a, const mci_point *b, int axis, bool *same)
 {
     int s;
     if ((a->exact_axes & b->exact_axes) >> axis & 1)
@@ -1276,18 +1315,37 @@ int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
     s = fv_sign(fv_sub((mci_fv){a->c[axis], a->r}, (mci_fv){b->c[axis], b->r}));
     if (s != MCI_UNCERTAIN)
         return s;
-    if (mci_points_same_definition(a, b) || equal_by_projection(a, b, axis))
+    if (mci_points_same_definition(a, b)) {
+        *same = true;
+        return 0;
+    }
+    if (equal_by_projection(a, b, axis))
         return 0;
     s = mci_compare_coord_filtered(a, b, axis);
-    return s != MCI_UNCERTAIN ? s : mci_compare_coord_exact(a, b, axis);
+    if (s != MCI_UNCERTAIN)
+        return s;
+    if (equal_by_lines(a, b)) {
+        *same = true;
+        return 0;
+    }
+    return mci_compare_coord_exact(a, b, axis);
+}
+
+/* The box test first: it decides most comparisons of distinct points and never returns 0
+ * (its error bound is positive), so the definitional equalities may follow it. */
+int mci_compare_coord(const mci_point *a, const mci_point *b, int axis)
+{
+    bool same = false;
+    return compare_coord(a, b, axis, &same);
 }
 
 int mci_compare_lex(const mci_point *a, const mci_point *b)
 {
+    bool same = false;
     if (a == b)
         return 0;
-    for (int axis = 0; axis < 3; axis++) {
-        int s = mci_compare_coord(a, b, axis);
+    for (int axis = 0; axis < 3 && !same; axis++) {
+        int s = compare_coord(a, b, axis, &same);
         if (s != 0)
             return s;
     }
