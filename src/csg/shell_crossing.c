@@ -78,6 +78,8 @@ typedef struct test_state {
     uint64_t *found;       /* when collecting: the pairs, s << 32 | t with s < t */
     mci_keyed *sweep;      /* a bucket's triangles, sorted along the sweep axis */
     swept *swept;          /* the same with their extents along it */
+    mci_plane *planes;     /* per triangle, when plane_ready */
+    uint8_t *plane_ready;
     size_t found_count, found_cap;
 } test_state;
 
@@ -617,18 +619,29 @@ static bool needs_test(const test_state *s, uint32_t t, uint32_t u)
     return s->patch[t] != s->patch[u] || !s->proven[s->patch[t]];
 }
 
+/* Triangle t's plane, built on first use (the pair tests ask it again and again). */
+static const mci_plane *plane_of(test_state *s, uint32_t t)
+{
+    if (!s->plane_ready[t]) {
+        mci_plane_init(&s->planes[t], corner(s->m, t, 0), corner(s->m, t, 1),
+                       corner(s->m, t, 2));
+        s->plane_ready[t] = 1;
+    }
+    return &s->planes[t];
+}
+
 /* Whether the corners of triangle u other than those it shares with t lie strictly on
  * one side of t's plane: then the two meet at most in their common corners. */
-static bool off_plane(const mcsg_mesh *m, uint32_t t, uint32_t u)
+static bool off_plane(test_state *s, uint32_t t, uint32_t u)
 {
-    const double *a = corner(m, t, 0), *b = corner(m, t, 1), *c = corner(m, t, 2);
+    const mci_plane *plane = plane_of(s, t);
     int side = 0;
     for (uint32_t i = 0; i < 3; i++) {
-        const double *x = corner(m, u, i);
+        const double *x = corner(s->m, u, i);
         int o;
-        if (same3(x, a) || same3(x, b) || same3(x, c))
+        if (same3(x, plane->a) || same3(x, plane->b) || same3(x, plane->c))
             continue;
-        o = mci_orient3d_vertices(a, b, c, x);
+        o = mci_orient3d_vertex(x, plane);
         if (o == 0 || (side != 0 && o != side))
             return false;
         side = o;
@@ -638,9 +651,9 @@ static bool off_plane(const mcsg_mesh *m, uint32_t t, uint32_t u)
 
 /* A quick proof that triangles t and u do not cross (most pairs of neighbours in
  * different patches); false when it does not apply. */
-static bool apart(const mcsg_mesh *m, uint32_t t, uint32_t u)
+static bool apart(test_state *s, uint32_t t, uint32_t u)
 {
-    return off_plane(m, t, u) || off_plane(m, u, t);
+    return off_plane(s, t, u) || off_plane(s, u, t);
 }
 
 /* The grid's (cell, triangle) entries, bucketed by cell hash (several cells may share a
@@ -726,7 +739,7 @@ static bool test_pair(test_state *s, const grid *g, const double *box, const buc
         (!s->collect && key > *first))
         return false;
     s->stats.pairs_tested++;
-    if (apart(s->m, t, u) || !mci_triangles_cross(s->m, t, u))
+    if (apart(s, t, u) || !mci_triangles_cross(s->m, t, u))
         return false;
     if (key < *first)
         *first = key;
@@ -851,8 +864,11 @@ static mcsg_status test_remaining_pairs(test_state *s, const mci_crossing_boxes 
         size_t largest = largest_bucket(&k) + 1;
         s->sweep = mci_malloc_array(s->ctx, largest, sizeof *s->sweep);
         s->swept = mci_malloc_array(s->ctx, largest, sizeof *s->swept);
+        s->planes = mci_malloc_array(s->ctx, n, sizeof *s->planes);
+        s->plane_ready = mci_calloc_array(s->ctx, n, 1);
     }
-    if (!box || !bucket_of || !k.tri || !k.start || !s->sweep || !s->swept) {
+    if (!box || !bucket_of || !k.tri || !k.start || !s->sweep || !s->swept || !s->planes ||
+        !s->plane_ready) {
         st = mci_fail_nomem(err, "testing the leaves for self-intersections");
     } else {
         s->stats.grid_entries = count;
@@ -886,6 +902,8 @@ static void free_state(test_state *s)
     mci_free(s->ctx, s->pinch);
     mci_free(s->ctx, s->sweep);
     mci_free(s->ctx, s->swept);
+    mci_free(s->ctx, s->planes);
+    mci_free(s->ctx, s->plane_ready);
 }
 
 enum { SPLIT_MIN = 32 };
