@@ -581,10 +581,10 @@ typedef struct mcsg_eval_stats {
                                    docs/robustness.md) */
     double seconds_frames;      /* those evaluations (in seconds_total; the other fields
                                    describe the last evaluation, the root's) */
-    int frames_flattened;       /* 1 when the frames' result broke a guarantee (or their
-                                   evaluation failed) and the tree evaluated with each
-                                   leaf turned on its own, which broke fewer, was
-                                   returned instead (the fields above are its) */
+    int frames_flattened;       /* 1 when the tree evaluated with each leaf turned on
+                                   its own was returned instead: the frames' evaluation
+                                   failed, or its result broke more guarantees (the
+                                   fields above are the returned evaluation's) */
     double seconds_total;
 } mcsg_eval_stats;
 

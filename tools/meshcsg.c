@@ -580,8 +580,8 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
                "with their results as leaves)\n", s->seconds_frames, s->frames_evaluated);
     else if (s->frames_evaluated)
         printf("  frames           %8.3f s  (%zu groups under a turning transform evaluated "
-               "in their own coordinates first broke a guarantee; the lines below are the "
-               "evaluation of the tree with each leaf turned on its own, which broke fewer)\n",
+               "in their own coordinates first, which failed or broke more guarantees; the lines "
+               "below are the evaluation of the tree with each leaf turned on its own)\n",
                s->seconds_frames, s->frames_evaluated);
     printf("  positive tree    %8.3f s\n", s->seconds_tree);
     printf("  input check      %8.3f s\n", s->seconds_check);

@@ -525,6 +525,8 @@ static mcsg_status flattened_after_error(frames *f, mcsg_mesh *out,
     if (st == MCSG_OK) {
         stats->frames_evaluated = count;
         stats->frames_flattened = 1;
+        stats->seconds_frames = f->frame_seconds;
+        stats->seconds_total += f->frame_seconds;
     }
     return st;
 }

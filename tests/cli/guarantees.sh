@@ -91,6 +91,18 @@ contains "turning a group's result made 12 pairs of its triangles cross; 2 corne
 run 0 check --self-intersections "$WORK/f5.off"
 contains "ok: no self-intersections"
 
+# A turned group whose turned result folds two slivers onto each other: evaluated as a
+# leaf that crosses itself it is refused, so the tree is evaluated again with each leaf
+# turned on its own, and that result is clean (a fuzz tree of 70 leaves, shrunk).
+rm -f "$WORK/fb.off"
+run 0 eval "$ROUNDING/frame-fails-flattened-3-leaves.scad" -o "$WORK/fb.off" -v --stats
+lacks "warning"
+contains "turned groups evaluated in their own coordinates failed"
+contains "the lines below are the evaluation of the tree with each leaf turned on its own"
+run 0 check --self-intersections "$WORK/fb.off"
+contains "ok: 54 vertices, 104 triangles, 1 component, volume 92942.942591863626"
+contains "ok: no self-intersections"
+
 printf 'union() { cube(1); translate([1, 1, 0]) cube(1); }\n' > "$WORK/touching.scad"
 run 0 eval "$WORK/touching.scad" -o "$WORK/touching.off" --check-crossings
 lacks "warning"
