@@ -164,10 +164,48 @@ static void join(mcsg_mesh *a, const mcsg_mesh *b)
     free(t);
 }
 
+/* Every crossing pair, by testing every pair whose boxes meet (shells not told apart). */
+static size_t oracle_pairs(const mcsg_mesh *m)
+{
+    size_t n = m->triangle_count, pairs = 0;
+    double *box = malloc((6 * n + 1) * sizeof *box);
+    for (size_t t = 0; t < n; t++)
+        box_of(m, t, box + 6 * t);
+    for (size_t t = 0; t < n; t++)
+        for (size_t u = t + 1; u < n; u++) {
+            bool meet = true;
+            for (int k = 0; k < 3 && meet; k++)
+                meet = box[6 * t + k] <= box[6 * u + k + 3] && box[6 * u + k] <= box[6 * t + k + 3];
+            pairs += meet && mci_triangles_cross(m, (uint32_t)t, (uint32_t)u);
+        }
+    free(box);
+    return pairs;
+}
+
+/* The pairs mci_list_shell_crossings lists (every shell against every other too). */
+static size_t listed_pairs(const mcsg_mesh *m)
+{
+    mci_ctx ctx;
+    mcsg_check_report report;
+    mcsg_error err;
+    uint64_t *pairs = NULL;
+    size_t count = 0;
+    uint32_t *twin = malloc((3 * m->triangle_count + 1) * sizeof *twin);
+    mci_ctx_init(&ctx, NULL);
+    CHECK_OK(mci_mesh_check_shells(&ctx, m, &report, NULL, twin, NULL, &err), &err);
+    CHECK_OK(mci_list_shell_crossings(&ctx, m, twin, NULL, &pairs, &count, &err), &err);
+    for (size_t i = 0; i < count; i++)
+        CHECK(mci_triangles_cross(m, (uint32_t)(pairs[i] >> 32), (uint32_t)pairs[i]));
+    free(pairs);
+    free(twin);
+    return count;
+}
+
 TEST(agrees_with_every_pair_on_random_meshes)
 {
     uint64_t rng = 0x5eed5ca1ab1e;
     size_t crossing = 0, apart = 0, proven = 0, triangles_apart = 0, shells = 0;
+    size_t listed_crossing = 0;
     for (int trial = 0; trial < 400; trial++) {
         mcsg_mesh m, other;
         answer a;
@@ -190,6 +228,12 @@ TEST(agrees_with_every_pair_on_random_meshes)
         truth = oracle_crosses(&m);
         CHECK_MSG(a.crosses == truth, "trial %d (kind %d, %zu triangles): fast test says %d, "
                   "every pair says %d", trial, kind, m.triangle_count, a.crosses, truth);
+        if (trial % 4 == 0) { /* the whole list, not only whether there is a pair */
+            size_t listed = listed_pairs(&m), every = oracle_pairs(&m);
+            CHECK_MSG(listed == every, "trial %d (kind %d): %zu pairs listed, %zu cross",
+                      trial, kind, listed, every);
+            listed_crossing += listed > 0;
+        }
         crossing += truth;
         apart += !truth;
         if (!truth) {
@@ -201,6 +245,7 @@ TEST(agrees_with_every_pair_on_random_meshes)
     /* Both answers common, two shells tried, and the proofs doing most of the work. */
     CHECK(crossing >= 60 && apart >= 60);
     CHECK(shells >= 50);
+    CHECK_MSG(listed_crossing >= 15, "only %zu lists compared had a pair", listed_crossing);
     CHECK_MSG(2 * proven > triangles_apart, "only %zu of %zu triangles proven", proven,
               triangles_apart);
 }
