@@ -91,9 +91,10 @@ contains "turning a group's result made 12 pairs of its triangles cross; 2 corne
 run 0 check --self-intersections "$WORK/f5.off"
 contains "ok: no self-intersections"
 
-# A turned group whose turned result folds two slivers onto each other: evaluated as a
-# leaf that crosses itself it is refused, so the tree is evaluated again with each leaf
-# turned on its own, and that result is clean (a fuzz tree of 70 leaves, shrunk).
+# A turned group whose turned result folds slivers onto each other: the evaluation around
+# it fails on that leaf (a region below the resolution of doubles whose winding number is
+# not decided), so the tree is evaluated again with each leaf turned on its own, and that
+# result is clean (a fuzz tree of 70 leaves, shrunk).
 rm -f "$WORK/fb.off"
 run 0 eval "$ROUNDING/frame-fails-flattened-3-leaves.scad" -o "$WORK/fb.off" -v --stats
 lacks "warning"
