@@ -9,6 +9,7 @@
  * Degeneracy and the sign of the volume are decided with exact predicates (exact/predicates.h).
  */
 #include "mesh/validate.h"
+#include "mesh/edge_fan.h"
 #include "base/sort.h"
 #include "exact/kernel.h"
 #include "exact/predicates.h"
@@ -300,8 +301,6 @@ static size_t kth_use(const edge_use *group, size_t n, uint32_t forward, size_t 
     return n;
 }
 
-enum { ANGLE_PAIRING_MAX = 64 };
-
 /* The corner of use e's triangle off the edge (canonical coordinates), or NULL for a
  * triangle with a repeated corner. */
 static const double *third_corner(const check_state *s, const edge_use *e)
@@ -314,121 +313,27 @@ static const double *third_corner(const check_state *s, const edge_use *e)
     return NULL;
 }
 
-/* Sorts order[0 .. n) (positions in group) by the angle of their triangles about the
- * edge, from its smaller to its larger vertex; tie[i] is set when order[i] lies in the
- * same half-plane as order[i - 1] (coincident or overlapping faces). False when a
- * triangle has no third corner. */
-static bool sort_by_angle(const check_state *s, const edge_use *group, size_t n,
-                          uint8_t *order, bool *tie)
-{
-    const double *u = s->mesh->vertices + 3 * (size_t)(group[0].key >> 32);
-    const double *v = s->mesh->vertices + 3 * (size_t)(uint32_t)group[0].key;
-    const double *w[ANGLE_PAIRING_MAX];
-    for (size_t i = 0; i < n; i++) {
-        order[i] = (uint8_t)i;
-        if (!(w[i] = third_corner(s, &group[i])))
-            return false;
-    }
-    for (size_t i = 1; i < n; i++) /* insertion sort: n is small */
-        for (size_t j = i; j > 0 && mci_half_plane_before(u, v, w[0], w[order[j]],
-                                                         w[order[j - 1]]); j--) {
-            uint8_t t = order[j];
-            order[j] = order[j - 1];
-            order[j - 1] = t;
-        }
-    tie[0] = false;
-    for (size_t i = 1; i < n; i++)
-        tie[i] = mci_half_plane_class(u, v, w[order[i - 1]], w[order[i]]) == 0;
-    return true;
-}
-
-/* Reorders each run of ties in order[] so that directions alternate around the edge,
- * forward uses at positions of parity `phase`; false when a run holds the wrong number
- * of forward uses for that. */
-static bool alternate_ties(const edge_use *group, size_t n, const bool *tie, int phase,
-                           uint8_t *order)
-{
-    for (size_t start = 0, end; start < n; start = end) {
-        uint8_t fwd[ANGLE_PAIRING_MAX], back[ANGLE_PAIRING_MAX];
-        size_t nf = 0, nb = 0, wanted = 0;
-        for (end = start + 1; end < n && tie[end]; end++)
-            ;
-        for (size_t i = start; i < end; i++) {
-            if (group[order[i]].forward)
-                fwd[nf++] = order[i];
-            else
-                back[nb++] = order[i];
-            wanted += (i & 1) == (size_t)phase;
-        }
-        if (nf != wanted)
-            return false;
-        for (size_t i = start; i < end; i++)
-            order[i] = (i & 1) == (size_t)phase ? fwd[--nf] : back[--nb];
-    }
-    return true;
-}
-
-/* Where directions do not alternate around the edge (surfaces of the shell crossing
- * each other there, or one lying inside another's wedge), the uses in turn order (no two
- * in one half-plane) paired without crossing: a stack takes them in turn, and one running
- * the other way than the top pairs with it. The uses between two partners, either way
- * round the edge, are whole pairs, as many one way as the other, so the winding numbers
- * beside the partners are equal on the sides facing each other and on their other sides:
- * their pieces may be joined into one region as a solid wedge's are, and each pair is one
- * sheet for the local test. Always succeeds on a balanced edge. */
-static void pair_neighbours(const edge_use *group, size_t n, const uint8_t *order,
-                            uint8_t *mate)
-{
-    uint8_t stack[ANGLE_PAIRING_MAX];
-    size_t top = 0;
-    for (size_t i = 0; i < n; i++) {
-        uint8_t here = order[i];
-        if (top > 0 && group[stack[top - 1]].forward != group[here].forward) {
-            uint8_t other = stack[--top];
-            mate[here] = other, mate[other] = here;
-        } else {
-            stack[top++] = here;
-        }
-    }
-}
-
-/* Pairs the uses of a balanced edge of more than two triangles by angle, as
- * csg/manifold_split.c pairs the output's: each use from the smaller vertex to the
- * larger with the one just before it in the turn, which must run the other way (the two
- * triangles then bound one solid wedge). Triangles in one half-plane (a sliver folded
- * flat, a face listed twice) may be taken in any order that makes directions alternate;
- * such a pair bounds a wedge of no width. Where directions cannot alternate and no two
- * lie in one half-plane, pair_neighbours pairs them. mate[i] is i's partner (positions
- * in group). 0 when the edge has too many uses, or directions cannot alternate and two
- * lie in one half-plane (no order of theirs is known to keep the winding numbers beside
- * partners equal); 2 when pair_neighbours paired them, else 1. */
+/* Pairs the uses of a balanced edge of more than two triangles by angle about the edge,
+ * from its smaller to its larger vertex (mci_pair_fan_by_angle, as csg/manifold_split.c
+ * pairs the output's): mate[i] is i's partner (positions in group). 0 when they cannot
+ * be paired (or a triangle has no third corner); 2 when directions do not alternate
+ * around the edge, else 1. */
 static int pair_by_angle(const check_state *s, const edge_use *group, size_t n,
                          uint8_t *mate)
 {
-    uint8_t order[ANGLE_PAIRING_MAX];
-    bool tie[ANGLE_PAIRING_MAX], ties = false;
-    size_t forward = 0;
-    int phase = 0;
-    for (size_t i = 0; i < n; i++)
-        forward += group[i].forward;
-    if (n > ANGLE_PAIRING_MAX || 2 * forward != n || !sort_by_angle(s, group, n, order, tie))
+    const double *third[MCI_FAN_MAX];
+    uint8_t forward[MCI_FAN_MAX];
+    mci_edge_fan fan = {s->mesh->vertices + 3 * (size_t)(group[0].key >> 32),
+                        s->mesh->vertices + 3 * (size_t)(uint32_t)group[0].key, third,
+                        forward, n};
+    if (n > MCI_FAN_MAX)
         return 0;
-    while (phase < 2 && !alternate_ties(group, n, tie, phase, order))
-        phase++;
-    for (size_t i = 0; i < n; i++)
-        ties |= tie[i];
-    if (phase == 2 && ties)
-        return 0;
-    if (phase == 2) {
-        pair_neighbours(group, n, order, mate);
-        return 2;
-    }
     for (size_t i = 0; i < n; i++) {
-        uint8_t here = order[i], before = order[(i + n - 1) % n];
-        if (group[here].forward)
-            mate[here] = before, mate[before] = here;
+        forward[i] = group[i].forward;
+        if (!(third[i] = third_corner(s, &group[i])))
+            return 0;
     }
-    return 1;
+    return mci_pair_fan_by_angle(&fan, mate);
 }
 
 /* Joins the triangles of one edge into shells: both of a manifold edge; at a balanced
@@ -493,7 +398,7 @@ static size_t uses_in_shell(const check_state *s, const edge_use *group, size_t 
 {
     uint32_t root = mci_find_root(s->parent, group[i].tri);
     size_t m = 0;
-    for (size_t j = 0; j < n && m < ANGLE_PAIRING_MAX; j++)
+    for (size_t j = 0; j < n && m < MCI_FAN_MAX; j++)
         if (mci_find_root(s->parent, group[j].tri) == root)
             out[m++] = group[j];
     return m;
@@ -505,23 +410,23 @@ static size_t uses_in_shell(const check_state *s, const edge_use *group, size_t 
  * counted as not supported. */
 static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
 {
-    edge_use mine[ANGLE_PAIRING_MAX];
-    uint8_t mate[ANGLE_PAIRING_MAX];
-    bool done[ANGLE_PAIRING_MAX] = {false};
+    edge_use mine[MCI_FAN_MAX];
+    uint8_t mate[MCI_FAN_MAX];
+    bool done[MCI_FAN_MAX] = {false};
     int paired;
     if (n <= 2)
         return true;
     for (size_t i = 0; i < n; i++) {
         size_t m;
-        if (i < ANGLE_PAIRING_MAX && done[i])
+        if (i < MCI_FAN_MAX && done[i])
             continue;
         m = uses_in_shell(s, group, n, i, mine);
-        for (size_t j = i; j < n && j < ANGLE_PAIRING_MAX; j++)
+        for (size_t j = i; j < n && j < MCI_FAN_MAX; j++)
             done[j] |= mci_find_root(s->parent, group[j].tri) ==
                        mci_find_root(s->parent, group[i].tri);
         if (m <= 2)
             continue;
-        paired = n > ANGLE_PAIRING_MAX ? 0 : pair_by_angle(s, mine, m, mate);
+        paired = n > MCI_FAN_MAX ? 0 : pair_by_angle(s, mine, m, mate);
         if (!paired) {
             note_edge(s->report->example_self_touching_edge, &s->report->self_touching_edges,
                       group[0].key);
