@@ -7,6 +7,7 @@
  */
 #include "csg/classify_leaf.h"
 #include "csg/triangulate.h"
+#include "mesh/edge_fan.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -306,13 +307,84 @@ static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool she
            mci_edge_mates_has(mates, f - w->face_base, g - w->face_base);
 }
 
+/* The edge of piece slot k's face that the slot lies along (sides left to pair lie on
+ * their faces' borders), or -1 if its ends do not tell. */
+static int slot_face_edge(const mci_leaf_work *w, size_t k)
+{
+    const mci_face_arr *arr = mci_scene_arr_of_face(w->s, w->pface[k / 3]);
+    int a, b;
+    if (!arr)
+        return (int)(k % 3); /* a whole face: its corners in order */
+    a = arr->where[w->plocal[k]];
+    b = arr->where[w->plocal[k - k % 3 + (k % 3 + 1) % 3]];
+    if (a >= MCI_AT_EDGE && a < MCI_AT_INSIDE && (b == a || b < MCI_AT_EDGE))
+        return b == a || b == a - MCI_AT_EDGE || b == (a - MCI_AT_EDGE + 1) % 3 ? a - MCI_AT_EDGE
+                                                                                  : -1;
+    if (b >= MCI_AT_EDGE && b < MCI_AT_INSIDE && a < MCI_AT_EDGE)
+        return a == b - MCI_AT_EDGE || a == (b - MCI_AT_EDGE + 1) % 3 ? b - MCI_AT_EDGE : -1;
+    if (a < MCI_AT_EDGE && b < MCI_AT_EDGE && b == (a + 1) % 3)
+        return a;
+    if (a < MCI_AT_EDGE && b < MCI_AT_EDGE && a == (b + 1) % 3)
+        return b;
+    return -1;
+}
+
+/* Input vertex `corner` of face f of the leaf. */
+static const double *face_corner(const mci_leaf_work *w, uint32_t f, int corner)
+{
+    const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+    return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)(f - w->face_base) + (size_t)corner];
+}
+
+/* Pairs the unpaired sides of the run in the shell of side `first` by angle about their
+ * common edge (mci_pair_fan_by_angle): each side lies along an edge of its face, the
+ * face in the half-plane of that edge holding its third corner. Where more than two
+ * sides meet (a shell touching itself along an edge, or input edges overlapping on one
+ * line), pairs that bound one wedge keep a region's winding numbers; pairs found
+ * otherwise (by face) need not. False when the sides cannot be paired so. */
+static bool pair_sides_by_angle(mci_leaf_work *w, const mci_keyed *run, size_t n, size_t first,
+                                bool shells, bool separator)
+{
+    const double *third[MCI_FAN_MAX];
+    uint8_t forward[MCI_FAN_MAX], mate[MCI_FAN_MAX];
+    uint32_t slot[MCI_FAN_MAX];
+    mci_edge_fan fan = {NULL, NULL, third, forward, 0};
+    uint32_t k0 = run[first].ref;
+    for (size_t i = first; i < n; i++) {
+        uint32_t k = run[i].ref, f = w->pface[k / 3];
+        int e = slot_face_edge(w, k);
+        if (w->mate[k] != MCI_NONE || (shells && slot_shell(w, k) != slot_shell(w, k0)))
+            continue;
+        if (e < 0 || fan.n == MCI_FAN_MAX)
+            return false;
+        forward[fan.n] = mci_leaf_slot_from(w, k) < mci_leaf_slot_to(w, k);
+        third[fan.n] = face_corner(w, f, (e + 2) % 3);
+        if (fan.n == 0) { /* the axis from the smaller output id to the larger */
+            fan.u = face_corner(w, f, forward[0] ? e : (e + 1) % 3);
+            fan.v = face_corner(w, f, forward[0] ? (e + 1) % 3 : e);
+        }
+        slot[fan.n++] = k;
+    }
+    if (mci_pair_fan_by_angle(&fan, mate) == 0)
+        return false;
+    for (size_t i = 0; i < fan.n; i++) {
+        w->mate[slot[i]] = slot[mate[i]];
+        w->is_sep[slot[i]] = separator;
+    }
+    return true;
+}
+
 /* Pairs the n sides of one edge (a run of equal keys), each with the opposite side of
- * its own shell (see side_pass); the pairs are separators if `separator`. */
+ * its own shell: by angle where more than two meet, else (or where that fails) by face
+ * (see side_pass); the pairs are separators if `separator`. */
 static mcsg_status pair_sides(mci_leaf_work *w, const mci_keyed *run, size_t n, bool separator)
 {
     bool shells = leaf_has_shells(w);
     bool mates = w->cl->tree->leaf_mates[w->leaf].count > 0;
     side_pass pass = n > 2 ? SAME_FACE : ANY_FACE;
+    for (size_t a = 0; n > 2 && a < n; a++)
+        if (w->mate[run[a].ref] == MCI_NONE)
+            pair_sides_by_angle(w, run, n, a, shells, separator);
     for (; pass <= ANY_FACE; pass++)
         for (size_t a = 0; a < n && (pass != ANGLE_MATES || mates); a++) {
             uint32_t k = run[a].ref;
@@ -406,12 +478,9 @@ static mcsg_status collect_separators(mci_leaf_work *w)
     return MCSG_OK;
 }
 
-/* Whether faces f and g, across an edge of their pieces, lie in one plane facing
- * opposite ways: a surface folded flat onto itself (a sliver that rounding turned over,
- * in a leaf crossing itself). Each one's front is the other's back there, and the
- * winding numbers on the two sides of the plane differ by what the faces covering it
- * add up to, so their pieces do not share a region's numbers. */
-static bool folded_flat(const mci_leaf_work *w, uint32_t f, uint32_t g)
+/* How faces f and g lie: 0 in different planes, 1 in one plane facing the same way, -1
+ * in one plane facing opposite ways. */
+static int plane_relation(const mci_leaf_work *w, uint32_t f, uint32_t g)
 {
     mci_plane pf, pg;
     int axis, sign;
@@ -419,22 +488,43 @@ static bool folded_flat(const mci_leaf_work *w, uint32_t f, uint32_t g)
     mci_scene_face_plane(w->s, g, &pg);
     if (mci_orient3d_vertex(pg.a, &pf) != 0 || mci_orient3d_vertex(pg.b, &pf) != 0 ||
         mci_orient3d_vertex(pg.c, &pf) != 0)
-        return false;
+        return 0;
     axis = mci_plane_projection_axis(&pf, &sign);
-    return axis >= 0 && mci_plane_normal_sign(&pg, axis) == -sign;
+    return axis >= 0 && mci_plane_normal_sign(&pg, axis) == -sign ? -1 : 1;
+}
+
+/* Whether another face lies in face f's plane over part of it (its arrangement took a
+ * coplanar face): f's pieces there lie in a stack of coincident sheets. */
+static bool stacked(const mci_leaf_work *w, uint32_t f)
+{
+    const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
+    return arr && arr->coplanar;
 }
 
 /* Whether pieces are joined across slot k: not a separator, and, in a leaf classified
- * by winding numbers, not a fold flat onto the piece across. */
+ * by winding numbers, not where the region's numbers stop meaning the same:
+ *   - a fold flat onto the piece across (faces in one plane facing opposite ways, a
+ *     sliver that rounding turned over): each one's front is the other's back there,
+ *     and the numbers on the two sides of the plane differ by what the faces covering
+ *     it add up to;
+ *   - from a face lying in a stack of coincident sheets to a face in another plane: a
+ *     ray from a piece in the stack tells the numbers beyond the whole stack, which are
+ *     not those beside a single sheet (where two sheets facing opposite ways bound a
+ *     crack of no width, the number in front of each is the crack's, and beyond the
+ *     stack it is the solid's around it). */
 static bool joins(const mci_leaf_work *w, size_t k)
 {
     uint32_t f, g;
+    int relation;
     if (w->is_sep[k])
         return false; /* walls too: they have no mate */
     if (!w->cl->tree->leaf_winding[w->leaf])
         return true;
     f = w->pface[k / 3], g = w->pface[w->mate[k] / 3];
-    return f == g || !folded_flat(w, f, g);
+    if (f == g)
+        return true;
+    relation = plane_relation(w, f, g);
+    return relation == 1 || (relation == 0 && !stacked(w, f) && !stacked(w, g));
 }
 
 /* Regions: pieces joined across non-separator edges; numbered by first piece. */
