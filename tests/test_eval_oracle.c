@@ -368,6 +368,39 @@ TEST(folded_slivers_keep_the_solid)
     mcsg_mesh_free(&m, NULL);
 }
 
+/* A shell folded flat onto itself: twelve needle triangles in one plane, six facing each
+ * way, tile the same quadrilateral twice (a crack of no width, inside the solid), and
+ * the shell's other faces meet them along its edges, four sides at some edges. Joined
+ * with those faces in one region, the fold's pieces gave it their seed ray's numbers,
+ * which are those beyond the whole stack (1, the solid around the crack) instead of
+ * those beside one sheet (0): every face was dropped and the result was empty. The
+ * component of fuzz seed 0x7e0c761b43f114a7 that went missing (csg-regressions). Its
+ * winding number is 0 or 1 everywhere, so its solid's volume is the mesh's own. */
+TEST(flat_fold_keeps_the_solid)
+{
+    mcsg_mesh m, out;
+    mcsg_repair_stats st;
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    csg_result r;
+    CHECK_OK(mcsg_mesh_read(test_data("rounding/flat-fold-crack.off"), MCSG_FORMAT_AUTO, NULL,
+                            &m, &err), &err);
+    CHECK_OK(mcsg_mesh_repair(&m, NULL, &out, &st, &err), &err);
+    CHECK_MSG(fabs(test_signed_volume(&out) - test_signed_volume(&m)) < 1e-6,
+              "volume %.17g, the mesh's %.17g", test_signed_volume(&out),
+              test_signed_volume(&m));
+    CHECK_MSG(out.triangle_count > 600, "%zu triangles", out.triangle_count);
+    mcsg_mesh_free(&out, NULL);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "flat fold", &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0xf01d, false, true, true, &r), "%s", r.why);
+    CHECK(r.checked > 0 && r.inside > 0);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&m, NULL);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -376,6 +409,7 @@ int main(void)
     RUN(spindle_torus);
     RUN(repair_of_generated_imperfect_meshes);
     RUN(folded_slivers_keep_the_solid);
+    RUN(flat_fold_keeps_the_solid);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();

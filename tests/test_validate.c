@@ -6,6 +6,7 @@
 #include "testlib.h"
 #include "exact/predicates.h"
 #include "exact/big.h"
+#include "mesh/edge_fan.h"
 
 #include <float.h>
 #include <gmp.h>
@@ -431,6 +432,85 @@ static mcsg_status check_cube(const void *mesh, const mcsg_options *opts, mcsg_e
     return st;
 }
 
+/* The winding numbers on the two sides of each use of a fan whose uses lie at the given
+ * whole-degree angles (distinct), taken in turn: crossing a forward use in the positive
+ * turn adds one, a backward use takes one away. lo[i] <= hi[i]. */
+static void fan_sides(const int *degrees, const uint8_t *forward, size_t n, int *lo, int *hi)
+{
+    for (size_t i = 0; i < n; i++) {
+        int before = 0; /* the sector just before use i, from the one before angle 0 */
+        for (size_t j = 0; j < n; j++)
+            if (degrees[j] < degrees[i])
+                before += forward[j] ? 1 : -1;
+        lo[i] = forward[i] ? before : before - 1;
+        hi[i] = lo[i] + 1;
+    }
+}
+
+/* Pairing by angle keeps a region's numbers: partners have the same numbers on each
+ * side (the property classification relies on when it joins their pieces), on random
+ * balanced fans of up to 16 uses about the x axis, in alternating and other orders. */
+TEST(fan_pairs_keep_winding_numbers)
+{
+    uint64_t rng = 0xfa4;
+    const double u[3] = {0, 0, 0}, v[3] = {1, 0, 0};
+    size_t stacked = 0;
+    for (int round = 0; round < 2000; round++) {
+        size_t n = 2 * (size_t)test_random_int(&rng, 1, 8);
+        double corner[16][3];
+        const double *third[16];
+        uint8_t forward[16], mate[16], used[360] = {0};
+        int degrees[16], lo[16], hi[16], got;
+        mci_edge_fan fan = {u, v, third, forward, n};
+        for (size_t i = 0; i < n; i++) {
+            do
+                degrees[i] = test_random_int(&rng, 0, 359);
+            while (used[degrees[i]]);
+            used[degrees[i]] = 1;
+            corner[i][0] = 0.5;
+            corner[i][1] = cos(degrees[i] * 3.14159265358979323846 / 180);
+            corner[i][2] = sin(degrees[i] * 3.14159265358979323846 / 180);
+            third[i] = corner[i];
+            forward[i] = i < n / 2;
+        }
+        for (size_t i = n; i-- > 1;) { /* shuffle the directions */
+            size_t j = (size_t)test_random_int(&rng, 0, (int)i);
+            uint8_t t = forward[i];
+            forward[i] = forward[j], forward[j] = t;
+        }
+        got = mci_pair_fan_by_angle(&fan, mate);
+        CHECK(got == 1 || got == 2);
+        stacked += got == 2;
+        fan_sides(degrees, forward, n, lo, hi);
+        for (size_t i = 0; i < n; i++) {
+            CHECK(mate[i] < n && mate[mate[i]] == i && forward[mate[i]] != forward[i]);
+            CHECK_MSG(lo[mate[i]] == lo[i] && hi[mate[i]] == hi[i],
+                      "round %d: uses %zu and %u have numbers %d/%d and %d/%d", round, i,
+                      mate[i], lo[i], hi[i], lo[mate[i]], hi[mate[i]]);
+        }
+    }
+    CHECK(stacked > 100 && stacked < 1900); /* both kinds of fan were met */
+}
+
+/* Two uses in one half-plane facing opposite ways (a sliver folded flat) and a pair across
+ * them: the folded pair is split so that directions alternate; an unbalanced fan and a
+ * fan that cannot alternate with two uses in one half-plane are refused. */
+TEST(fan_ties_and_refusals)
+{
+    const double u[3] = {0, 0, 0}, v[3] = {1, 0, 0};
+    const double up[3] = {0.5, 0, 1}, down[3] = {0.5, 0, -1}, side[3] = {0.5, 1, 0};
+    const double *third[4] = {up, up, down, side};
+    uint8_t forward[4] = {1, 0, 1, 0}, mate[4];
+    mci_edge_fan fan = {u, v, third, forward, 4};
+    CHECK(mci_pair_fan_by_angle(&fan, mate) == 1);
+    CHECK(mate[0] != 1 && mate[mate[0]] == 0 && mate[mate[1]] == 1);
+    forward[3] = 1;
+    CHECK(mci_pair_fan_by_angle(&fan, mate) == 0);
+    third[3] = down;
+    forward[0] = 1, forward[1] = 1, forward[2] = 0, forward[3] = 0;
+    CHECK(mci_pair_fan_by_angle(&fan, mate) == 0);
+}
+
 TEST(check_survives_every_allocation_failure)
 {
     test_mesh m;
@@ -456,6 +536,8 @@ int main(void)
     RUN(orient2d_constructed_collinear);
     RUN(det3_random_and_coplanar_match_rationals);
     RUN(models_validate_clean);
+    RUN(fan_pairs_keep_winding_numbers);
+    RUN(fan_ties_and_refusals);
     RUN(check_survives_every_allocation_failure);
     return test_summary();
 }

@@ -1,11 +1,10 @@
 // fuzz-csg: seed 0x7e0c761b43f114a7 family export touching yes provenance yes; 72 leaves
-// OPEN (not replayed by any test): fuzz seed 0x7e0c761b43f114a7 (run 44), shrunk to 12
-// leaves by removing leaves (its empty groups matter). With crossings checked
-// (check_output_crossings, as the fuzzer ran it), the result misses a part of the
-// solid: test_eval_oracle, given this file alone in a csg-regressions folder
-// (MCSG_TEST_DATA), reports a point inside the tree's solid where the result's
-// winding number is 0. The turned group's result crosses itself, and evaluated as a
-// leaf by its winding number it loses that part (docs/robustness.md, run 44).
+// Fuzz seed 0x7e0c761b43f114a7 (run 44), shrunk to 12 leaves by removing leaves (its
+// empty groups matter). The turned group's result crosses itself; evaluated as a leaf by
+// its winding number it lost a part of the solid: a fold flat onto itself there (a crack
+// of no width between coincident sheets facing opposite ways) was joined into one region
+// with the faces beside it, and the ray from a piece of the fold gave them all the
+// numbers beyond the whole stack (tests/data/rounding/flat-fold-crack.off).
 multmatrix([[0.70710700000000004, 0.70710700000000004, 0, 0], [-4.3297799999999998e-17, 4.3297799999999998e-17, -1, 0], [-0.70710700000000004, 0.70710700000000004, 6.1232300000000004e-17, 0], [0, 0, 0, 1]]) {
   union() {
     intersection() {
