@@ -286,6 +286,43 @@ TEST(tiny_triangles_get_inside_points)
     CHECK(found);
 }
 
+/* A triangle in z = -25 far smaller than the unit of its coordinates there (1.8e-15
+ * across, 1.1e-16 wide in x, against units of 7.1e-15 in x and 3.6e-15 in z): two
+ * corners are doubles one unit apart in y, the third a line meeting a plane next to the
+ * first. The line through a point of its corners' doubles along the normal, as long as
+ * the triangle, rounds back onto the plane at both ends; the search for a point inside
+ * gave up there instead of trying a line from far away, and a region of such a piece
+ * (a turned result evaluated as a leaf by its winding number) was left undecided. */
+TEST(triangles_below_the_unit_get_inside_points)
+{
+    static const double a[3] = {-46.279362785375007, -13.481394198375, -25},
+                        b[3] = {-46.279362785375007, -13.481394198375002, -25},
+                        d[3] = {-46.974794344704073, -12.276871966039092, -25},
+                        p[3] = {-47.141000000000005, 1.6506250000000016, -25},
+                        q[3] = {-46.279362785375007, -13.481394198375002, -24};
+    mci_plane line_plane, plane;
+    mci_point corner[3], out;
+    double ends[2][3];
+    int sign, axis, found = -1;
+    mci_plane_init(&line_plane, b, p, q);
+    mci_plane_init(&plane, p, a, b);
+    mci_point_explicit(&corner[0], a);
+    mci_point_explicit(&corner[1], b);
+    CHECK(mci_point_lpi(&corner[2], d, a, &line_plane));
+    CHECK(mci_orient3d(&corner[2], &plane) == 0);
+    axis = mci_plane_projection_axis(&plane, &sign);
+    CHECK(mci_orient2d_projected(&corner[0], &corner[1], &corner[2], axis) == sign);
+    for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS && found < 0; attempt++) {
+        if (!mci_point_inside_triangle(corner, &plane, attempt, ends, &out))
+            continue;
+        for (int i = 0; i < 3; i++)
+            CHECK_MSG(mci_orient2d_projected(&corner[i], &corner[(i + 1) % 3], &out, axis) ==
+                          sign, "attempt %d: the point is not strictly inside", attempt);
+        found = attempt;
+    }
+    CHECK(found >= 0);
+}
+
 TEST(box_overlaps_match_every_pair)
 {
     mci_ctx ctx;
@@ -332,5 +369,6 @@ int main(void)
     RUN(windings_on_both_sides_of_a_face);
     RUN(slivers_get_inside_points);
     RUN(tiny_triangles_get_inside_points);
+    RUN(triangles_below_the_unit_get_inside_points);
     return test_summary();
 }

@@ -264,14 +264,16 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
         ends[0][k] = centre + step;
         ends[1][k] = centre - step;
     }
-    if (mci_orient3d_vertex(ends[0], plane) * mci_orient3d_vertex(ends[1], plane) >= 0 ||
-        !mci_point_lpi(out, ends[0], ends[1], plane) ||
-        (axis = mci_plane_projection_axis(plane, &sign)) < 0)
-        return false;
-    for (int i = 0; i < 3; i++)
-        turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
-    if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
-        return true;
+    /* The line may miss: a triangle much smaller than its coordinates' unit (ends
+     * rounded onto the plane). The last attempt then searches as for a sliver. */
+    if (mci_orient3d_vertex(ends[0], plane) * mci_orient3d_vertex(ends[1], plane) < 0 &&
+        mci_point_lpi(out, ends[0], ends[1], plane) &&
+        (axis = mci_plane_projection_axis(plane, &sign)) >= 0) {
+        for (int i = 0; i < 3; i++)
+            turns[i] = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], out, axis);
+        if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
+            return true;
+    }
     if (attempt != MCI_INSIDE_ATTEMPTS - 1)
         return false;
     return point_inside_sliver(c, x, plane, ends, out) || point_inside_tiny(c, plane, ends, out);
