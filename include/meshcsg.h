@@ -283,9 +283,10 @@ typedef struct mcsg_check_report {
      * half-plane, such as a sliver folded flat, taken in an order that makes directions
      * alternate), or, where directions do not alternate (surfaces entering each other's
      * wedges), without crossing pairs: taken in turn about the edge, each with the last
-     * one not yet paired running the other way. An edge where directions do not
-     * alternate and two of the shell's triangles there lie in one half-plane is counted
-     * here: mcsg_eval does not take such a primitive. */
+     * one not yet paired running the other way (triangles in one half-plane then in a
+     * fixed order, as if turned apart by an infinitesimal angle). An edge where one
+     * shell has more than 64 triangles is counted here: mcsg_eval does not take such a
+     * primitive. */
     size_t self_touching_edges;
     uint32_t example_self_touching_edge[2];
 } mcsg_check_report;
@@ -595,8 +596,7 @@ typedef struct mcsg_eval_stats {
  * Input contract: every non-empty leaf the root reaches must be closed as a chain (with
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
- * coordinates, no shell meeting itself at an edge with more than two triangles that
- * cannot be paired about it (self_touching_edges). Zero-area triangles bound nothing
+ * coordinates, no shell with more than 64 triangles at one edge (self_touching_edges). Zero-area triangles bound nothing
  * and are removed first, with a warning (one with three collinear corners splits a
  * neighbour at its middle corner, several back to back split every edge through their
  * corners; provenance names the leaf's own triangles).

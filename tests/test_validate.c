@@ -493,8 +493,9 @@ TEST(fan_pairs_keep_winding_numbers)
 }
 
 /* Two uses in one half-plane facing opposite ways (a sliver folded flat) and a pair across
- * them: the folded pair is split so that directions alternate; an unbalanced fan and a
- * fan that cannot alternate with two uses in one half-plane are refused. */
+ * them: the folded pair is split so that directions alternate. An unbalanced fan is
+ * refused. Two uses each way, each way's in one half-plane (directions cannot
+ * alternate): paired by the stack, partners running opposite ways. */
 TEST(fan_ties_and_refusals)
 {
     const double u[3] = {0, 0, 0}, v[3] = {1, 0, 0};
@@ -508,7 +509,9 @@ TEST(fan_ties_and_refusals)
     CHECK(mci_pair_fan_by_angle(&fan, mate) == 0);
     third[3] = down;
     forward[0] = 1, forward[1] = 1, forward[2] = 0, forward[3] = 0;
-    CHECK(mci_pair_fan_by_angle(&fan, mate) == 0);
+    CHECK(mci_pair_fan_by_angle(&fan, mate) == 2);
+    for (size_t i = 0; i < 4; i++)
+        CHECK(mate[i] < 4 && mate[mate[i]] == i && forward[mate[i]] != forward[i]);
 }
 
 TEST(check_survives_every_allocation_failure)

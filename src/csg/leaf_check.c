@@ -74,9 +74,7 @@ static void describe_problem(const mcsg_mesh *m, const mcsg_check_report *r, cha
         format_point(a, sizeof a, m, r->example_self_touching_edge[0]);
         format_point(b, sizeof b, m, r->example_self_touching_edge[1]);
         snprintf(out, size, "not supported: %zu edges where one shell meets itself with "
-                 "more than two triangles that cannot be paired about the edge (surfaces "
-                 "entering each other's wedges, two of them in one plane), e.g. from %s "
-                 "to %s", r->self_touching_edges, a, b);
+                 "more than 64 triangles, e.g. from %s to %s", r->self_touching_edges, a, b);
     }
 }
 

@@ -71,7 +71,7 @@ static void pair_neighbours(const mci_edge_fan *fan, const uint8_t *order, uint8
 int mci_pair_fan_by_angle(const mci_edge_fan *fan, uint8_t *mate)
 {
     uint8_t order[MCI_FAN_MAX];
-    bool tie[MCI_FAN_MAX], ties = false;
+    bool tie[MCI_FAN_MAX];
     size_t forward = 0, n = fan->n;
     int phase = 0;
     for (size_t i = 0; i < n; i++)
@@ -81,11 +81,7 @@ int mci_pair_fan_by_angle(const mci_edge_fan *fan, uint8_t *mate)
     sort_by_angle(fan, order, tie);
     while (phase < 2 && !alternate_ties(fan, tie, phase, order))
         phase++;
-    for (size_t i = 0; i < n; i++)
-        ties |= tie[i];
-    if (phase == 2 && ties)
-        return 0;
-    if (phase == 2) {
+    if (phase == 2) { /* ties, if any, in the sort's order: see edge_fan.h */
         pair_neighbours(fan, order, mate);
         return 2;
     }

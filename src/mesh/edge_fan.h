@@ -27,13 +27,16 @@ typedef struct mci_edge_fan {
  * region): each use running from u to v with the one just before it in the turn, which
  * must run the other way (they bound one solid wedge). Uses in one half-plane (a sliver
  * folded flat, a face listed twice) may be taken in any order that makes directions
- * alternate. Where directions cannot alternate and no two uses share a half-plane, uses
- * in turn order are paired without crossing (a stack: one running the other way than
- * the top pairs with it), so that the uses between two partners, either way round, are
- * whole pairs. mate[i]: i's partner. Returns 0 when the fan has more than MCI_FAN_MAX
- * uses, is unbalanced, or directions cannot alternate and two uses share a half-plane (no
- * order of theirs is known to keep the numbers equal); 2 when paired by the stack; else
- * 1. */
+ * alternate. Where directions cannot alternate, uses in turn order are paired without
+ * crossing (a stack: one running the other way than the top pairs with it), so that
+ * the uses between two partners, either way round, are whole pairs; uses in one
+ * half-plane are then taken in the sort's order, as if turned apart by an infinitesimal
+ * angle: the sectors between them have no width, and the numbers there, which that
+ * order makes up, bound nothing (classification does not join the pieces of faces that
+ * lie on other faces to another face's, csg/classify_regions.c). mate[i]: i's partner.
+ * Returns 0 when the fan has more than MCI_FAN_MAX uses or is unbalanced; 2 when paired
+ * by the stack; else 1. Deterministic: the order depends on the uses' order and
+ * coordinates only. */
 int mci_pair_fan_by_angle(const mci_edge_fan *fan, uint8_t *mate);
 
 #endif

@@ -406,8 +406,8 @@ static size_t uses_in_shell(const check_state *s, const edge_use *group, size_t 
 
 /* After the shells are joined: a balanced edge of more than two triangles where a shell
  * has more than two uses. That shell's uses are paired by angle (pair_by_angle, the
- * other shells' left out) and listed in s->mates; where they cannot be, the edge is
- * counted as not supported. */
+ * other shells' left out) and listed in s->mates; where they cannot be (more than
+ * MCI_FAN_MAX of them), the edge is counted as not supported. */
 static bool check_self_touching(check_state *s, const edge_use *group, size_t n)
 {
     edge_use mine[MCI_FAN_MAX];
