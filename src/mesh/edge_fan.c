@@ -51,7 +51,7 @@ static bool alternate_ties(const mci_edge_fan *fan, const bool *tie, int phase, 
     return true;
 }
 
-/* Uses in turn order (no two in one half-plane) paired without crossing. Always succeeds
+/* Uses in turn order (ties in the order given) paired without crossing. Always succeeds
  * on a balanced fan. */
 static void pair_neighbours(const mci_edge_fan *fan, const uint8_t *order, uint8_t *mate)
 {

@@ -32,8 +32,9 @@ typedef struct mci_edge_fan {
  * the uses between two partners, either way round, are whole pairs; uses in one
  * half-plane are then taken in the sort's order, as if turned apart by an infinitesimal
  * angle: the sectors between them have no width, and the numbers there, which that
- * order makes up, bound nothing (classification does not join the pieces of faces that
- * lie on other faces to another face's, csg/classify_regions.c). mate[i]: i's partner.
+ * order makes up, bound nothing (classification does not join the pieces of a face that
+ * lies on other faces to a face in another plane, csg/classify_regions.c). mate[i]: i's
+ * partner.
  * Returns 0 when the fan has more than MCI_FAN_MAX uses or is unbalanced; 2 when paired
  * by the stack; else 1. Deterministic: the order depends on the uses' order and
  * coordinates only. */
