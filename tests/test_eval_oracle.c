@@ -390,6 +390,34 @@ TEST(flat_fold_keeps_the_solid)
     expect_leaf_solid("rounding/flat-fold-crack.off", NAN, 600);
 }
 
+/* A needle below double-double resolution: one piece of a face in y = -22.5, 4.4e-16
+ * long and about 1e-32 wide (two corners are lines meeting a plane 1e-32 apart), between
+ * two crossing sheets of the same shell. No point strictly inside it is found to cast a
+ * ray from, and every step into its region crosses a sheet lying in one of the regions:
+ * its winding numbers were undecided and the evaluation failed. They are now carried
+ * across each separator from the decided regions beside it, which agree, and which
+ * coplanar faces cover it decides whether it is output. The first rounded result of
+ * fuzz seed 0x50787350156e0653 (13 turned boxes): 1,342 triangles, 1,107 crossing pairs;
+ * the oracle checks the evaluation at sampled points (rounding still breaks the
+ * result's guarantees, reported). */
+TEST(needle_region_decided_from_neighbours)
+{
+    mcsg_mesh m;
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    csg_result r;
+    CHECK_OK(mcsg_mesh_read(test_data("rounding/needle-below-double-double.off"),
+                            MCSG_FORMAT_AUTO, NULL, &m, &err), &err);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "needle", &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0x2eed1e, false, true, true, &r), "%s", r.why);
+    CHECK(r.checked > 250 && r.inside > 20);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&m, NULL);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -399,6 +427,7 @@ int main(void)
     RUN(repair_of_generated_imperfect_meshes);
     RUN(folded_slivers_keep_the_solid);
     RUN(flat_fold_keeps_the_solid);
+    RUN(needle_region_decided_from_neighbours);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();

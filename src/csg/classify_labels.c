@@ -407,9 +407,109 @@ static bool separator_on_leaf(const mci_leaf_work *w, size_t k, uint32_t m)
     return false;
 }
 
+/* This leaf's own numbers of region r (separator slot k, on this leaf) carried over from
+ * region `from` across k, sheets lying in either region included (own_across leaves
+ * those out: which shell comes first there, own_first, is not carried). False when not
+ * known. */
+static bool own_carried(mci_leaf_work *w, size_t k, uint32_t from, int32_t *front,
+                        int32_t *coin)
+{
+    uint64_t key = mci_edge_key(mci_leaf_slot_from(w, k), mci_leaf_slot_to(w, k));
+    size_t e = mci_leaf_find_separator(w, key), end;
+    mci_wind_sum sum = {0, 0, true, false};
+    for (; e < w->nsep && w->sep[e].key == key; e = end) {
+        uint32_t leaf = w->s->octree.face_leaf[w->sep[e].ref];
+        for (end = e + 1; end < w->nsep && w->sep[end].key == key &&
+                          w->s->octree.face_leaf[w->sep[end].ref] == leaf;)
+            end++;
+        if (leaf == w->leaf)
+            sum = wind_steps(w, k, e, end);
+    }
+    if (sum.unknown || w->own_front[from] == MCI_WIND_UNKNOWN)
+        return false;
+    *front = w->own_front[from] + sum.front;
+    *coin = w->own_coin[from] + sum.coincident;
+    return true;
+}
+
+/* Whether the closed triangle of face h (an input triangle in the plane of the points)
+ * holds point q, projected along axis. */
+static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
+{
+    const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+    const uint32_t *t = m->triangles + 3 * (size_t)(h - w->face_base);
+    mci_point c[3];
+    int turn;
+    for (int i = 0; i < 3; i++)
+        mci_point_explicit(&c[i], m->vertices + 3 * (size_t)t[i]);
+    turn = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
+    for (int i = 0; i < 3; i++) {
+        int side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], q, axis);
+        if (side != 0 && side != turn)
+            return false;
+    }
+    return true;
+}
+
+/* own_first of region r without a ray: whether no face of the leaf in a lower group lies
+ * in the region facing its way. The region lies in no such face's border (the borders of
+ * coplanar faces are separators), so a face holds the region exactly where its closed
+ * triangle holds the corners of a piece of it. */
+static bool own_first_by_cover(const mci_leaf_work *w, uint32_t r)
+{
+    uint32_t p = w->reg_pieces[w->reg_start[r]], f = w->pface[p];
+    uint32_t group = mci_octree_face_group(&w->s->octree, f);
+    mci_plane plane;
+    mci_point corner[3];
+    int sign, axis;
+    mci_scene_face_plane(w->s, f, &plane);
+    axis = mci_plane_projection_axis(&plane, &sign);
+    for (int i = 0; i < 3; i++)
+        mci_leaf_piece_point(w, p, i, &corner[i]);
+    for (uint32_t h = w->face_base; axis >= 0 && h < w->face_base + w->face_count; h++) {
+        bool holds = h != f && mci_octree_face_group(&w->s->octree, h) < group &&
+                     mci_leaf_plane_relation(w, f, h) == 1;
+        for (int i = 0; holds && i < 3; i++)
+            holds = face_holds(w, h, &corner[i], axis);
+        if (holds)
+            return false;
+    }
+    return true;
+}
+
+/* A region still unknown where every step into it crosses a sheet lying in one of the
+ * two regions (a needle narrower than double-double numbers resolve, between crossing
+ * sheets, casts no ray): its numbers carried across each decided neighbour's separator
+ * on this leaf, when they all agree, and own_first by the faces covering it. True when
+ * it was decided. */
+static bool own_from_neighbours(mci_leaf_work *w, uint32_t r)
+{
+    int32_t front = 0, coin = 0, f, c;
+    size_t agreeing = 0;
+    for (uint32_t i = w->sep_start[r]; i < w->sep_start[r + 1]; i++) {
+        uint32_t k = w->sep_slots[i], from;
+        if (w->mate[k] == MCI_NONE || !separator_on_leaf(w, k, w->leaf))
+            continue;
+        from = w->region[w->mate[k] / 3];
+        if (!own_carried(w, k, from, &f, &c))
+            continue;
+        if (agreeing > 0 && (f != front || c != coin))
+            return false;
+        front = f, coin = c, agreeing++;
+    }
+    if (agreeing == 0)
+        return false;
+    w->own_front[r] = front;
+    w->own_coin[r] = coin;
+    /* read only where the region bounds the solid */
+    w->own_first[r] = front <= 0 && front + coin > 0 && own_first_by_cover(w, r);
+    return true;
+}
+
 /* This leaf's own numbers still unknown (a region whose pieces give no point to cast a
  * ray from, and the regions reached from it): taken from a neighbour across a
- * separator, changed by the shells of this leaf holding it, until nothing changes. */
+ * separator, changed by the shells of this leaf holding it, until nothing changes; then
+ * by own_from_neighbours, and again. */
 static void fill_unknown_own(mci_leaf_work *w)
 {
     bool changed = true;
@@ -430,6 +530,8 @@ static void fill_unknown_own(mci_leaf_work *w)
                     own_copy(w, r2, r);
                 changed |= w->own_front[r] != MCI_WIND_UNKNOWN;
             }
+        for (uint32_t r = 0; !changed && r < w->nreg; r++)
+            changed = w->own_front[r] == MCI_WIND_UNKNOWN && own_from_neighbours(w, r);
     }
 }
 

@@ -153,6 +153,10 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],
                            mci_point *out, mci_plane *plane);
 
+/* How faces f and g lie: 0 in different planes, 1 in one plane facing the same way, -1
+ * in one plane facing opposite ways (classify_regions.c). */
+int mci_leaf_plane_relation(const mci_leaf_work *w, uint32_t f, uint32_t g);
+
 mcsg_status mci_leaf_regions(mci_leaf_work *w);
 mcsg_status mci_leaf_trim(mci_leaf_work *w);
 mcsg_status mci_leaf_label(mci_leaf_work *w);

@@ -478,9 +478,7 @@ static mcsg_status collect_separators(mci_leaf_work *w)
     return MCSG_OK;
 }
 
-/* How faces f and g lie: 0 in different planes, 1 in one plane facing the same way, -1
- * in one plane facing opposite ways. */
-static int plane_relation(const mci_leaf_work *w, uint32_t f, uint32_t g)
+int mci_leaf_plane_relation(const mci_leaf_work *w, uint32_t f, uint32_t g)
 {
     mci_plane pf, pg;
     int axis, sign;
@@ -526,7 +524,7 @@ static bool joins(const mci_leaf_work *w, size_t k)
     f = w->pface[k / 3], g = w->pface[w->mate[k] / 3];
     if (f == g)
         return true;
-    relation = plane_relation(w, f, g);
+    relation = mci_leaf_plane_relation(w, f, g);
     return relation == 1 || (relation == 0 && !stacked(w, f) && !stacked(w, g));
 }
 
