@@ -339,6 +339,18 @@ static void own_across(mci_leaf_work *w, uint32_t from, uint32_t r, mci_wind_sum
         w->own_front[r] += sum.front;
 }
 
+/* The end of the run of separator entries from e on with e's key and leaf (entries of
+ * one leaf are consecutive: sorted by face). */
+static size_t leaf_run_end(const mci_leaf_work *w, size_t e)
+{
+    uint32_t leaf = w->s->octree.face_leaf[w->sep[e].ref];
+    size_t end = e + 1;
+    while (end < w->nsep && w->sep[end].key == w->sep[e].key &&
+           w->s->octree.face_leaf[w->sep[end].ref] == leaf)
+        end++;
+    return end;
+}
+
 /* Labels of region r, whose piece has edge slot k, with respect to the leaves holding
  * that slot, by local tests (only those still unknown if only_unknown). A winding leaf's
  * number (and this leaf's own, where another of its shells holds the slot) is carried
@@ -355,9 +367,7 @@ static void local_labels_at(mci_leaf_work *w, uint32_t r, size_t k, bool only_un
     slot_points(w, k, &x, &y, &far);
     for (; e < w->nsep && w->sep[e].key == key; e = end) {
         uint32_t leaf = s->octree.face_leaf[w->sep[e].ref], c = w->slot_of_leaf[leaf];
-        for (end = e + 1; end < w->nsep && w->sep[end].key == key &&
-                          s->octree.face_leaf[w->sep[end].ref] == leaf;)
-            end++;
+        end = leaf_run_end(w, e);
         if (leaf == w->leaf) {
             if (w->own_front && from != MCI_NONE && (!only_unknown ||
                                                      w->own_front[r] == MCI_WIND_UNKNOWN))
@@ -418,11 +428,8 @@ static bool own_carried(mci_leaf_work *w, size_t k, uint32_t from, int32_t *fron
     size_t e = mci_leaf_find_separator(w, key), end;
     mci_wind_sum sum = {0, 0, true, false};
     for (; e < w->nsep && w->sep[e].key == key; e = end) {
-        uint32_t leaf = w->s->octree.face_leaf[w->sep[e].ref];
-        for (end = e + 1; end < w->nsep && w->sep[end].key == key &&
-                          w->s->octree.face_leaf[w->sep[end].ref] == leaf;)
-            end++;
-        if (leaf == w->leaf)
+        end = leaf_run_end(w, e);
+        if (w->s->octree.face_leaf[w->sep[e].ref] == w->leaf)
             sum = wind_steps(w, k, e, end);
     }
     if (sum.unknown || w->own_front[from] == MCI_WIND_UNKNOWN)

@@ -307,26 +307,26 @@ static bool sides_match(const mci_leaf_work *w, uint32_t k, uint32_t j, bool she
            mci_edge_mates_has(mates, f - w->face_base, g - w->face_base);
 }
 
+/* The edges of its face that a point with location `where` (MCI_AT_*) lies on, as bits:
+ * a corner on the two edges it ends, an edge point on its edge. */
+static unsigned edges_at(int where)
+{
+    if (where < MCI_AT_EDGE)
+        return 1u << where | 1u << (where + 2) % 3;
+    return where < MCI_AT_INSIDE ? 1u << (where - MCI_AT_EDGE) : 0;
+}
+
 /* The edge of piece slot k's face that the slot lies along (sides left to pair lie on
- * their faces' borders), or -1 if its ends do not tell. */
+ * their faces' borders): the one edge both its ends lie on, or -1. */
 static int slot_face_edge(const mci_leaf_work *w, size_t k)
 {
     const mci_face_arr *arr = mci_scene_arr_of_face(w->s, w->pface[k / 3]);
-    int a, b;
+    unsigned common;
     if (!arr)
         return (int)(k % 3); /* a whole face: its corners in order */
-    a = arr->where[w->plocal[k]];
-    b = arr->where[w->plocal[k - k % 3 + (k % 3 + 1) % 3]];
-    if (a >= MCI_AT_EDGE && a < MCI_AT_INSIDE && (b == a || b < MCI_AT_EDGE))
-        return b == a || b == a - MCI_AT_EDGE || b == (a - MCI_AT_EDGE + 1) % 3 ? a - MCI_AT_EDGE
-                                                                                  : -1;
-    if (b >= MCI_AT_EDGE && b < MCI_AT_INSIDE && a < MCI_AT_EDGE)
-        return a == b - MCI_AT_EDGE || a == (b - MCI_AT_EDGE + 1) % 3 ? b - MCI_AT_EDGE : -1;
-    if (a < MCI_AT_EDGE && b < MCI_AT_EDGE && b == (a + 1) % 3)
-        return a;
-    if (a < MCI_AT_EDGE && b < MCI_AT_EDGE && a == (b + 1) % 3)
-        return b;
-    return -1;
+    common = edges_at(arr->where[w->plocal[k]]) &
+             edges_at(arr->where[w->plocal[k - k % 3 + (k % 3 + 1) % 3]]);
+    return common == 1 ? 0 : common == 2 ? 1 : common == 4 ? 2 : -1;
 }
 
 /* Input vertex `corner` of face f of the leaf. */
