@@ -418,6 +418,46 @@ TEST(needle_region_decided_from_neighbours)
     mcsg_mesh_free(&m, NULL);
 }
 
+/* Sheets of one shell stacked in one plane facing one way: a shell crossing itself
+ * whose faces in x = 165 overlap (a fold of slivers, one to four sheets deep), each face
+ * its own group. A region of one face's pieces reached past the stack, so its seed ray,
+ * cast where no lower face lies, made every piece of it first: the pieces lying under a
+ * lower face were output too, triangulated unlike that face's, and the result had open
+ * edges and edges of three triangles, exact before any rounding. Only the lowest
+ * group's pieces of a stack are output now, decided per piece. The turned group's
+ * result of fuzz seed 0xe331b365b94fc3c0 (97 leaves, shrunk to 8), as the outer
+ * evaluation takes it: a clean closed mesh of the mesh's own volume, no crossings. */
+TEST(stacked_sheets_of_one_shell_output_once)
+{
+    mcsg_options opts = {0};
+    mcsg_mesh m, out;
+    mcsg_eval_stats st;
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    csg_result r;
+    const char *name = "rounding/stacked-sheets-of-one-shell.off";
+    opts.threads = 1;
+    opts.check_self_intersections = 1;
+    opts.check_output_crossings = 1;
+    CHECK_OK(mcsg_mesh_read(test_data(name), MCSG_FORMAT_AUTO, NULL, &m, &err), &err);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, name, &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    CHECK_MSG(!mcsg_output_check_failed(&st.output_check) && st.output_check.open_edges == 0 &&
+                  st.output_check.index_nonmanifold_edges == 0,
+              "open %zu, not manifold by index %zu, crossing %zu", st.output_check.open_edges,
+              st.output_check.index_nonmanifold_edges, st.output_check.crossing_pairs);
+    CHECK_MSG(fabs(test_signed_volume(&out) - test_signed_volume(&m)) < 1e-6,
+              "volume %.17g, not %.17g", test_signed_volume(&out), test_signed_volume(&m));
+    CHECK_MSG(csg_check_tree(tree, NULL, 0x57ac, false, true, true, &r), "%s", r.why);
+    CHECK(r.checked > 100 && r.inside > 20);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&m, NULL);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -428,6 +468,7 @@ int main(void)
     RUN(folded_slivers_keep_the_solid);
     RUN(flat_fold_keeps_the_solid);
     RUN(needle_region_decided_from_neighbours);
+    RUN(stacked_sheets_of_one_shell_output_once);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();

@@ -10,6 +10,7 @@
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 /* Which candidates are winding leaves, and room for their numbers if any is. */
@@ -458,30 +459,84 @@ static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, i
     return true;
 }
 
+/* Whether face h holds piece p (corners given, projected along axis): its closed triangle
+ * holds the corners. The piece lies in no coplanar face's border (those borders are
+ * separators and constraints of the piece's face), so this tells whether h holds it. */
+static bool face_holds_piece(const mci_leaf_work *w, uint32_t h, const mci_point corner[3],
+                             int axis)
+{
+    for (int i = 0; i < 3; i++)
+        if (!face_holds(w, h, &corner[i], axis))
+            return false;
+    return true;
+}
+
+/* The projection axis of piece p's face, and the piece's corners; -1 when the plane has
+ * none (never for a face with pieces). */
+static int piece_corners(const mci_leaf_work *w, size_t p, mci_point corner[3])
+{
+    mci_plane plane;
+    int sign;
+    mci_scene_face_plane(w->s, w->pface[p], &plane);
+    for (int i = 0; i < 3; i++)
+        mci_leaf_piece_point(w, p, i, &corner[i]);
+    return mci_plane_projection_axis(&plane, &sign);
+}
+
 /* own_first of region r without a ray: whether no face of the leaf in a lower group lies
- * in the region facing its way. The region lies in no such face's border (the borders of
- * coplanar faces are separators), so a face holds the region exactly where its closed
- * triangle holds the corners of a piece of it. */
+ * in the region facing its way (a face holds the region where it holds a piece of it). */
 static bool own_first_by_cover(const mci_leaf_work *w, uint32_t r)
 {
     uint32_t p = w->reg_pieces[w->reg_start[r]], f = w->pface[p];
     uint32_t group = mci_octree_face_group(&w->s->octree, f);
-    mci_plane plane;
     mci_point corner[3];
-    int sign, axis;
-    mci_scene_face_plane(w->s, f, &plane);
-    axis = mci_plane_projection_axis(&plane, &sign);
-    for (int i = 0; i < 3; i++)
-        mci_leaf_piece_point(w, p, i, &corner[i]);
-    for (uint32_t h = w->face_base; axis >= 0 && h < w->face_base + w->face_count; h++) {
-        bool holds = h != f && mci_octree_face_group(&w->s->octree, h) < group &&
-                     mci_leaf_plane_relation(w, f, h) == 1;
-        for (int i = 0; holds && i < 3; i++)
-            holds = face_holds(w, h, &corner[i], axis);
-        if (holds)
+    int axis = piece_corners(w, p, corner);
+    for (uint32_t h = w->face_base; axis >= 0 && h < w->face_base + w->face_count; h++)
+        if (h != f && mci_octree_face_group(&w->s->octree, h) < group &&
+            mci_leaf_plane_relation(w, f, h) == 1 && face_holds_piece(w, h, corner, axis))
+            return false;
+    return true;
+}
+
+/* Whether the boxes of faces f and h of this leaf meet (closed boxes of their corners). */
+static bool face_boxes_meet(const mci_leaf_work *w, uint32_t f, uint32_t h)
+{
+    const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+    const uint32_t *a = m->triangles + 3 * (size_t)(f - w->face_base);
+    const uint32_t *b = m->triangles + 3 * (size_t)(h - w->face_base);
+    for (int k = 0; k < 3; k++) {
+        double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
+        for (int i = 0; i < 3; i++) {
+            double x = m->vertices[3 * (size_t)a[i] + k], y = m->vertices[3 * (size_t)b[i] + k];
+            alo = fmin(alo, x), ahi = fmax(ahi, x), blo = fmin(blo, y), bhi = fmax(bhi, y);
+        }
+        if (ahi < blo || bhi < alo)
             return false;
     }
     return true;
+}
+
+size_t mci_leaf_faces_below(const mci_leaf_work *w, uint32_t f, uint32_t *below)
+{
+    uint32_t group = mci_octree_face_group(&w->s->octree, f);
+    size_t n = 0;
+    for (size_t i = 0; i < w->nstacked; i++) {
+        uint32_t h = w->stacked[i];
+        if (mci_octree_face_group(&w->s->octree, h) < group && face_boxes_meet(w, f, h) &&
+            mci_leaf_plane_relation(w, f, h) == 1)
+            below[n++] = h;
+    }
+    return n;
+}
+
+bool mci_leaf_piece_held_below(const mci_leaf_work *w, size_t p, const uint32_t *below, size_t n)
+{
+    mci_point corner[3];
+    int axis = n > 0 ? piece_corners(w, p, corner) : -1;
+    for (size_t i = 0; axis >= 0 && i < n; i++)
+        if (face_holds_piece(w, below[i], corner, axis))
+            return true;
+    return false;
 }
 
 /* A region still unknown where every step into it crosses a sheet lying in one of the

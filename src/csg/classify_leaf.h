@@ -68,6 +68,10 @@ typedef struct mci_leaf_work {
     size_t *copy_nlist;
     uint8_t *borrowed;    /* per candidate: a copy of another leaf, labelled as that one */
     mci_kept *kept_all;   /* per leaf: the kept triangles (copies' too) */
+    uint32_t *stacked;    /* a winding leaf's faces whose arrangement took a coplanar
+                             face, ascending, then room for as many (mci_leaf_select);
+                             NULL otherwise */
+    size_t nstacked;
     mci_classify_stats *stats;
     mcsg_error *err;
 } mci_leaf_work;
@@ -111,6 +115,16 @@ bool mci_leaf_label_by_ray(mci_leaf_work *w, uint32_t r, size_t c, const mci_poi
  * the numbers on both sides of a piece lying in that surface). False when nothing was
  * learnt (w->out_of_memory set when out of memory). */
 bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only);
+
+/* The faces of this winding leaf that may hold pieces of face f lying in a stack of
+ * coincident sheets: in w->stacked, in a lower group, in f's plane facing its way, with
+ * boxes meeting f's. Written to below (room for w->nstacked); returns how many. */
+size_t mci_leaf_faces_below(const mci_leaf_work *w, uint32_t f, uint32_t *below);
+/* Whether one of those faces (below[0 .. n)) holds piece p of f. Of coincident pieces
+ * that bound the solid only the lowest group's is output: own_first says so per region,
+ * and this per piece, where a region reaches beyond the stack it lies in (joined across
+ * an edge to a piece that lies in fewer sheets). */
+bool mci_leaf_piece_held_below(const mci_leaf_work *w, size_t p, const uint32_t *below, size_t n);
 
 /* Winding numbers (classify_winding.c). */
 #define MCI_WIND_UNKNOWN INT32_MIN

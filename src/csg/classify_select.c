@@ -56,8 +56,11 @@ static mcsg_status emit_arranged_face(mci_leaf_work *w, uint32_t f, size_t first
                                                 : mci_malloc_array(w->ctx, 2 * arr->tri_count, 1);
     uint8_t *tri_keep = piece_keep ? piece_keep + arr->tri_count : NULL;
     mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    uint32_t *below = w->stacked ? w->stacked + w->nstacked : NULL;
+    size_t nbelow = arr->coplanar && below ? mci_leaf_faces_below(w, f, below) : 0;
     for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
-        piece_keep[i] = o->keep[w->region[first + i]];
+        piece_keep[i] = o->keep[w->region[first + i]] &&
+                        !mci_leaf_piece_held_below(w, first + i, below, nbelow);
     if (st == MCSG_OK)
         st = mci_arr_retessellate(w->ctx, arr, piece_keep, tri_keep, w->err);
     for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
@@ -81,9 +84,12 @@ static mcsg_status emit_shared_face(mci_leaf_work *w, uint32_t f, size_t first,
                                     const owner *owners, size_t n)
 {
     const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
+    uint32_t *below = w->stacked ? w->stacked + w->nstacked : NULL;
+    size_t nbelow = arr->coplanar && below ? mci_leaf_faces_below(w, f, below) : 0;
     for (size_t k = 0; k < n; k++)
         for (size_t p = first; p < first + arr->tri_count; p++)
             if (owners[k].keep[w->region[p]] &&
+                !mci_leaf_piece_held_below(w, p, below, nbelow) &&
                 !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
                                f + owners[k].face_offset))
                 return mci_fail_nomem(w->err, "classifying faces");
@@ -224,6 +230,27 @@ static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
     return MCSG_OK;
 }
 
+/* w->stacked for a winding leaf: its faces whose arrangement took a coplanar face (and
+ * room for as many, for mci_leaf_faces_below). */
+static mcsg_status list_stacked_faces(mci_leaf_work *w)
+{
+    size_t n = 0;
+    for (uint32_t h = w->face_base; h < w->face_base + w->face_count; h++) {
+        const mci_face_arr *arr = mci_scene_arr_of_face(w->s, h);
+        n += arr && arr->coplanar;
+    }
+    if (n == 0)
+        return MCSG_OK;
+    if (!(w->stacked = mci_malloc_array(w->ctx, 2 * n, sizeof *w->stacked)))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (uint32_t h = w->face_base; h < w->face_base + w->face_count; h++) {
+        const mci_face_arr *arr = mci_scene_arr_of_face(w->s, h);
+        if (arr && arr->coplanar)
+            w->stacked[w->nstacked++] = h;
+    }
+    return MCSG_OK;
+}
+
 /* Evaluate each region's CSGlist (this leaf's and its copies') and output the pieces of
  * the kept ones. */
 mcsg_status mci_leaf_select(mci_leaf_work *w)
@@ -233,6 +260,8 @@ mcsg_status mci_leaf_select(mci_leaf_work *w)
     owner *owners = mci_malloc_array(w->ctx, n, sizeof *owners);
     uint8_t *keep = mci_malloc_array(w->ctx, n * (w->nreg + 1), 1);
     mcsg_status st = owners && keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
+    if (st == MCSG_OK && t->leaf_winding[w->leaf])
+        st = list_stacked_faces(w);
     for (size_t k = 0; k < n && st == MCSG_OK; k++) {
         uint32_t as = k == 0 ? w->leaf : w->copies[k - 1];
         owners[k] = (owner){keep + k * (w->nreg + 1), t->nodes[t->leaf_node[as]].complement,
