@@ -551,17 +551,31 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const vertex_
 }
 
 /* Whether arrangement t already has point p with the same definition among its located
- * points on an edge. Nearly always so: the neighbour across an edge meets the same
- * surfaces there and builds the same edge-plane points itself (on the bench scenes every
- * shared point is such a copy). Sharing adds only what a face lacks, so most receivers
- * stay merged: no copy, no second merge. */
-static bool has_edge_point(const mci_face_arr *t, const mci_point *p)
+ * points on its edge `at` (an MCI_AT_EDGE location; MCI_AT_INSIDE: any edge). Nearly always so: the neighbour
+ * across an edge meets the same surfaces there and builds the same edge-plane points
+ * itself (on the bench scenes every shared point is such a copy). Sharing adds only what
+ * a face lacks, so most receivers stay merged: no copy, no second merge. Only the points
+ * on that one edge are compared: a face cut by hundreds of others has thousands of
+ * points, and comparing each edge point's definition with all of them grew with the
+ * square of the cuts (the level-4 Menger sponge's faces). */
+static bool has_edge_point(const mci_face_arr *t, uint8_t at, const mci_point *p)
 {
     for (size_t q = 3; q < t->where_count; q++)
-        if (t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE &&
+        if ((t->where[q] == at ||
+             (at == MCI_AT_INSIDE && t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE)) &&
             mci_points_same_definition(t->points[q], p))
             return true;
     return false;
+}
+
+/* The edge of face nb across which face f lies, as an MCI_AT_EDGE location; MCI_AT_INSIDE
+ * if none (where a leaf's edges pair unevenly). */
+static uint8_t edge_toward(const mci_scene *s, uint32_t nb, uint32_t f)
+{
+    for (int k = 0; k < 3; k++)
+        if (s->neighbour[3 * (size_t)nb + k] == f)
+            return (uint8_t)(MCI_AT_EDGE + k);
+    return MCI_AT_INSIDE;
 }
 
 /* The arrangement that point p of arr should also be in (its edge neighbour's), or NULL
@@ -570,13 +584,15 @@ static mci_face_arr *share_target(const mci_scene *s, const mci_face_arr *arr, s
 {
     uint32_t nb;
     mci_face_arr *t;
+    uint8_t at;
     if (arr->where[p] < MCI_AT_EDGE || arr->where[p] >= MCI_AT_INSIDE)
         return NULL;
     nb = s->neighbour[3 * (size_t)arr->face + (arr->where[p] - MCI_AT_EDGE)];
     if (nb == MCI_NONE || is_dropped(s, s->arr_of[nb]))
         return NULL; /* a face dropped whole has no pieces to join (see collect_walls) */
     t = &s->arrs[s->arr_of[nb]];
-    return has_edge_point(t, arr->points[p]) ? NULL : t;
+    at = edge_toward(s, nb, arr->face);
+    return has_edge_point(t, at, arr->points[p]) ? NULL : t;
 }
 
 /* Which arrangements have an edge point their neighbour lacks: a read-only pass over
