@@ -460,8 +460,10 @@ static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, i
 }
 
 /* Whether face h holds piece p (corners given, projected along axis): its closed triangle
- * holds the corners. The piece lies in no coplanar face's border (those borders are
- * separators and constraints of the piece's face), so this tells whether h holds it. */
+ * holds the corners. A coplanar face's borders are constraints of the piece's face, so
+ * the piece lies on one side of each, except where the face across such a border lies
+ * flat in the same plane (no constraint: intersect_arrange.c, edge_is_crease): a piece
+ * straddling that border is held by neither face as tested here. */
 static bool face_holds_piece(const mci_leaf_work *w, uint32_t h, const mci_point corner[3],
                              int axis)
 {

@@ -551,20 +551,22 @@ static mcsg_status add_receivers(const mci_ctx *ctx, mci_scene *s, const vertex_
 }
 
 /* Whether arrangement t already has point p with the same definition among its located
- * points on its edge `at` (an MCI_AT_EDGE location; MCI_AT_INSIDE: any edge). Nearly always so: the neighbour
- * across an edge meets the same surfaces there and builds the same edge-plane points
- * itself (on the bench scenes every shared point is such a copy). Sharing adds only what
- * a face lacks, so most receivers stay merged: no copy, no second merge. Only the points
- * on that one edge are compared: a face cut by hundreds of others has thousands of
- * points, and comparing each edge point's definition with all of them grew with the
- * square of the cuts (the level-4 Menger sponge's faces). */
+ * points on its edge `at` (an MCI_AT_EDGE location; MCI_AT_INSIDE: on any edge). Nearly
+ * always so: the neighbour across an edge meets the same surfaces there and builds the
+ * same edge-plane points itself (on the bench scenes every shared point is such a copy).
+ * Sharing adds only what a face lacks, so most receivers stay merged: no copy, no second
+ * merge. Only the points on that one edge are compared: a face cut by hundreds of others
+ * has thousands of points, and comparing each edge point's definition with all of them
+ * grew with the square of the cuts (the level-4 Menger sponge's faces). */
 static bool has_edge_point(const mci_face_arr *t, uint8_t at, const mci_point *p)
 {
-    for (size_t q = 3; q < t->where_count; q++)
-        if ((t->where[q] == at ||
-             (at == MCI_AT_INSIDE && t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE)) &&
-            mci_points_same_definition(t->points[q], p))
+    for (size_t q = 3; q < t->where_count; q++) {
+        bool on_edge = at == MCI_AT_INSIDE
+                           ? t->where[q] >= MCI_AT_EDGE && t->where[q] < MCI_AT_INSIDE
+                           : t->where[q] == at;
+        if (on_edge && mci_points_same_definition(t->points[q], p))
             return true;
+    }
     return false;
 }
 
