@@ -518,27 +518,93 @@ static bool face_boxes_meet(const mci_leaf_work *w, uint32_t f, uint32_t h)
     return true;
 }
 
-size_t mci_leaf_faces_below(const mci_leaf_work *w, uint32_t f, uint32_t *below)
+size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *faces,
+                                 int8_t *facing)
 {
-    uint32_t group = mci_octree_face_group(&w->s->octree, f);
     size_t n = 0;
     for (size_t i = 0; i < w->nstacked; i++) {
         uint32_t h = w->stacked[i];
-        if (mci_octree_face_group(&w->s->octree, h) < group && face_boxes_meet(w, f, h) &&
-            mci_leaf_plane_relation(w, f, h) == 1)
-            below[n++] = h;
+        int relation = h != f && face_boxes_meet(w, f, h) ? mci_leaf_plane_relation(w, f, h) : 0;
+        if (relation != 0) {
+            faces[n] = h;
+            facing[n++] = (int8_t)relation;
+        }
     }
     return n;
 }
 
-bool mci_leaf_piece_held_below(const mci_leaf_work *w, size_t p, const uint32_t *below, size_t n)
+/* Where point q lies about face h's closed triangle, projected along axis: 1 inside, 0
+ * on its border, -1 outside. */
+static int face_side(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
 {
-    mci_point corner[3];
-    int axis = n > 0 ? piece_corners(w, p, corner) : -1;
-    for (size_t i = 0; axis >= 0 && i < n; i++)
-        if (face_holds_piece(w, below[i], corner, axis))
+    const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
+    const uint32_t *t = m->triangles + 3 * (size_t)(h - w->face_base);
+    mci_point c[3];
+    int turn, on_border = 0;
+    for (int i = 0; i < 3; i++)
+        mci_point_explicit(&c[i], m->vertices + 3 * (size_t)t[i]);
+    turn = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
+    for (int i = 0; i < 3; i++) {
+        int side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], q, axis);
+        if (side != 0 && side != turn)
+            return -1;
+        on_border |= side == 0;
+    }
+    return on_border ? 0 : 1;
+}
+
+/* The stack at a point strictly inside piece p off every candidate face's border; false
+ * when no attempt gives one. */
+static bool stack_at_inner_point(const mci_leaf_work *w, size_t p, const uint32_t *faces,
+                                 const int8_t *facing, size_t n, int32_t *coin, bool *first)
+{
+    uint32_t group = mci_octree_face_group(&w->s->octree, w->pface[p]);
+    for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS; attempt++) {
+        double ends[2][3];
+        mci_point q;
+        mci_plane at;
+        int sign, axis;
+        bool clear = true;
+        if (!mci_leaf_piece_inside(w, p, attempt, ends, &q, &at) ||
+            (axis = mci_plane_projection_axis(&at, &sign)) < 0)
+            continue;
+        *coin = 1;
+        *first = true;
+        for (size_t i = 0; clear && i < n; i++) {
+            int side = face_side(w, faces[i], &q, axis);
+            clear = side != 0;
+            if (side <= 0)
+                continue;
+            *coin += facing[i];
+            if (facing[i] > 0 && mci_octree_face_group(&w->s->octree, faces[i]) < group)
+                *first = false;
+        }
+        if (clear)
             return true;
+    }
     return false;
+}
+
+void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *faces,
+                          const int8_t *facing, size_t n, int32_t *coin, bool *first)
+{
+    uint32_t group = mci_octree_face_group(&w->s->octree, w->pface[p]);
+    mci_point corner[3];
+    int axis;
+    *coin = 1;
+    *first = true;
+    if (n == 0 || stack_at_inner_point(w, p, faces, facing, n, coin, first))
+        return;
+    *coin = 1;
+    *first = true;
+    axis = piece_corners(w, p, corner);
+    for (size_t i = 0; axis >= 0 && i < n; i++) {
+        if (!face_holds_piece(w, faces[i], corner, axis))
+            continue;
+        *coin += facing[i];
+        if (facing[i] > 0 && mci_octree_face_group(&w->s->octree, faces[i]) < group)
+            *first = false;
+    }
 }
 
 /* A region still unknown where every step into it crosses a sheet lying in one of the

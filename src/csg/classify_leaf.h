@@ -71,6 +71,7 @@ typedef struct mci_leaf_work {
     uint32_t *stacked;    /* a winding leaf's faces whose arrangement took a coplanar
                              face, ascending, then room for as many (mci_leaf_select);
                              NULL otherwise */
+    int8_t *stacked_facing; /* room for nstacked (mci_leaf_coincident_faces) */
     size_t nstacked;
     mci_classify_stats *stats;
     mcsg_error *err;
@@ -116,15 +117,20 @@ bool mci_leaf_label_by_ray(mci_leaf_work *w, uint32_t r, size_t c, const mci_poi
  * learnt (w->out_of_memory set when out of memory). */
 bool mci_leaf_labels_from_inside(mci_leaf_work *w, uint32_t r, bool winding_only);
 
-/* The faces of this winding leaf that may hold pieces of face f lying in a stack of
- * coincident sheets: in w->stacked, in a lower group, in f's plane facing its way, with
- * boxes meeting f's. Written to below (room for w->nstacked); returns how many. */
-size_t mci_leaf_faces_below(const mci_leaf_work *w, uint32_t f, uint32_t *below);
-/* Whether one of those faces (below[0 .. n)) holds piece p of f. Of coincident pieces
- * that bound the solid only the lowest group's is output: own_first says so per region,
- * and this per piece, where a region reaches beyond the stack it lies in (joined across
- * an edge to a piece that lies in fewer sheets). */
-bool mci_leaf_piece_held_below(const mci_leaf_work *w, size_t p, const uint32_t *below, size_t n);
+/* The faces of this winding leaf that may lie where face f does: in w->stacked, in f's
+ * plane, with boxes meeting f's; facing[i] 1 where faces[i] faces f's way, -1 where it
+ * faces the other. Both have room for w->nstacked; returns how many. */
+size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *faces,
+                                 int8_t *facing);
+/* The stack piece p lies in, from those faces (faces[0 .. n) of its face f): *coin, how
+ * much more the leaf's winding number is behind p than in front (1 for f, plus one for
+ * each face holding p that faces its way, less one for each facing the other), and
+ * *first, whether no face holding p faces its way in a lower group. A face holds p where
+ * its closed triangle holds a point strictly inside p and off every listed face's
+ * border (a border between two faces of one flat region is no constraint, and may cross
+ * p); failing such a point, where it holds p's corners. */
+void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *faces,
+                          const int8_t *facing, size_t n, int32_t *coin, bool *first);
 
 /* Winding numbers (classify_winding.c). */
 #define MCI_WIND_UNKNOWN INT32_MIN

@@ -43,7 +43,64 @@ typedef struct owner {
     bool reversed;
     mci_kept *kept;
     uint32_t face_offset;
+    size_t k;            /* w->ncopies for the leaf itself, else the copy's index */
+    const uint8_t *piece_keep; /* per piece, where pieces are decided one by one (a
+                                  winding leaf with stacks, decide_pieces); else NULL */
 } owner;
+
+/* Whether owner o keeps piece p. */
+static bool owner_keeps(const mci_leaf_work *w, const owner *o, size_t p)
+{
+    return o->piece_keep ? o->piece_keep[p] : o->keep[w->region[p]];
+}
+
+static int region_accepts(mci_leaf_work *w, uint32_t r, size_t k);
+static bool off_own_boundary(const mci_leaf_work *w, uint32_t r);
+
+/* Faces lying where face f does, in a winding leaf (mci_leaf_coincident_faces): a view
+ * of w's arrays, n = 0 for a face in no stack (a face that another overlaps in its plane
+ * took it into its arrangement: only such faces are listed in w->stacked). */
+typedef struct coincident {
+    const uint32_t *faces;
+    const int8_t *facing;
+    size_t n;
+} coincident;
+
+static coincident coincident_faces(const mci_leaf_work *w, uint32_t f)
+{
+    const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
+    coincident c = {NULL, NULL, 0};
+    if (w->stacked && arr && arr->coplanar) {
+        uint32_t *faces = w->stacked + w->nstacked;
+        c.n = mci_leaf_coincident_faces(w, f, faces, w->stacked_facing);
+        c.faces = faces;
+        c.facing = w->stacked_facing;
+    }
+    return c;
+}
+
+/* Whether owner o keeps piece p: its region's decision, with the stack the piece lies
+ * in (mci_leaf_piece_stack: none but its own face's sheet for a face in no stack) in
+ * place of the region's; where that turns the piece into a border of the leaf's solid,
+ * the region's CSGlist decides. */
+static bool piece_kept(mci_leaf_work *w, const owner *o, size_t p, const coincident *c)
+{
+    uint32_t r = w->region[p];
+    int32_t coin, front;
+    bool first, own;
+    int accepts;
+    front = w->own_front[r];
+    mci_leaf_piece_stack(w, p, c->faces, c->facing, c->n, &coin, &first);
+    own = front <= 0 && front + coin > 0 && first;
+    if (own == !off_own_boundary(w, r))
+        return o->keep[r];
+    if (!own || (o->k == w->ncopies ? w->rejected : w->copy_nlist[o->k] == SIZE_MAX))
+        return false;
+    accepts = region_accepts(w, r, o->k);
+    if (o->k != w->ncopies)
+        w->leaf_labels[w->leaf] = MCI_LABEL_OUT; /* as trimming left it */
+    return accepts == 1;
+}
 
 /* The kept triangles of arranged face f, whose pieces start at piece `first`, after
  * re-tessellating it with its valid constraints only. */
@@ -56,11 +113,8 @@ static mcsg_status emit_arranged_face(mci_leaf_work *w, uint32_t f, size_t first
                                                 : mci_malloc_array(w->ctx, 2 * arr->tri_count, 1);
     uint8_t *tri_keep = piece_keep ? piece_keep + arr->tri_count : NULL;
     mcsg_status st = piece_keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
-    uint32_t *below = w->stacked ? w->stacked + w->nstacked : NULL;
-    size_t nbelow = arr->coplanar && below ? mci_leaf_faces_below(w, f, below) : 0;
     for (size_t i = 0; st == MCSG_OK && i < arr->tri_count; i++)
-        piece_keep[i] = o->keep[w->region[first + i]] &&
-                        !mci_leaf_piece_held_below(w, first + i, below, nbelow);
+        piece_keep[i] = owner_keeps(w, o, first + i);
     if (st == MCSG_OK)
         st = mci_arr_retessellate(w->ctx, arr, piece_keep, tri_keep, w->err);
     for (size_t t = 0; st == MCSG_OK && t < arr->tri_count; t++) {
@@ -84,12 +138,9 @@ static mcsg_status emit_shared_face(mci_leaf_work *w, uint32_t f, size_t first,
                                     const owner *owners, size_t n)
 {
     const mci_face_arr *arr = mci_scene_arr_of_face(w->s, f);
-    uint32_t *below = w->stacked ? w->stacked + w->nstacked : NULL;
-    size_t nbelow = arr->coplanar && below ? mci_leaf_faces_below(w, f, below) : 0;
     for (size_t k = 0; k < n; k++)
         for (size_t p = first; p < first + arr->tri_count; p++)
-            if (owners[k].keep[w->region[p]] &&
-                !mci_leaf_piece_held_below(w, p, below, nbelow) &&
+            if (owner_keeps(w, &owners[k], p) &&
                 !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
                                f + owners[k].face_offset))
                 return mci_fail_nomem(w->err, "classifying faces");
@@ -105,7 +156,7 @@ static const owner *face_owner(const mci_leaf_work *w, size_t first, size_t coun
     *n = 0;
     for (size_t k = 0; k < n_owners; k++)
         for (size_t p = first; p < first + count; p++)
-            if (owners[k].keep[w->region[p]]) {
+            if (owner_keeps(w, &owners[k], p)) {
                 found = &owners[k];
                 ++*n;
                 break;
@@ -131,7 +182,7 @@ static mcsg_status emit_kept(mci_leaf_work *w, const owner *owners, size_t n_own
             continue;
         }
         for (size_t k = 0; k < n_owners && st == MCSG_OK; k++)
-            if (owners[k].keep[w->region[p]] &&
+            if (owner_keeps(w, &owners[k], p) &&
                 !push_triangle(w->ctx, owners[k].kept, w->pv + 3 * p, owners[k].reversed,
                                f + owners[k].face_offset))
                 st = mci_fail_nomem(w->err, "classifying faces");
@@ -231,7 +282,7 @@ static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
 }
 
 /* w->stacked for a winding leaf: its faces whose arrangement took a coplanar face (and
- * room for as many, for mci_leaf_faces_below). */
+ * room for as many, for mci_leaf_coincident_faces). */
 static mcsg_status list_stacked_faces(mci_leaf_work *w)
 {
     size_t n = 0;
@@ -241,7 +292,9 @@ static mcsg_status list_stacked_faces(mci_leaf_work *w)
     }
     if (n == 0)
         return MCSG_OK;
-    if (!(w->stacked = mci_malloc_array(w->ctx, 2 * n, sizeof *w->stacked)))
+    w->stacked = mci_malloc_array(w->ctx, 2 * n, sizeof *w->stacked);
+    w->stacked_facing = mci_malloc_array(w->ctx, n, sizeof *w->stacked_facing);
+    if (!w->stacked || !w->stacked_facing)
         return mci_fail_nomem(w->err, "classifying faces");
     for (uint32_t h = w->face_base; h < w->face_base + w->face_count; h++) {
         const mci_face_arr *arr = mci_scene_arr_of_face(w->s, h);
@@ -249,6 +302,28 @@ static mcsg_status list_stacked_faces(mci_leaf_work *w)
             w->stacked[w->nstacked++] = h;
     }
     return MCSG_OK;
+}
+
+/* In a winding leaf whose faces lie in stacks of coincident sheets, each piece decided
+ * with the stack it lies in (piece_kept): a region's own_coin and own_first are those at
+ * its seed, and a region can reach beyond the stack its seed lies in (a face in a stack
+ * is joined to same-facing faces of its plane, and their pieces to pieces under fewer
+ * sheets). Sets each owner's piece_keep (*out: the array, n x np). */
+static mcsg_status decide_pieces(mci_leaf_work *w, owner *owners, size_t n, uint8_t **out)
+{
+    uint8_t *keep = mci_malloc_array(w->ctx, n * w->np + 1, 1);
+    if (!(*out = keep))
+        return mci_fail_nomem(w->err, "classifying faces");
+    for (size_t p = 0, end; p < w->np; p = end) {
+        uint32_t f = w->pface[p];
+        coincident c = coincident_faces(w, f);
+        for (end = p; end < w->np && w->pface[end] == f; end++)
+            for (size_t k = 0; k < n; k++)
+                keep[k * w->np + end] = piece_kept(w, &owners[k], end, &c);
+    }
+    for (size_t k = 0; k < n; k++)
+        owners[k].piece_keep = keep + k * w->np;
+    return w->out_of_memory ? mci_fail_nomem(w->err, "classifying faces") : MCSG_OK;
 }
 
 /* Evaluate each region's CSGlist (this leaf's and its copies') and output the pieces of
@@ -259,6 +334,7 @@ mcsg_status mci_leaf_select(mci_leaf_work *w)
     size_t n = w->ncopies + 1;
     owner *owners = mci_malloc_array(w->ctx, n, sizeof *owners);
     uint8_t *keep = mci_malloc_array(w->ctx, n * (w->nreg + 1), 1);
+    uint8_t *piece_keep = NULL;
     mcsg_status st = owners && keep ? MCSG_OK : mci_fail_nomem(w->err, "classifying faces");
     if (st == MCSG_OK && t->leaf_winding[w->leaf])
         st = list_stacked_faces(w);
@@ -266,11 +342,15 @@ mcsg_status mci_leaf_select(mci_leaf_work *w)
         uint32_t as = k == 0 ? w->leaf : w->copies[k - 1];
         owners[k] = (owner){keep + k * (w->nreg + 1), t->nodes[t->leaf_node[as]].complement,
                             &w->kept_all[as],
-                            w->s->octree.face_base[as] - w->s->octree.face_base[w->leaf]};
+                            w->s->octree.face_base[as] - w->s->octree.face_base[w->leaf],
+                            k == 0 ? w->ncopies : k - 1, NULL};
         st = decide_regions(w, k == 0 ? w->ncopies : k - 1, keep + k * (w->nreg + 1));
     }
+    if (st == MCSG_OK && w->stacked)
+        st = decide_pieces(w, owners, n, &piece_keep);
     st = st == MCSG_OK ? emit_kept(w, owners, n) : st;
     mci_free(w->ctx, owners);
     mci_free(w->ctx, keep);
+    mci_free(w->ctx, piece_keep);
     return st;
 }

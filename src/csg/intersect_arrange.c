@@ -170,11 +170,15 @@ static bool index_hits(const mci_ctx *ctx, const mci_scene *s, const mci_hit_lis
     return true;
 }
 
-/* Whether the surface bends at edge i of face f (the face across is not coplanar; an
- * open edge counts as a crease). */
+/* Whether the surface bends at edge i of face f: the face across is not coplanar, or
+ * lies folded back onto f (its third corner in f's half-plane about the edge: a shell
+ * crossing itself, a sliver turned over by rounding), where the sheets covering the
+ * plane change as at a bend; an open edge counts as a crease. Across any other edge the
+ * flat region goes on, and faces lying on it take the edge as no constraint. */
 static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t f, int i)
 {
     uint32_t nb = s->neighbour[3 * (size_t)f + i];
+    const double *corners[3] = {plane->a, plane->b, plane->c};
     mci_point far;
     if (nb == MCI_NONE)
         return true;
@@ -183,8 +187,9 @@ static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t 
         if (v == plane->a || v == plane->b || v == plane->c)
             continue;
         mci_point_explicit(&far, v);
-        if (mci_orient3d(&far, plane) != 0)
-            return true;
+        return mci_orient3d(&far, plane) != 0 ||
+               mci_half_plane_class(corners[i], corners[(i + 1) % 3], corners[(i + 2) % 3],
+                                    v) == 0;
     }
     return false;
 }

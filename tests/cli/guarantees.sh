@@ -87,7 +87,8 @@ contains "non-manifold edges"
 rm -f "$WORK/f5.off"
 run 0 eval "$ROUNDING/frame-turn-makes-crossings-5-leaves.scad" -o "$WORK/f5.off" -v
 lacks "warning"
-contains "turning a group's result made 12 pairs of its triangles cross; 2 corners moved"
+contains "turning a group's result made"
+contains "corners moved by a unit in the last place mend them"
 run 0 check --self-intersections "$WORK/f5.off"
 contains "ok: no self-intersections"
 
@@ -102,7 +103,7 @@ lacks "warning"
 contains "it is evaluated as a mesh that crosses itself"
 lacks "failed"
 run 0 check --self-intersections "$WORK/fb.off"
-contains "ok: 51 vertices, 98 triangles, 1 component, volume 92942.942591863626"
+contains "ok: 51 vertices, 98 triangles, 1 component, volume 92942.9425918635"
 contains "ok: no self-intersections"
 
 printf 'union() { cube(1); translate([1, 1, 0]) cube(1); }\n' > "$WORK/touching.scad"
