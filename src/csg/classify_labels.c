@@ -440,23 +440,30 @@ static bool own_carried(mci_leaf_work *w, size_t k, uint32_t from, int32_t *fron
     return true;
 }
 
-/* Whether the closed triangle of face h (an input triangle in the plane of the points)
- * holds point q, projected along axis. */
-static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
+/* Where point q lies about the closed triangle of face h (an input triangle in the plane
+ * of the points), projected along axis: 1 inside, 0 on its border, -1 outside. */
+static int face_side(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
 {
     const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
     const uint32_t *t = m->triangles + 3 * (size_t)(h - w->face_base);
     mci_point c[3];
-    int turn;
+    int turn, on_border = 0;
     for (int i = 0; i < 3; i++)
         mci_point_explicit(&c[i], m->vertices + 3 * (size_t)t[i]);
     turn = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
     for (int i = 0; i < 3; i++) {
         int side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], q, axis);
         if (side != 0 && side != turn)
-            return false;
+            return -1;
+        on_border |= side == 0;
     }
-    return true;
+    return on_border ? 0 : 1;
+}
+
+/* Whether face h's closed triangle holds point q, projected along axis. */
+static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
+{
+    return face_side(w, h, q, axis) >= 0;
 }
 
 /* Whether face h holds piece p (corners given, projected along axis): its closed triangle
@@ -531,26 +538,6 @@ size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *f
         }
     }
     return n;
-}
-
-/* Where point q lies about face h's closed triangle, projected along axis: 1 inside, 0
- * on its border, -1 outside. */
-static int face_side(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
-{
-    const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
-    const uint32_t *t = m->triangles + 3 * (size_t)(h - w->face_base);
-    mci_point c[3];
-    int turn, on_border = 0;
-    for (int i = 0; i < 3; i++)
-        mci_point_explicit(&c[i], m->vertices + 3 * (size_t)t[i]);
-    turn = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
-    for (int i = 0; i < 3; i++) {
-        int side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], q, axis);
-        if (side != 0 && side != turn)
-            return -1;
-        on_border |= side == 0;
-    }
-    return on_border ? 0 : 1;
 }
 
 /* The stack at a point strictly inside piece p off every candidate face's border; false
