@@ -540,6 +540,16 @@ size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *f
     return n;
 }
 
+/* One more face holding a piece of a face in `group`: *coin and *first as
+ * mci_leaf_piece_stack counts them. */
+static void add_sheet(const mci_leaf_work *w, uint32_t group, uint32_t h, int8_t facing,
+                      int32_t *coin, bool *first)
+{
+    *coin += facing;
+    if (facing > 0 && mci_octree_face_group(&w->s->octree, h) < group)
+        *first = false;
+}
+
 /* The stack at a point strictly inside piece p off every candidate face's border; false
  * when no attempt gives one. */
 static bool stack_at_inner_point(const mci_leaf_work *w, size_t p, const uint32_t *faces,
@@ -560,11 +570,8 @@ static bool stack_at_inner_point(const mci_leaf_work *w, size_t p, const uint32_
         for (size_t i = 0; clear && i < n; i++) {
             int side = face_side(w, faces[i], &q, axis);
             clear = side != 0;
-            if (side <= 0)
-                continue;
-            *coin += facing[i];
-            if (facing[i] > 0 && mci_octree_face_group(&w->s->octree, faces[i]) < group)
-                *first = false;
+            if (side > 0)
+                add_sheet(w, group, faces[i], facing[i], coin, first);
         }
         if (clear)
             return true;
@@ -585,13 +592,9 @@ void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *face
     *coin = 1;
     *first = true;
     axis = piece_corners(w, p, corner);
-    for (size_t i = 0; axis >= 0 && i < n; i++) {
-        if (!face_holds_piece(w, faces[i], corner, axis))
-            continue;
-        *coin += facing[i];
-        if (facing[i] > 0 && mci_octree_face_group(&w->s->octree, faces[i]) < group)
-            *first = false;
-    }
+    for (size_t i = 0; axis >= 0 && i < n; i++)
+        if (face_holds_piece(w, faces[i], corner, axis))
+            add_sheet(w, group, faces[i], facing[i], coin, first);
 }
 
 /* A region still unknown where every step into it crosses a sheet lying in one of the

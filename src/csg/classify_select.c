@@ -80,18 +80,13 @@ static coincident coincident_faces(const mci_leaf_work *w, uint32_t f)
 }
 
 /* Whether owner o keeps piece p: its region's decision, with the stack the piece lies
- * in (mci_leaf_piece_stack: none but its own face's sheet for a face in no stack) in
- * place of the region's; where that turns the piece into a border of the leaf's solid,
- * the region's CSGlist decides. */
-static bool piece_kept(mci_leaf_work *w, const owner *o, size_t p, const coincident *c)
+ * in (own: whether the piece bounds the leaf's solid by its own stack, as
+ * mci_leaf_piece_stack counts it) in place of the region's; where that turns the piece
+ * into a border of the leaf's solid, the region's CSGlist decides. */
+static bool piece_kept(mci_leaf_work *w, const owner *o, size_t p, bool own)
 {
     uint32_t r = w->region[p];
-    int32_t coin, front;
-    bool first, own;
     int accepts;
-    front = w->own_front[r];
-    mci_leaf_piece_stack(w, p, c->faces, c->facing, c->n, &coin, &first);
-    own = front <= 0 && front + coin > 0 && first;
     if (own == !off_own_boundary(w, r))
         return o->keep[r];
     if (!own || (o->k == w->ncopies ? w->rejected : w->copy_nlist[o->k] == SIZE_MAX))
@@ -317,9 +312,14 @@ static mcsg_status decide_pieces(mci_leaf_work *w, owner *owners, size_t n, uint
     for (size_t p = 0, end; p < w->np; p = end) {
         uint32_t f = w->pface[p];
         coincident c = coincident_faces(w, f);
-        for (end = p; end < w->np && w->pface[end] == f; end++)
+        for (end = p; end < w->np && w->pface[end] == f; end++) {
+            int32_t coin, front = w->own_front[w->region[end]];
+            bool first, own;
+            mci_leaf_piece_stack(w, end, c.faces, c.facing, c.n, &coin, &first);
+            own = front <= 0 && front + coin > 0 && first;
             for (size_t k = 0; k < n; k++)
-                keep[k * w->np + end] = piece_kept(w, &owners[k], end, &c);
+                keep[k * w->np + end] = piece_kept(w, &owners[k], end, own);
+        }
     }
     for (size_t k = 0; k < n; k++)
         owners[k].piece_keep = keep + k * w->np;
