@@ -1394,6 +1394,65 @@ TEST(input_contract_is_checked)
     }
 }
 
+/* op(cube, slab) through the API, the slab [-0.5,1.5]^2 x [1,1.5] lying on the cube's
+ * top face and reaching past its edges; the output's volume and triangle count. */
+static bool cube_and_slab(const mcsg_mesh *cube, mcsg_node_kind op, double *volume,
+                          size_t *triangles)
+{
+    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    static const double on_top[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.5, 0, 0, 1, 1.25};
+    double size[3] = {2, 2, 0.5};
+    mcsg_tree *tree;
+    mcsg_mesh slab, out;
+    mcsg_node_id ids[2], root;
+    mcsg_error err;
+    mcsg_status st;
+    CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
+    CHECK_OK(mcsg_make_cube(size, 1, NULL, &slab, &err), &err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, cube, identity, "cube", &ids[0], &err), &err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, &slab, on_top, "slab", &ids[1], &err), &err);
+    CHECK_OK(mcsg_tree_add_op(tree, op, ids, 2, NULL, &root, &err), &err);
+    CHECK_OK(mcsg_tree_set_root(tree, root, &err), &err);
+    st = mcsg_eval(tree, NULL, &out, NULL, NULL, &err);
+    CHECK_MSG(st == MCSG_OK, "%s", err.message);
+    if (st == MCSG_OK) {
+        *volume = test_signed_volume(&out);
+        *triangles = out.triangle_count;
+        mcsg_mesh_free(&out, NULL);
+    }
+    mcsg_mesh_free(&slab, NULL);
+    mcsg_tree_free(tree);
+    return st == MCSG_OK;
+}
+
+/* A leaf whose triangles each have their own three vertices (a triangle soup, as STL
+ * files and meshes read without welding give) is the same solid as the welded one: its
+ * faces are neighbours by coordinates, and its cube's edges are still where the surface
+ * bends. Taken as flat once, the slab's bottom face had no constraint along the cube's
+ * edges and its triangulation failed. */
+TEST(triangle_soup_leaf_is_its_welded_solid)
+{
+    double v[3 * 36];
+    uint32_t t[36];
+    mcsg_mesh welded = {(double *)contract_cube_v, (uint32_t *)contract_cube_t, 8, 12};
+    mcsg_mesh soup = {v, t, 36, 12};
+    static const mcsg_node_kind ops[] = {MCSG_NODE_UNION, MCSG_NODE_DIFFERENCE,
+                                         MCSG_NODE_INTERSECTION};
+    static const double volumes[] = {3, 1, 0};
+    for (int i = 0; i < 36; i++) {
+        memcpy(v + 3 * i, contract_cube_v + 3 * contract_cube_t[i], 3 * sizeof *v);
+        t[i] = (uint32_t)i;
+    }
+    for (int k = 0; k < 3; k++) {
+        double vs = -1, vw = -1;
+        size_t ts = 0, tw = 0;
+        if (!cube_and_slab(&soup, ops[k], &vs, &ts) || !cube_and_slab(&welded, ops[k], &vw, &tw))
+            continue;
+        CHECK_MSG(vs == volumes[k] && vw == volumes[k] && ts == tw,
+                  "op %d: soup %.17g (%zu triangles), welded %.17g (%zu)", k, vs, ts, vw, tw);
+    }
+}
+
 /* Zero-area triangles bound nothing (no solid angle from any point off them) and are
  * removed before evaluation; one with three distinct corners takes a split of its
  * neighbour across its long edge with it, so the leaf stays closed. Provenance names
@@ -1497,6 +1556,7 @@ int main(void)
     RUN(intersect_reports_progress_and_can_cancel);
     RUN(output_check_tells_what_rounding_broke);
     RUN(input_contract_is_checked);
+    RUN(triangle_soup_leaf_is_its_welded_solid);
     RUN(zero_area_triangles_are_removed);
     RUN(leaves_with_several_shells);
     RUN(leaves_with_crossing_shells);

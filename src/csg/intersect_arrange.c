@@ -175,6 +175,13 @@ static bool index_hits(const mci_ctx *ctx, const mci_scene *s, const mci_hit_lis
  * crossing itself, a sliver turned over by rounding), where the sheets covering the
  * plane change as at a bend; an open edge counts as a crease. Across any other edge the
  * flat region goes on, and faces lying on it take the edge as no constraint. */
+/* Whether two vertices are one point: a leaf may hold copies of a vertex (where parts
+ * touch), and faces are neighbours across an edge by coordinates. */
+static bool same_vertex(const double *u, const double *v)
+{
+    return u == v || (u[0] == v[0] && u[1] == v[1] && u[2] == v[2]);
+}
+
 static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t f, int i)
 {
     uint32_t nb = s->neighbour[3 * (size_t)f + i];
@@ -184,7 +191,7 @@ static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t 
         return true;
     for (int k = 0; k < 3; k++) {
         const double *v = mci_scene_corner(s, nb, k);
-        if (v == plane->a || v == plane->b || v == plane->c)
+        if (same_vertex(v, plane->a) || same_vertex(v, plane->b) || same_vertex(v, plane->c))
             continue;
         mci_point_explicit(&far, v);
         return mci_orient3d(&far, plane) != 0 ||
