@@ -126,7 +126,9 @@ typedef struct mcsg_options {
                                      models, more on long slivers), and evaluates
                                      a leaf with a shell that crosses itself exactly, by
                                      its winding number, its faces intersected with each
-                                     other */
+                                     other. Zero tests only the leaves with several
+                                     shells, a negative or zero volume or an edge of
+                                     more than two triangles */
     int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
                                    triangles that cross each other (exact, costs about as
                                    much as an evaluation; see mcsg_output_check) */
@@ -607,11 +609,14 @@ typedef struct mcsg_eval_stats {
  * docs/robustness.md). This is checked first; the first leaf that fails it gives
  * MCSG_ERR_INVALID_MESH with a message naming the leaf (its label: file or primitive, and
  * position in the CSG text) and an example of the problem. A shell that crosses itself
- * is evaluated exactly when opts->check_self_intersections asks for the test up front
- * (it costs about a third of an evaluation on scanned models), or when an internal consistency check
- * trips on it (the leaves are tested then, and the faces evaluated again); otherwise its
- * faces are not compared with each other and the result is unspecified (a mesh that may
- * not be the intended set; see docs/robustness.md).
+ * is evaluated exactly when its leaf is tested up front: always where the leaf has
+ * several shells, a negative or zero volume or an edge of more than two triangles, and
+ * in every leaf when opts->check_self_intersections asks (it costs about a third of an
+ * evaluation on scanned models); or when an internal consistency check trips on it (the
+ * leaves are tested then, and the faces evaluated again). Otherwise (one shell of
+ * positive volume, not tested) its faces are not compared with each other and the
+ * result is unspecified (a mesh that may not be the intended set; see
+ * docs/robustness.md).
  * The result is checked before it is returned (stats->output_check): rounding to doubles
  * can break a guarantee where the exact result has features below the spacing of
  * doubles. Then, where triangles cross, their corners are moved by one unit in the last

@@ -479,6 +479,55 @@ TEST(fold_edges_bound_their_sheets)
     expect_clean_winding_leaf("rounding/fold-edges-in-a-flat-region.off", 0xf01d5);
 }
 
+/* A hexagonal frustum with one bottom corner pushed up through its top (fuzz seed
+ * 0xfc62763d0f4250fb, folds family): one shell crossing itself, of negative volume
+ * (-3.75), whose winding number is +1 only in a lobe above the top (volume about 0.13).
+ * Without asking for the shells to be tested, such a leaf was taken as not crossing
+ * itself, and came out empty (alone) or open (unioned with a box that its lobe nearly
+ * touches). A leaf that only winding numbers tell is now always tested. */
+TEST(shell_folded_through_itself_found_without_asking)
+{
+    static const double v[] = {0.8285343647237764, -1.9134181540245112, 1.5401402744709511,
+                              2.7617812157459207, -0.9567090770122556, -1.2321122195767609,
+                              1.6570687294475526, -0.9567090770122556, -1.2321122195767609,
+                              1.1047124862983684, -1.9134181540245112, -1.2321122195767609,
+                              1.6570687294475526, -2.8701272310367667, -1.2321122195767609,
+                              2.7617812157459207, -2.8701272310367667, -1.2321122195767609,
+                              3.1749959159973815, -1.9134181540245112, 1.2321122195767609,
+                              2.692210444297059, -1.0772091878834464, 1.2321122195767609,
+                              1.7266395008964144, -1.0772091878834464, 1.2321122195767609,
+                              1.243854029196092, -1.9134181540245112, 1.2321122195767609,
+                              1.7266395008964144, -2.749627120165576, 1.2321122195767609,
+                              2.692210444297059, -2.749627120165576, 1.2321122195767609};
+    static const uint32_t t[] = {0, 7, 1, 0, 6, 7, 1, 8, 2, 1, 7, 8,
+                                2, 9, 3, 2, 8, 9, 3, 10, 4, 3, 9, 10,
+                                4, 11, 5, 4, 10, 11, 5, 6, 0, 5, 11, 6,
+                                5, 3, 4, 5, 2, 3, 5, 1, 2, 5, 0, 1,
+                                6, 8, 7, 6, 9, 8, 6, 10, 9, 6, 11, 10};
+    mcsg_mesh m = {(double *)v, (uint32_t *)t, 12, 20}, box;
+    const double size[3] = {2, 2, 2};
+    const double moved[12] = {1, 0, 0, 2.5, 0, 1, 0, -1.2, 0, 0, 1, 2.3};
+    mcsg_tree *tree = NULL;
+    mcsg_node_id ids[2];
+    mcsg_error err;
+    csg_result r;
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "frustum", &ids[0], &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0xf01d, false, true, false, &r), "%s", r.why);
+    CHECK_MSG(r.checked > 100 && r.inside > 5, "%zu points checked, %zu inside", r.checked,
+              r.inside);
+    mcsg_tree_free(tree);
+    CHECK_OK(mcsg_make_cube(size, 1, NULL, &box, &err), &err);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "frustum", &ids[0], &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, &box, moved, "box", &ids[1], &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, NULL, &err) == MCSG_OK);
+    CHECK_MSG(csg_check_tree(tree, NULL, 0xf01e, false, true, false, &r), "%s", r.why);
+    mcsg_tree_free(tree);
+    mcsg_mesh_free(&box, NULL);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -491,6 +540,7 @@ int main(void)
     RUN(needle_region_decided_from_neighbours);
     RUN(stacked_sheets_of_one_shell_output_once);
     RUN(fold_edges_bound_their_sheets);
+    RUN(shell_folded_through_itself_found_without_asking);
     RUN(saved_regressions);
     RUN(random_trees);
     csg_free_models();

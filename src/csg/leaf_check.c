@@ -12,9 +12,11 @@
  * message (its label says which file or primitive it came from, and where in the CSG
  * text) with the first offending edge, triangle or vertex; nothing is evaluated.
  * Shells crossing themselves are looked for (csg/shell_crossing.c, exact, about a third
- * of an evaluation on scanned models) when the options ask, in primitives where a
- * surface of one shell enters another's wedge at an edge (mci_edge_mates.entering_edges),
- * and, by the test that counts every pair, when evaluation stops on an internal
+ * of an evaluation on scanned models) when the options ask, in every primitive marked
+ * for winding numbers (several shells, an inward volume, a shell meeting itself at an
+ * edge: rare in clean input, so clean scenes pay nothing), in the leaves a tree asks
+ * for (a frame's turned result), and, by the test that counts every pair, when
+ * evaluation stops on an internal
  * consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
  * evaluated with their faces intersected with each other.
  */
@@ -205,12 +207,13 @@ static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_che
     t->leaf_crossing[k] |= no_volume;
     t->leaf_winding[k] = report->components > 1 || report->volume_sign < 0 ||
                          t->leaf_mates[k].count > 0 || no_volume;
-    /* A leaf where one surface of a shell enters another's wedge at an edge (a part nested
-     * in another and joined to it there) often overlaps itself in their common faces
-     * too: such leaves, rare in clean input, are always tested; every leaf when the
-     * options ask. */
+    /* A leaf that only winding numbers tell (several shells, an inward volume, a shell
+     * meeting itself at an edge) is rare in clean input and often crosses itself: a
+     * shell folded through itself mostly encloses a negative volume, and a part nested
+     * in another and joined to it at an edge overlaps it in their common faces. Such
+     * leaves are always tested; every leaf when the options ask. */
     if (t->leaf_crossing[k] ||
-        (!job->ctx->check_self_intersections && t->leaf_mates[k].entering_edges == 0 &&
+        (!job->ctx->check_self_intersections && !t->leaf_winding[k] &&
          !mci_tree_tests_crossing(job->tree, t->leaf_source[k])))
         return MCSG_OK;
     return find_crossing(job, k, err);
