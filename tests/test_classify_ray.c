@@ -323,6 +323,47 @@ TEST(triangles_below_the_unit_get_inside_points)
     CHECK(found >= 0);
 }
 
+/* A needle in the plane x = 69.60141415711261 whose middle corner lies a unit (1.8e-15)
+ * from the far corner, on the line through the other two within about 1e-31: far
+ * thinner than any line near its middle resolves (the sliver search moves its line by
+ * units of the offset along the long edge, about 1e-32 there). Next to the middle
+ * corner, an input vertex, a line from far away meets the plane 2^-112 of a unit from
+ * it, inside. The only piece of a region in the rounded result of fuzz seed
+ * 0xe2096d867567563a evaluated again; with no point to cast a ray from, its winding
+ * numbers were undecided. */
+TEST(needles_below_double_double_get_inside_points)
+{
+    static const double a[3] = {69.60141415711261, 1.1187469739708047, 18.968332756382562},
+                        b[3] = {69.60141415711261, 11.755378344372957, 8.33170138598041},
+                        c[3] = {69.60141415711261, 11.755378344372959, 8.331701385980407};
+    mci_plane plane;
+    mci_point corner[3], out;
+    double ends[2][3];
+    bool near_middle = false;
+    mci_plane_init(&plane, a, b, c);
+    mci_point_explicit(&corner[0], a);
+    mci_point_explicit(&corner[1], b);
+    mci_point_explicit(&corner[2], c);
+    for (int attempt = 0; attempt < MCI_INSIDE_WEIGHTED; attempt++)
+        near_middle |= mci_point_inside_triangle(corner, &plane, attempt, ends, &out);
+    CHECK(!near_middle); /* the case needs the corner's attempts */
+    CHECK(inside_point_found(a, b, c));
+    CHECK(inside_point_found(c, a, b));
+    {
+        /* Two corners 6e-64 apart in x at x = 5e-50 (a rounded result's vertices near
+         * 0), the third 0.13 away: the point must lie within about 1e-64 of a corner,
+         * 2^-160 of the unit of its other coordinates (fuzz seed 0x323af87d8f33eb18). */
+        static const double p[3] = {5.0806567214241748e-50, -25.000000000000004,
+                                    -28.867506729742217},
+                            q[3] = {5.0806567214241169e-50, -25.000000000000004,
+                                    -28.867506729742217},
+                            r[3] = {0.11309941359603591, -25.000000000000004,
+                                    -28.802208722412153};
+        CHECK(inside_point_found(p, q, r));
+        CHECK(inside_point_found(q, p, r));
+    }
+}
+
 TEST(box_overlaps_match_every_pair)
 {
     mci_ctx ctx;
@@ -370,5 +411,6 @@ int main(void)
     RUN(slivers_get_inside_points);
     RUN(tiny_triangles_get_inside_points);
     RUN(triangles_below_the_unit_get_inside_points);
+    RUN(needles_below_double_double_get_inside_points);
     return test_summary();
 }

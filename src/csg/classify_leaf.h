@@ -159,15 +159,19 @@ void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local)
  * (an LPI of input vertices: `ends` holds the line's two ends, and *plane the face's
  * plane, which the point refers to). False when the doubles do not give a line crossing
  * the plane or a point strictly inside (slivers). */
-#define MCI_INSIDE_ATTEMPTS 4
+#define MCI_INSIDE_WEIGHTED 4
+#define MCI_INSIDE_ATTEMPTS (MCI_INSIDE_WEIGHTED + 96)
 /* The same for the triangle with corners c[0..2] (input vertices or implicit points)
  * lying in `plane`: a point strictly inside it where the line through a point of the
  * corners' approximate triangle along the plane's approximate normal pierces the plane
  * (an LPI of input vertices; `ends` holds the line's two ends, which *out refers to).
- * The last attempt also searches a sliver narrower than the spacing of doubles (a line
- * from next to its long edge to a far end moved a unit at a time). A plane whose normal
- * rounds to zero in doubles is crossed along its projection axis. False when no point
- * strictly inside was found. */
+ * The last of the first MCI_INSIDE_WEIGHTED attempts also searches a sliver narrower
+ * than the spacing of doubles (a line from next to its long edge to a far end moved a
+ * unit at a time). The 96 after them look next to a corner that is an input vertex (by
+ * angle, largest first) in 16 directions at two distances, for a triangle thinner still
+ * (a corner nearly on the line through the others, far below the spacing of doubles). A plane
+ * whose normal rounds to zero in doubles is crossed along its projection axis. False
+ * when no point strictly inside was found. */
 bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int attempt,
                                double ends[2][3], mci_point *out);
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],

@@ -237,24 +237,98 @@ static bool point_inside_tiny(const mci_point c[3], const mci_plane *plane, doub
            mci_orient2d_projected(&c[2], &c[0], out, axis) == turn;
 }
 
+/* The corners' angles from their doubles x, largest first: order[0..2]. */
+static void corners_by_angle(double x[3][3], int order[3])
+{
+    double angle[3];
+    for (int i = 0; i < 3; i++) {
+        double u[3], v[3], dot = 0, cross = 0;
+        for (int k = 0; k < 3; k++) {
+            u[k] = x[(i + 1) % 3][k] - x[i][k];
+            v[k] = x[(i + 2) % 3][k] - x[i][k];
+            dot += u[k] * v[k];
+        }
+        for (int k = 0; k < 3; k++) {
+            double c = u[(k + 1) % 3] * v[(k + 2) % 3] - u[(k + 2) % 3] * v[(k + 1) % 3];
+            cross += c * c;
+        }
+        angle[i] = atan2(sqrt(cross), dot);
+        order[i] = i;
+    }
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && angle[order[j]] > angle[order[j - 1]]; j--) {
+            int t = order[j];
+            order[j] = order[j - 1], order[j - 1] = t;
+        }
+}
+
+/* A point strictly inside a triangle too thin for a line near its middle to be found
+ * piercing it (its width below what doubles near its coordinates resolve: a corner a
+ * unit from another, nearly on the line through the other two), next to a corner that
+ * is an input vertex: the line from that corner moved a unit off the plane to a far
+ * end on the other side, moved a unit within the plane in one of 16 directions (about
+ * 22.5 degrees apart in the projection). It meets the plane next to the corner, inside
+ * the triangle when that direction lies strictly within the corner's angle and the
+ * triangle is wider than the distance there. `pick` chooses the corner (pick % 3, by
+ * angle, largest first), the direction (pick / 3 % 16) and how far the far end is: 2^60
+ * times the coordinates (the point about 2^-112 of a unit from the corner) for the
+ * first 48, 2^600 times (2^-652 of a unit: slower exact arithmetic) for the next 48. */
+static bool point_inside_at_corner(const mci_point c[3], double x[3][3],
+                                   const mci_plane *plane, int pick, double ends[2][3],
+                                   mci_point *out)
+{
+    static const int step[16][2] = {{1, 0},   {2, 1},   {1, 1},   {1, 2},
+                                    {0, 1},   {-1, 2},  {-1, 1},  {-2, 1},
+                                    {-1, 0},  {-2, -1}, {-1, -1}, {-1, -2},
+                                    {0, -1},  {1, -2},  {1, -1},  {2, -1}};
+    const mci_point *corner;
+    double big = 0, unit;
+    int order[3], sign, axis = mci_plane_projection_axis(plane, &sign), s0, turn;
+    corners_by_angle(x, order);
+    corner = &c[order[pick % 3]];
+    if (axis < 0 || corner->kind != MCI_POINT_EXPLICIT)
+        return false;
+    for (int k = 0; k < 3; k++)
+        big = fmax(big, fabs(corner->v[0][k]));
+    unit = ldexp(1.0, (big > 0 ? ilogb(big) : -1022) - 52);
+    memcpy(ends[0], corner->v[0], sizeof ends[0]);
+    for (int n = 0; (s0 = mci_orient3d_vertex(ends[0], plane)) == 0; n++) {
+        if (n == 64)
+            return false;
+        ends[0][axis] += unit;
+    }
+    memcpy(ends[1], corner->v[0], sizeof ends[1]);
+    ends[1][(axis + 1) % 3] += step[pick / 3 % 16][0] * unit;
+    ends[1][(axis + 2) % 3] += step[pick / 3 % 16][1] * unit;
+    ends[1][axis] -= (ends[0][axis] > corner->v[0][axis] ? 1 : -1) *
+                     ldexp(big + 1, pick < 48 ? 60 : 600);
+    if (mci_orient3d_vertex(ends[1], plane) != -s0 || !mci_point_lpi(out, ends[0], ends[1], plane))
+        return false;
+    turn = mci_orient2d_projected(&c[0], &c[1], out, axis);
+    return turn != 0 && mci_orient2d_projected(&c[1], &c[2], out, axis) == turn &&
+           mci_orient2d_projected(&c[2], &c[0], out, axis) == turn;
+}
+
 /* See classify_leaf.h. */
 bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int attempt,
                                 double ends[2][3], mci_point *out)
 {
     /* Barycentric weights, the centroid first: a point on the border of a face of another
      * surface lying in this one decides nothing, and another point rarely is too. */
-    static const double weight[MCI_INSIDE_ATTEMPTS][3] = {
+    static const double weight[MCI_INSIDE_WEIGHTED][3] = {
         {1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.3, 0.2}, {0.2, 0.5, 0.3}, {0.3, 0.2, 0.5}};
-    const double *wt = weight[attempt];
+    const double *wt = weight[attempt < MCI_INSIDE_WEIGHTED ? attempt : 0];
     double x[3][3], n[3], size = 0, norm = approx_normal(plane, n);
     int axis, sign, turns[3];
     for (int i = 0; i < 3; i++)
         mci_point_near(&c[i], x[i]);
+    if (attempt >= MCI_INSIDE_WEIGHTED)
+        return point_inside_at_corner(c, x, plane, attempt - MCI_INSIDE_WEIGHTED, ends, out);
     for (int k = 0; k < 3; k++) {
         for (int v = 0; v < 3; v++)
             size = fmax(size, fabs(x[v][k] - x[(v + 1) % 3][k]));
     }
-    if (!(size > 0) && attempt == MCI_INSIDE_ATTEMPTS - 1) /* corners on one double */
+    if (!(size > 0) && attempt == MCI_INSIDE_WEIGHTED - 1) /* corners on one double */
         return point_inside_tiny(c, plane, ends, out);
     if (!(norm > 0) || !(size > 0) || !isfinite(norm) || !isfinite(size))
         return false;
@@ -274,7 +348,7 @@ bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int
         if (turns[0] != 0 && turns[0] == turns[1] && turns[1] == turns[2])
             return true;
     }
-    if (attempt != MCI_INSIDE_ATTEMPTS - 1)
+    if (attempt != MCI_INSIDE_WEIGHTED - 1)
         return false;
     return point_inside_sliver(c, x, plane, ends, out) || point_inside_tiny(c, plane, ends, out);
 }
