@@ -117,15 +117,25 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
     return MCSG_OK;
 }
 
+/* Room for a half-edge twin list of leaf k (3 per triangle), or NULL when out of
+ * memory. */
+static uint32_t *twin_room(const leaf_check_job *job, size_t k)
+{
+    return mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
+                            3 * sizeof(uint32_t));
+}
+
 /* Leaf k's report and shells (per triangle, in shell[]), after removing its zero-area
- * triangles if they are its only problem (*shell reallocated then). */
+ * triangles if they are its only problem (*shell reallocated then). With *twin (a leaf
+ * that will be tested for crossing itself), its half-edge twins as well, from the same
+ * pass (*twin reallocated with the shells). */
 static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_report *report,
-                                uint32_t **shell, mcsg_error *err)
+                                uint32_t **shell, uint32_t **twin, mcsg_error *err)
 {
     mci_edge_mates *mates = &job->ptree->leaf_mates[k];
     size_t removed;
     mcsg_status st = mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell,
-                                           NULL, mates, err);
+                                           *twin, mates, err);
     if (st != MCSG_OK || !only_zero_area(report))
         return st;
     if ((st = remove_zero_area(job, k, &removed, err)) != MCSG_OK || removed == 0)
@@ -134,9 +144,13 @@ static mcsg_status check_shells(const leaf_check_job *job, size_t k, mcsg_check_
     mci_edge_mates_free(job->ctx, mates);
     *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
                               sizeof **shell);
-    if (!*shell)
+    if (*twin) {
+        mci_free(job->ctx, *twin);
+        *twin = twin_room(job, k);
+    }
+    if (!*shell || (!*twin && job->ctx->check_self_intersections))
         return mci_fail_nomem(err, "checking the leaves");
-    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, NULL,
+    return mci_mesh_check_shells(job->ctx, job->ptree->leaf_mesh[k], report, *shell, *twin,
                                  mates, err);
 }
 
@@ -155,9 +169,10 @@ static const mci_crossing_boxes *crossing_boxes(const leaf_check_job *job, size_
 }
 
 /* Marks leaf k (leaf_crossing, leaf_winding) when a shell of it crosses itself: the fast
- * exact test of csg/shell_crossing.c, on the half-edge twins of a second pass of the
- * mesh check (only the leaves tested pay for them). */
-static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error *err)
+ * exact test of csg/shell_crossing.c, on the half-edge twins of the mesh check (`known`,
+ * when it listed them; else from a second pass, which only the leaves tested pay for). */
+static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint32_t *known,
+                                 mcsg_error *err)
 {
     mci_crossing_boxes boxes;
     mci_ptree *t = job->ptree;
@@ -166,11 +181,12 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error
     mcsg_check_report report;
     uint32_t example[2];
     bool crosses = false;
-    uint32_t *twin = mci_malloc_array(job->ctx, m->triangle_count + 1, 3 * sizeof *twin);
-    mcsg_status st = twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
-                          : mci_fail_nomem(err, "checking the leaves");
+    uint32_t *twin = known ? NULL : twin_room(job, k);
+    mcsg_status st = known ? MCSG_OK
+                     : twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
+                            : mci_fail_nomem(err, "checking the leaves");
     if (st == MCSG_OK)
-        st = mci_find_shell_crossing_boxed(job->ctx, m, t->leaf_shell[k], twin,
+        st = mci_find_shell_crossing_boxed(job->ctx, m, t->leaf_shell[k], known ? known : twin,
                                            crossing_boxes(job, k, &boxes), &crosses, example,
                                            &stats, err);
     mci_free(job->ctx, twin);
@@ -195,7 +211,7 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, mcsg_error
  * winding numbers tell, leaf_crossing where its faces must be intersected with each
  * other. */
 static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_check_report *report,
-                             mcsg_error *err)
+                             const uint32_t *twin, mcsg_error *err)
 {
     mci_ptree *t = job->ptree;
     /* Where one shell meets itself at an edge, parts of it may lie inside others or face
@@ -216,7 +232,7 @@ static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_che
         (!job->ctx->check_self_intersections && !t->leaf_winding[k] &&
          !mci_tree_tests_crossing(job->tree, t->leaf_source[k])))
         return MCSG_OK;
-    return find_crossing(job, k, err);
+    return find_crossing(job, k, twin, err);
 }
 
 static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
@@ -228,8 +244,12 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     char problem[400];
     uint32_t *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
                                        sizeof *shell);
-    mcsg_status st = shell ? check_shells(job, k, &report, &shell, err)
-                           : mci_fail_nomem(err, "checking the leaves");
+    /* A leaf sure to be tested for crossing itself gets its twins from the check's pass. */
+    uint32_t *twin = job->ctx->check_self_intersections || mci_tree_tests_crossing(job->tree, node)
+                         ? twin_room(job, k) : NULL;
+    mcsg_status st = shell && (twin || !job->ctx->check_self_intersections)
+                         ? check_shells(job, k, &report, &shell, &twin, err)
+                         : mci_fail_nomem(err, "checking the leaves");
     if (st == MCSG_OK) {
         describe_problem(job->ptree->leaf_mesh[k], &report, problem, sizeof problem);
         if (problem[0] == '\0' && report.components > 1) {
@@ -238,12 +258,13 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
             shell = NULL;
         }
         if (problem[0] == '\0')
-            st = mark_kind(job, k, &report, err);
+            st = mark_kind(job, k, &report, twin, err);
         else
             st = mci_fail(err, MCSG_ERR_INVALID_MESH, "leaf %u%s%s: %s", node,
                           label[0] ? ", " : "", label, problem);
     }
     mci_free(job->ctx, shell);
+    mci_free(job->ctx, twin);
     return st;
 }
 
