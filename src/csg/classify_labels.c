@@ -440,43 +440,36 @@ static bool own_carried(mci_leaf_work *w, size_t k, uint32_t from, int32_t *fron
     return true;
 }
 
-/* Where point q lies about the closed triangle of face h (an input triangle in the plane
- * of the points), projected along axis: 1 inside, 0 on its border, -1 outside. */
-static int face_side(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
+/* Whether face h's triangle (an input triangle in the plane of the piece) holds the
+ * piece with these corners, projected along axis: whether it holds the point
+ * corner[0] + e (corner[1] - corner[0]) + e^2 (corner[2] - corner[0]) for every small
+ * enough e > 0, a point strictly inside the piece next to its first corner. An
+ * orientation is linear in its last point, so each side of h is the sign for the first
+ * corner off that side's line, in that order (not all three lie on one line): the point
+ * never lies on h's border (a piece's corners often do), and no point need be built,
+ * however thin the piece (no line through doubles may pierce a piece far narrower than
+ * their spacing). A coplanar
+ * face's borders are constraints of the piece's face, so h holds all of the piece or
+ * none, except across a border with a face lying flat in the same plane (no
+ * constraint: intersect_arrange.c, edge_is_crease): each of the two holds part of the
+ * piece then, and one of them this point. */
+static bool face_holds_piece(const mci_leaf_work *w, uint32_t h, const mci_point corner[3],
+                             int axis)
 {
     const mcsg_mesh *m = w->s->octree.leaves[w->leaf];
     const uint32_t *t = m->triangles + 3 * (size_t)(h - w->face_base);
     mci_point c[3];
-    int turn, on_border = 0;
+    int turn;
     for (int i = 0; i < 3; i++)
         mci_point_explicit(&c[i], m->vertices + 3 * (size_t)t[i]);
     turn = mci_orient2d_projected(&c[0], &c[1], &c[2], axis);
     for (int i = 0; i < 3; i++) {
-        int side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], q, axis);
-        if (side != 0 && side != turn)
-            return -1;
-        on_border |= side == 0;
-    }
-    return on_border ? 0 : 1;
-}
-
-/* Whether face h's closed triangle holds point q, projected along axis. */
-static bool face_holds(const mci_leaf_work *w, uint32_t h, const mci_point *q, int axis)
-{
-    return face_side(w, h, q, axis) >= 0;
-}
-
-/* Whether face h holds piece p (corners given, projected along axis): its closed triangle
- * holds the corners. A coplanar face's borders are constraints of the piece's face, so
- * the piece lies on one side of each, except where the face across such a border lies
- * flat in the same plane (no constraint: intersect_arrange.c, edge_is_crease): a piece
- * straddling that border is held by neither face as tested here. */
-static bool face_holds_piece(const mci_leaf_work *w, uint32_t h, const mci_point corner[3],
-                             int axis)
-{
-    for (int i = 0; i < 3; i++)
-        if (!face_holds(w, h, &corner[i], axis))
+        int side = 0;
+        for (int k = 0; k < 3 && side == 0; k++)
+            side = mci_orient2d_projected(&c[i], &c[(i + 1) % 3], &corner[k], axis);
+        if (side != turn)
             return false;
+    }
     return true;
 }
 
@@ -550,48 +543,14 @@ static void add_sheet(const mci_leaf_work *w, uint32_t group, uint32_t h, int8_t
         *first = false;
 }
 
-/* The stack at a point strictly inside piece p off every candidate face's border; false
- * when no attempt gives one. */
-static bool stack_at_inner_point(const mci_leaf_work *w, size_t p, const uint32_t *faces,
-                                 const int8_t *facing, size_t n, int32_t *coin, bool *first)
-{
-    uint32_t group = mci_octree_face_group(&w->s->octree, w->pface[p]);
-    for (int attempt = 0; attempt < MCI_INSIDE_ATTEMPTS; attempt++) {
-        double ends[2][3];
-        mci_point q;
-        mci_plane at;
-        int sign, axis;
-        bool clear = true;
-        if (!mci_leaf_piece_inside(w, p, attempt, ends, &q, &at) ||
-            (axis = mci_plane_projection_axis(&at, &sign)) < 0)
-            continue;
-        *coin = 1;
-        *first = true;
-        for (size_t i = 0; clear && i < n; i++) {
-            int side = face_side(w, faces[i], &q, axis);
-            clear = side != 0;
-            if (side > 0)
-                add_sheet(w, group, faces[i], facing[i], coin, first);
-        }
-        if (clear)
-            return true;
-    }
-    return false;
-}
-
 void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *faces,
                           const int8_t *facing, size_t n, int32_t *coin, bool *first)
 {
     uint32_t group = mci_octree_face_group(&w->s->octree, w->pface[p]);
     mci_point corner[3];
-    int axis;
+    int axis = n > 0 ? piece_corners(w, p, corner) : -1;
     *coin = 1;
     *first = true;
-    if (n == 0 || stack_at_inner_point(w, p, faces, facing, n, coin, first))
-        return;
-    *coin = 1;
-    *first = true;
-    axis = piece_corners(w, p, corner);
     for (size_t i = 0; axis >= 0 && i < n; i++)
         if (face_holds_piece(w, faces[i], corner, axis))
             add_sheet(w, group, faces[i], facing[i], coin, first);

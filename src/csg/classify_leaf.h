@@ -126,9 +126,9 @@ size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *f
  * much more the leaf's winding number is behind p than in front (1 for f, plus one for
  * each face holding p that faces its way, less one for each facing the other), and
  * *first, whether no face holding p faces its way in a lower group. A face holds p where
- * its closed triangle holds a point strictly inside p and off every listed face's
- * border (a border between two faces of one flat region is no constraint, and may cross
- * p); failing such a point, where it holds p's corners. */
+ * its triangle holds the points of p next to p's first corner (a symbolic point, never
+ * on a face's border: a border between two faces of one flat region is no constraint,
+ * and may cross p). */
 void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *faces,
                           const int8_t *facing, size_t n, int32_t *coin, bool *first);
 
