@@ -302,6 +302,9 @@ static bool point_inside_at_corner(const mci_point c[3], double x[3][3],
     ends[1][(axis + 2) % 3] += step[pick / 3 % 16][1] * unit;
     ends[1][axis] -= (ends[0][axis] > corner->v[0][axis] ? 1 : -1) *
                      ldexp(big + 1, pick < 48 ? 60 : 600);
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(ends[0][k]) || !isfinite(ends[1][k])) /* coordinates near the limit */
+            return false;
     if (mci_orient3d_vertex(ends[1], plane) != -s0 || !mci_point_lpi(out, ends[0], ends[1], plane))
         return false;
     turn = mci_orient2d_projected(&c[0], &c[1], out, axis);

@@ -170,11 +170,6 @@ static bool index_hits(const mci_ctx *ctx, const mci_scene *s, const mci_hit_lis
     return true;
 }
 
-/* Whether the surface bends at edge i of face f: the face across is not coplanar, or
- * lies folded back onto f (its third corner in f's half-plane about the edge: a shell
- * crossing itself, a sliver turned over by rounding), where the sheets covering the
- * plane change as at a bend; an open edge counts as a crease. Across any other edge the
- * flat region goes on, and faces lying on it take the edge as no constraint. */
 /* Whether two vertices are one point: a leaf may hold copies of a vertex (where parts
  * touch), and faces are neighbours across an edge by coordinates. */
 static bool same_vertex(const double *u, const double *v)
@@ -182,6 +177,11 @@ static bool same_vertex(const double *u, const double *v)
     return u == v || (u[0] == v[0] && u[1] == v[1] && u[2] == v[2]);
 }
 
+/* Whether the surface bends at edge i of face f: the face across is not coplanar, or
+ * lies folded back onto f (its third corner in f's half-plane about the edge: a shell
+ * crossing itself, a sliver turned over by rounding), where the sheets covering the
+ * plane change as at a bend; an open edge counts as a crease. Across any other edge the
+ * flat region goes on, and faces lying on it take the edge as no constraint. */
 static bool edge_is_crease(const mci_scene *s, const mci_plane *plane, uint32_t f, int i)
 {
     uint32_t nb = s->neighbour[3 * (size_t)f + i];

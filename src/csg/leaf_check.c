@@ -245,8 +245,8 @@ static mcsg_status check_one(void *user, size_t k, mcsg_error *err)
     uint32_t *shell = mci_malloc_array(job->ctx, job->ptree->leaf_mesh[k]->triangle_count + 1,
                                        sizeof *shell);
     /* A leaf sure to be tested for crossing itself gets its twins from the check's pass. */
-    uint32_t *twin = job->ctx->check_self_intersections || mci_tree_tests_crossing(job->tree, node)
-                         ? twin_room(job, k) : NULL;
+    bool tested = job->ctx->check_self_intersections || mci_tree_tests_crossing(job->tree, node);
+    uint32_t *twin = tested ? twin_room(job, k) : NULL;
     mcsg_status st = shell && (twin || !job->ctx->check_self_intersections)
                          ? check_shells(job, k, &report, &shell, &twin, err)
                          : mci_fail_nomem(err, "checking the leaves");
