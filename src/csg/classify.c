@@ -175,7 +175,8 @@ static void free_work(mci_leaf_work *w)
                    w->reg_start, w->reg_pieces, w->sep_start, w->sep_slots, w->cand,
                    w->slot_of_leaf, w->labels, w->needed, w->list, w->scratch,
                    w->leaf_labels, w->blist_slot, w->cand_winding, w->wind, w->coin, w->own_front,
-                   w->own_coin, w->own_first, w->stacked, w->stacked_facing};
+                   w->own_coin, w->own_first, w->stacked, w->stacked_facing,
+                   w->sheet_key};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         mci_free(w->ctx, all[i]);
     for (size_t k = 0; w->copy_list && k < w->ncopies; k++)

@@ -533,27 +533,28 @@ size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *f
     return n;
 }
 
-/* One more face holding a piece of a face in `group`: *coin and *first as
- * mci_leaf_piece_stack counts them. */
-static void add_sheet(const mci_leaf_work *w, uint32_t group, uint32_t h, int8_t facing,
+/* One more face h holding a piece of face f: *coin and *first as mci_leaf_piece_stack
+ * counts them. A face of f's own sheet holds f's piece only where the sheet overlaps
+ * itself (turning more than once about a vertex in its plane): the lower face first. */
+static void add_sheet(const mci_leaf_work *w, uint32_t f, uint32_t h, int8_t facing,
                       int32_t *coin, bool *first)
 {
+    uint64_t kh = w->sheet_key[h - w->face_base], kf = w->sheet_key[f - w->face_base];
     *coin += facing;
-    if (facing > 0 && mci_octree_face_group(&w->s->octree, h) < group)
+    if (facing > 0 && (kh < kf || (kh == kf && h < f)))
         *first = false;
 }
 
 void mci_leaf_piece_stack(const mci_leaf_work *w, size_t p, const uint32_t *faces,
                           const int8_t *facing, size_t n, int32_t *coin, bool *first)
 {
-    uint32_t group = mci_octree_face_group(&w->s->octree, w->pface[p]);
     mci_point corner[3];
     int axis = n > 0 ? piece_corners(w, p, corner) : -1;
     *coin = 1;
     *first = true;
     for (size_t i = 0; axis >= 0 && i < n; i++)
         if (face_holds_piece(w, faces[i], corner, axis))
-            add_sheet(w, group, faces[i], facing[i], coin, first);
+            add_sheet(w, w->pface[p], faces[i], facing[i], coin, first);
 }
 
 /* A region still unknown where every step into it crosses a sheet lying in one of the

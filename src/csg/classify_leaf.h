@@ -73,6 +73,12 @@ typedef struct mci_leaf_work {
                              NULL otherwise */
     int8_t *stacked_facing; /* room for nstacked (mci_leaf_coincident_faces) */
     size_t nstacked;
+    /* With stacked: per face of the leaf (from face_base), its sheet's key: faces joined
+     * across edges to a neighbour in their plane facing their way (a flat region, whose
+     * inner borders are no constraints) share the least (group << 32 | face) among
+     * them. Which coincident sheet comes first is decided by these keys, constant over
+     * a sheet (a shell crossing itself has a group per face). */
+    uint64_t *sheet_key;
     mci_classify_stats *stats;
     mcsg_error *err;
 } mci_leaf_work;

@@ -276,8 +276,43 @@ static mcsg_status decide_regions(mci_leaf_work *w, size_t k, uint8_t *keep)
     return MCSG_OK;
 }
 
+/* w->sheet_key (see classify_leaf.h): faces joined across edges to their neighbours in
+ * the same plane facing the same way (mci_leaf_plane_relation 1; a face folded back
+ * onto the same side faces the other way, and its edge bounds the sheet). */
+static mcsg_status find_sheets(mci_leaf_work *w)
+{
+    uint32_t n = w->face_count, base = w->face_base;
+    uint32_t *parent = mci_malloc_array(w->ctx, n + 1, sizeof *parent);
+    w->sheet_key = mci_malloc_array(w->ctx, n + 1, sizeof *w->sheet_key);
+    if (!parent || !w->sheet_key) {
+        mci_free(w->ctx, parent);
+        return mci_fail_nomem(w->err, "classifying faces");
+    }
+    for (uint32_t f = 0; f < n; f++) {
+        parent[f] = f;
+        w->sheet_key[f] = UINT64_MAX;
+    }
+    for (uint32_t f = 0; f < n; f++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t nb = w->s->neighbour[3 * (size_t)(base + f) + k];
+            if (nb != MCI_NONE && nb > base + f && nb < base + n &&
+                mci_leaf_plane_relation(w, base + f, nb) == 1)
+                parent[mci_find_root(parent, nb - base)] = mci_find_root(parent, f);
+        }
+    for (uint32_t f = 0; f < n; f++) {
+        uint32_t root = mci_find_root(parent, f);
+        uint64_t key = (uint64_t)mci_octree_face_group(&w->s->octree, base + f) << 32 | f;
+        if (key < w->sheet_key[root])
+            w->sheet_key[root] = key;
+    }
+    for (uint32_t f = 0; f < n; f++)
+        w->sheet_key[f] = w->sheet_key[mci_find_root(parent, f)];
+    mci_free(w->ctx, parent);
+    return MCSG_OK;
+}
+
 /* w->stacked for a winding leaf: its faces whose arrangement took a coplanar face (and
- * room for as many, for mci_leaf_coincident_faces). */
+ * room for as many, for mci_leaf_coincident_faces), and the sheets of its faces. */
 static mcsg_status list_stacked_faces(mci_leaf_work *w)
 {
     size_t n = 0;
@@ -296,7 +331,7 @@ static mcsg_status list_stacked_faces(mci_leaf_work *w)
         if (arr && arr->coplanar)
             w->stacked[w->nstacked++] = h;
     }
-    return MCSG_OK;
+    return find_sheets(w);
 }
 
 /* In a winding leaf whose faces lie in stacks of coincident sheets, each piece decided
