@@ -418,27 +418,36 @@ TEST(needle_region_decided_from_neighbours)
     mcsg_mesh_free(&m, NULL);
 }
 
+/* A leaf alone in a union: the mesh in test data file `name` (*m), evaluated (*out,
+ * *st) with its shells tested and its crossings checked, one thread. */
+static mcsg_tree *evaluate_leaf_alone(const char *name, mcsg_mesh *m, mcsg_mesh *out,
+                                      mcsg_eval_stats *st)
+{
+    mcsg_options opts = {0};
+    mcsg_tree *tree = NULL;
+    mcsg_node_id leaf;
+    mcsg_error err;
+    opts.threads = 1;
+    opts.check_self_intersections = 1;
+    opts.check_output_crossings = 1;
+    CHECK_OK(mcsg_mesh_read(test_data(name), MCSG_FORMAT_AUTO, NULL, m, &err), &err);
+    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_leaf(tree, m, NULL, name, &leaf, &err) == MCSG_OK);
+    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
+    CHECK_OK(mcsg_eval(tree, &opts, out, NULL, st, &err), &err);
+    return tree;
+}
+
 /* The mesh in test data file `name`, a shell crossing itself, evaluated alone by its
  * winding number with its crossings checked: a clean closed mesh (nothing for rounding
  * to report), of the mesh's own volume (its winding number is 0 or 1 everywhere), that
  * the oracle agrees with. */
 static void expect_clean_winding_leaf(const char *name, uint64_t seed)
 {
-    mcsg_options opts = {0};
     mcsg_mesh m, out;
     mcsg_eval_stats st;
-    mcsg_tree *tree = NULL;
-    mcsg_node_id leaf;
-    mcsg_error err;
     csg_result r;
-    opts.threads = 1;
-    opts.check_self_intersections = 1;
-    opts.check_output_crossings = 1;
-    CHECK_OK(mcsg_mesh_read(test_data(name), MCSG_FORMAT_AUTO, NULL, &m, &err), &err);
-    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
-    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, name, &leaf, &err) == MCSG_OK);
-    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
-    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    mcsg_tree *tree = evaluate_leaf_alone(name, &m, &out, &st);
     CHECK_MSG(!mcsg_output_check_failed(&st.output_check) && st.output_check.open_edges == 0 &&
                   st.output_check.index_nonmanifold_edges == 0,
               "%s: open %zu, not manifold by index %zu, crossing %zu", name,
@@ -539,22 +548,10 @@ TEST(shell_folded_through_itself_found_without_asking)
  * 0x5af83a17601fa799 (79 leaves, shrunk to 6), as the outer evaluation takes it. */
 TEST(back_to_back_fans_leave_no_holes)
 {
-    mcsg_options opts = {0};
     mcsg_mesh m, out;
     mcsg_eval_stats st;
-    mcsg_tree *tree = NULL;
-    mcsg_node_id leaf;
-    mcsg_error err;
     csg_result r;
-    opts.threads = 1;
-    opts.check_self_intersections = 1;
-    opts.check_output_crossings = 1;
-    CHECK_OK(mcsg_mesh_read(test_data("rounding/back-to-back-fans.off"), MCSG_FORMAT_AUTO, NULL,
-                            &m, &err), &err);
-    CHECK(mcsg_tree_create(NULL, &tree, &err) == MCSG_OK);
-    CHECK(mcsg_tree_add_leaf(tree, &m, NULL, "fans", &leaf, &err) == MCSG_OK);
-    CHECK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, &leaf, 1, NULL, NULL, &err) == MCSG_OK);
-    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    mcsg_tree *tree = evaluate_leaf_alone("rounding/back-to-back-fans.off", &m, &out, &st);
     CHECK_MSG(st.output_check.open_edges == 0 && st.output_check.index_nonmanifold_edges == 0,
               "open %zu, not manifold by index %zu", st.output_check.open_edges,
               st.output_check.index_nonmanifold_edges);
