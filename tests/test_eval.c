@@ -1313,22 +1313,34 @@ static const double contract_cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0,
 static const uint32_t contract_cube_t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
                                            1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
 
+static const double identity_matrix[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+
+/* The tree op(a, b) through the API, each leaf under its matrix and with its label. */
+static mcsg_tree *tree_of_two(const mcsg_mesh *a, const double *ma, const char *la,
+                              const mcsg_mesh *b, const double *mb, const char *lb,
+                              mcsg_node_kind op, mcsg_error *err)
+{
+    mcsg_tree *tree = NULL;
+    mcsg_node_id ids[2], root;
+    CHECK_OK(mcsg_tree_create(NULL, &tree, err), err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, a, ma, la, &ids[0], err), err);
+    CHECK_OK(mcsg_tree_add_leaf(tree, b, mb, lb, &ids[1], err), err);
+    CHECK_OK(mcsg_tree_add_op(tree, op, ids, 2, NULL, &root, err), err);
+    CHECK_OK(mcsg_tree_set_root(tree, root, err), err);
+    return tree;
+}
+
 /* Evaluates union(cube(2), leaf) through the API; the status and message. */
 static mcsg_status eval_with_leaf_opts(const mcsg_mesh *leaf, const mcsg_options *opts,
                                        mcsg_error *err)
 {
-    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     double size[3] = {2, 2, 2};
     mcsg_tree *tree;
     mcsg_mesh cube, out;
-    mcsg_node_id ids[2], root;
     mcsg_status st;
-    CHECK_OK(mcsg_tree_create(NULL, &tree, err), err);
     CHECK_OK(mcsg_make_cube(size, 1, NULL, &cube, err), err);
-    CHECK_OK(mcsg_tree_add_leaf(tree, &cube, identity, "big cube", &ids[0], err), err);
-    CHECK_OK(mcsg_tree_add_leaf(tree, leaf, identity, "the leaf", &ids[1], err), err);
-    CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, &root, err), err);
-    CHECK_OK(mcsg_tree_set_root(tree, root, err), err);
+    tree = tree_of_two(&cube, identity_matrix, "big cube", leaf, identity_matrix, "the leaf",
+                       MCSG_NODE_UNION, err);
     st = mcsg_eval(tree, opts, &out, NULL, NULL, err);
     CHECK(st != MCSG_OK || out.triangle_count > 0);
     mcsg_mesh_free(&out, NULL);
@@ -1399,20 +1411,14 @@ TEST(input_contract_is_checked)
 static bool cube_and_slab(const mcsg_mesh *cube, mcsg_node_kind op, double *volume,
                           size_t *triangles)
 {
-    static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     static const double on_top[12] = {1, 0, 0, 0.5, 0, 1, 0, 0.5, 0, 0, 1, 1.25};
     double size[3] = {2, 2, 0.5};
     mcsg_tree *tree;
     mcsg_mesh slab, out;
-    mcsg_node_id ids[2], root;
     mcsg_error err;
     mcsg_status st;
-    CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
     CHECK_OK(mcsg_make_cube(size, 1, NULL, &slab, &err), &err);
-    CHECK_OK(mcsg_tree_add_leaf(tree, cube, identity, "cube", &ids[0], &err), &err);
-    CHECK_OK(mcsg_tree_add_leaf(tree, &slab, on_top, "slab", &ids[1], &err), &err);
-    CHECK_OK(mcsg_tree_add_op(tree, op, ids, 2, NULL, &root, &err), &err);
-    CHECK_OK(mcsg_tree_set_root(tree, root, &err), &err);
+    tree = tree_of_two(cube, identity_matrix, "cube", &slab, on_top, "slab", op, &err);
     st = mcsg_eval(tree, NULL, &out, NULL, NULL, &err);
     CHECK_MSG(st == MCSG_OK, "%s", err.message);
     if (st == MCSG_OK) {
