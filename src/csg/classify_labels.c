@@ -448,11 +448,10 @@ static bool own_carried(mci_leaf_work *w, size_t k, uint32_t from, int32_t *fron
  * corner off that side's line, in that order (not all three lie on one line): the point
  * never lies on h's border (a piece's corners often do), and no point need be built,
  * however thin the piece (no line through doubles may pierce a piece far narrower than
- * their spacing). A coplanar
- * face's borders are constraints of the piece's face, so h holds all of the piece or
- * none, except across a border with a face lying flat in the same plane (no
- * constraint: intersect_arrange.c, edge_is_crease): each of the two holds part of the
- * piece then, and one of them this point. */
+ * their spacing). A coplanar face's borders are constraints of the piece's face, so h
+ * holds all of the piece or none, except across a border with a face lying flat in the
+ * same plane (no constraint: intersect_arrange.c, edge_is_crease): each of the two
+ * holds part of the piece then, and one of them this point. */
 static bool face_holds_piece(const mci_leaf_work *w, uint32_t h, const mci_point corner[3],
                              int axis)
 {

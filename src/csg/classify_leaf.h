@@ -131,7 +131,8 @@ size_t mci_leaf_coincident_faces(const mci_leaf_work *w, uint32_t f, uint32_t *f
 /* The stack piece p lies in, from those faces (faces[0 .. n) of its face f): *coin, how
  * much more the leaf's winding number is behind p than in front (1 for f, plus one for
  * each face holding p that faces its way, less one for each facing the other), and
- * *first, whether no face holding p faces its way in a lower group. A face holds p where
+ * *first, whether no face holding p faces its way in a lower sheet (sheet_key; of one
+ * sheet overlapping itself, a lower face). A face holds p where
  * its triangle holds the points of p next to p's first corner (a symbolic point, never
  * on a face's border: a border between two faces of one flat region is no constraint,
  * and may cross p). */
@@ -175,9 +176,9 @@ void mci_wind_sheet(mci_wind_sum *sum, mci_label from_local, mci_label to_local)
  * than the spacing of doubles (a line from next to its long edge to a far end moved a
  * unit at a time). The 96 after them look next to a corner that is an input vertex (by
  * angle, largest first) in 16 directions at two distances, for a triangle thinner still
- * (a corner nearly on the line through the others, far below the spacing of doubles). A plane
- * whose normal rounds to zero in doubles is crossed along its projection axis. False
- * when no point strictly inside was found. */
+ * (a corner nearly on the line through the others, far below the spacing of doubles).
+ * A plane whose normal rounds to zero in doubles is crossed along its projection axis.
+ * False when no point strictly inside was found. */
 bool mci_point_inside_triangle(const mci_point c[3], const mci_plane *plane, int attempt,
                                double ends[2][3], mci_point *out);
 bool mci_leaf_piece_inside(const mci_leaf_work *w, size_t p, int attempt, double ends[2][3],
