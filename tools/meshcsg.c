@@ -886,7 +886,8 @@ static const cli_option eval_options[] = {
      "first test every shell of every leaf for self-intersections, exactly, and evaluate "
      "one that crosses itself by its winding number (about a third of an evaluation's "
      "cost on scanned models; by default only leaves with several shells, a negative "
-     "or zero volume or an edge of more than two triangles are tested)"},
+     "or zero volume or an edge of more than two triangles are tested, and the others "
+     "when the result would come out open)"},
     {"verbose", 'v', CLI_FLAG, NULL, 0, 0, VALUE(verbose),
      "also print the library's informational messages (what rounding did, why a step "
      "was retried)"},

@@ -820,6 +820,20 @@ static mcsg_status evaluate_faces_safely(eval_state *e, mcsg_error *err)
     return evaluate_faces(e, err);
 }
 
+/* Everything the faces' evaluation built, freed for another. */
+static void free_faces(eval_state *e)
+{
+    mci_classifier_free(&e->ctx, &e->cl);
+    mci_kept_free(&e->ctx, &e->kept);
+    free_trimmed(e);
+    mci_scene_free(&e->ctx, &e->scene);
+    mci_free(&e->ctx, e->alias);
+    mci_free(&e->ctx, e->face_group);
+    mci_free(&e->ctx, e->face_shell);
+    e->alias = NULL;
+    e->face_group = e->face_shell = NULL;
+}
+
 /* Shells are not tested for crossing themselves up front unless the options ask (it
  * costs about an evaluation). When an internal check trips, they are tested then, and
  * if one crosses itself the faces are evaluated again with that primitive's faces
@@ -837,23 +851,66 @@ static mcsg_status evaluate_faces_checked(eval_state *e, const mcsg_tree *tree, 
         return st;
     mci_log(&e->ctx, MCSG_LOG_INFO, "%zu primitives cross themselves: evaluating again with "
             "their faces intersected with each other", marked);
-    mci_classifier_free(&e->ctx, &e->cl);
-    mci_kept_free(&e->ctx, &e->kept);
-    free_trimmed(e);
-    mci_scene_free(&e->ctx, &e->scene);
-    mci_free(&e->ctx, e->alias);
-    mci_free(&e->ctx, e->face_group);
-    mci_free(&e->ctx, e->face_shell);
-    e->alias = NULL;
-    e->face_group = e->face_shell = NULL;
+    free_faces(e);
     e->stats = before;
     return evaluate_faces_safely(e, err);
+}
+
+/* The faces evaluated and the result assembled (with the output check). */
+static mcsg_status evaluate_and_assemble(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
+                                         mcsg_provenance **provenance, mcsg_error *err)
+{
+    mcsg_status st = evaluate_faces_checked(e, tree, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "assemble", 0, err);
+    if (st == MCSG_OK)
+        st = assemble(e, out, provenance, err);
+    if (st == MCSG_OK)
+        st = mci_progress(&e->ctx, "assemble", 1, err);
+    return st;
+}
+
+/* Rounding keeps a mesh closed and oriented (it joins vertices and drops what collapses),
+ * and clean leaves give a closed exact result; a shell crossing itself that was not tested
+ * (one shell enclosing a positive volume, like every clean leaf) does not. So when the
+ * result is open or misoriented, the leaves not yet tested are, and if one crosses itself
+ * the whole evaluation is done again with its faces intersected with each other: nothing
+ * is paid for clean input. `before`: the stats before the faces were evaluated. */
+static mcsg_status evaluate_open_result_again(eval_state *e, const mcsg_tree *tree,
+                                              const mcsg_eval_stats *before, mcsg_mesh *out,
+                                              mcsg_provenance **provenance, mcsg_error *err)
+{
+    const mcsg_output_check *c = &e->stats.output_check;
+    size_t marked = 0;
+    mcsg_status st;
+    if ((c->open_edges == 0 && c->misoriented_edges == 0) || e->ctx.check_self_intersections)
+        return MCSG_OK;
+    st = mci_mark_untested_crossing_leaves(&e->ctx, tree, &e->tree, &marked, err);
+    if (st != MCSG_OK || marked == 0)
+        return st;
+    /* A warning: the first evaluation's warnings, above it, no longer apply. */
+    mci_log(&e->ctx, MCSG_LOG_WARNING, "the result came out open because %zu primitives cross "
+            "themselves (--check-inputs finds them first): evaluating again with their faces "
+            "intersected with each other; warnings above this line were about the first result",
+            marked);
+    mci_mesh_free(&e->ctx, out);
+    if (provenance) {
+        mci_free(&e->ctx, *provenance);
+        *provenance = NULL;
+    }
+    mci_free(&e->ctx, e->touching);
+    e->touching = NULL;
+    e->touching_count = 0;
+    free_faces(e);
+    e->stats = *before;
+    return evaluate_and_assemble(e, tree, out, provenance, err);
 }
 
 static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
                        mcsg_provenance **provenance, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
+    mcsg_eval_stats before;
     mcsg_status st = mci_ptree_build(&e->ctx, tree, &e->tree, err);
     e->stats.seconds_tree = mci_seconds_now() - t0;
     if (st != MCSG_OK)
@@ -870,13 +927,10 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     e->stats.seconds_check = mci_seconds_now() - t0;
     if (st != MCSG_OK)
         return st;
-    st = evaluate_faces_checked(e, tree, err);
+    before = e->stats;
+    st = evaluate_and_assemble(e, tree, out, provenance, err);
     if (st == MCSG_OK)
-        st = mci_progress(&e->ctx, "assemble", 0, err);
-    if (st == MCSG_OK)
-        st = assemble(e, out, provenance, err);
-    if (st == MCSG_OK)
-        st = mci_progress(&e->ctx, "assemble", 1, err);
+        st = evaluate_open_result_again(e, tree, &before, out, provenance, err);
     if (st != MCSG_OK)
         mci_mesh_free(&e->ctx, out);
     /* A round of evaluating a rounded result again only logs why it failed: the

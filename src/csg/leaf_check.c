@@ -15,9 +15,9 @@
  * of an evaluation on scanned models) when the options ask, in every primitive marked
  * for winding numbers (several shells, an inward volume, a shell meeting itself at an
  * edge: rare in clean input, so clean scenes pay nothing), in the leaves a tree asks
- * for (a frame's turned result), and, by the test that counts every pair, when
- * evaluation stops on an internal
- * consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
+ * for (a frame's turned result), in the untested ones when the result comes out open
+ * (mci_mark_untested_crossing_leaves), and, by the test that counts every pair, when
+ * evaluation stops on an internal consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
  * evaluated with their faces intersected with each other.
  */
 #include "csg/leaf_check.h"
@@ -352,6 +352,38 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
         }
     }
     return MCSG_OK;
+}
+
+/* Whether leaf k was tested for crossing itself by mci_check_leaves (mark_kind's rule). */
+static bool was_tested(const leaf_check_job *job, size_t k)
+{
+    const mci_ptree *t = job->ptree;
+    return job->ctx->check_self_intersections || t->leaf_crossing[k] || t->leaf_winding[k] ||
+           mci_tree_tests_crossing(job->tree, t->leaf_source[k]);
+}
+
+static mcsg_status test_untested_one(void *user, size_t k, mcsg_error *err)
+{
+    leaf_check_job *job = user;
+    return was_tested(job, k) ? MCSG_OK : find_crossing(job, k, NULL, err);
+}
+
+mcsg_status mci_mark_untested_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
+                                              mci_ptree *ptree, size_t *marked,
+                                              mcsg_error *err)
+{
+    leaf_check_job job = {tree, ptree, ctx};
+    uint8_t *before = mci_malloc_array(ctx, ptree->leaf_count + 1, 1);
+    mcsg_status st;
+    *marked = 0;
+    if (!before)
+        return mci_fail_nomem(err, "checking the leaves");
+    memcpy(before, ptree->leaf_crossing, ptree->leaf_count);
+    st = mci_parallel_for(ctx, ptree->leaf_count, test_untested_one, &job, err);
+    for (size_t k = 0; st == MCSG_OK && k < ptree->leaf_count; k++)
+        *marked += ptree->leaf_crossing[k] && !before[k];
+    mci_free(ctx, before);
+    return st;
 }
 
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,

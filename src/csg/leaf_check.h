@@ -22,6 +22,14 @@ mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptre
 mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                      mci_ptree *ptree, size_t *marked, mcsg_error *err);
 
+/* The fast test of mci_check_leaves (csg/shell_crossing.c) on every primitive that it
+ * skipped (one shell enclosing a positive volume, without the options asking), marking
+ * those with a shell that crosses itself; *marked: how many. For a result that came out
+ * open: clean input cannot make one, a shell crossing itself can. */
+mcsg_status mci_mark_untested_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
+                                              mci_ptree *ptree, size_t *marked,
+                                              mcsg_error *err);
+
 /* Called when evaluation failed with MCSG_ERR_INTERNAL (after self-crossing shells were
  * marked and evaluated again): if two triangles of a primitive cross or meet other than
  * in their shared edge (the likeliest cause of such a failure), returns
