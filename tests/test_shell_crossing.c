@@ -12,6 +12,7 @@
 #include "csg/frames.h"
 #include "csg/self_intersect.h"
 #include "csg/shell_crossing.h"
+#include "exact/kernel.h"
 #include "mesh/validate.h"
 
 #include <math.h>
@@ -192,7 +193,7 @@ TEST(agrees_with_every_pair_on_random_meshes)
 {
     uint64_t rng = 0x5eed5ca1ab1e;
     size_t crossing = 0, apart = 0, proven = 0, triangles_apart = 0, shells = 0;
-    size_t listed_crossing = 0;
+    size_t listed_crossing = 0, star_shaped = 0;
     for (int trial = 0; trial < 400; trial++) {
         mcsg_mesh m, other;
         answer a;
@@ -213,6 +214,11 @@ TEST(agrees_with_every_pair_on_random_meshes)
             add_noise(&m, &rng, 0.2 * uniform(&rng) / sqrt((double)m.triangle_count));
         a = fast_answer(&m);
         truth = oracle_crosses(&m);
+        if (mci_star_shaped(&m)) {
+            CHECK_MSG(!truth, "trial %d (kind %d): proven star-shaped, but it crosses itself",
+                      trial, kind);
+            star_shaped++;
+        }
         CHECK_MSG(a.crosses == truth, "trial %d (kind %d, %zu triangles): fast test says %d, "
                   "every pair says %d", trial, kind, m.triangle_count, a.crosses, truth);
         if (trial % 4 == 0) { /* the whole list, not only whether there is a pair */
@@ -235,6 +241,87 @@ TEST(agrees_with_every_pair_on_random_meshes)
     CHECK_MSG(listed_crossing >= 15, "only %zu lists compared had a pair", listed_crossing);
     CHECK_MSG(2 * proven > triangles_apart, "only %zu of %zu triangles proven", proven,
               triangles_apart);
+    CHECK_MSG(star_shaped >= 40 && star_shaped < apart, "%zu of %zu meshes apart proven "
+              "star-shaped", star_shaped, apart);
+}
+
+/* A bipyramid over a pentagram: its equator goes around the axis twice. Every triangle
+ * faces away from the centre, yet the triangles cross: the ray from the centre meets
+ * two, and the proof of star shape must say no. */
+static void pentagram_bipyramid(mcsg_mesh *out)
+{
+    double v[21];
+    uint32_t t[30];
+    mcsg_mesh m = {v, t, 7, 10};
+    mcsg_error err;
+    for (int k = 0; k < 5; k++) {
+        double angle = 2 * 3.14159265358979323846 * k / 5;
+        v[3 * k] = cos(angle), v[3 * k + 1] = sin(angle), v[3 * k + 2] = 0;
+    }
+    v[15] = v[16] = 0, v[17] = 1;
+    v[18] = v[19] = 0, v[20] = -1;
+    for (uint32_t i = 0; i < 5; i++) {
+        uint32_t a = 2 * i % 5, b = 2 * (i + 1) % 5;
+        t[6 * i] = a, t[6 * i + 1] = b, t[6 * i + 2] = 5;
+        t[6 * i + 3] = b, t[6 * i + 4] = a, t[6 * i + 5] = 6;
+    }
+    CHECK_OK(mcsg_mesh_copy(&m, NULL, out, &err), &err);
+}
+
+static bool faces_away_from(const mcsg_mesh *m, const double *o)
+{
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *c = m->triangles + 3 * t;
+        if (mci_orient3d_vertices(m->vertices + 3 * c[0], m->vertices + 3 * c[1],
+                                  m->vertices + 3 * c[2], o) >= 0)
+            return false;
+    }
+    return true;
+}
+
+/* Star shape on known meshes: convex ones pass (an octahedron whose corner lies on the
+ * ray too), far from the origin as well, and a sphere
+ * with every other vertex pushed out (star-shaped, not convex); a vertex pushed through
+ * the other side, a mesh listed twice and a surface wound twice around its centre do
+ * not. */
+TEST(star_shaped_cases)
+{
+    mcsg_mesh m, twice;
+    mcsg_error err;
+    mcsg_resolution res = {24, 0, 0};
+    double centre[3] = {0, 0, 0};
+    CHECK_OK(mcsg_make_sphere(1, res, NULL, &m, &err), &err);
+    CHECK(mci_star_shaped(&m));
+    for (size_t v = 0; v < m.vertex_count; v += 2)
+        for (int k = 0; k < 3; k++)
+            m.vertices[3 * v + k] *= 1.5;
+    CHECK(mci_star_shaped(&m) && !oracle_crosses(&m));
+    CHECK_OK(mcsg_mesh_copy(&m, NULL, &twice, &err), &err);
+    join(&twice, &m);
+    CHECK(!mci_star_shaped(&twice));
+    mcsg_mesh_free(&twice, NULL);
+    for (size_t v = 0; v < m.vertex_count; v++)
+        m.vertices[3 * v] += 1e6;
+    CHECK(mci_star_shaped(&m));
+    m.vertices[2] = -m.vertices[2] * 3; /* the first vertex through the other side */
+    CHECK(!mci_star_shaped(&m) && oracle_crosses(&m));
+    mcsg_mesh_free(&m, NULL);
+    CHECK_OK(mcsg_make_cylinder(2, 1, 1, 0, res, NULL, &m, &err), &err);
+    CHECK(mci_star_shaped(&m));
+    mcsg_mesh_free(&m, NULL);
+    {
+        /* The ray from the centre of an octahedron runs through its corner (1, 0, 0),
+         * and the edges from there: only its symbolic perturbation picks one triangle. */
+        double v[18] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+        uint32_t t[24] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
+                          2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+        mcsg_mesh octahedron = {v, t, 6, 8};
+        CHECK(faces_away_from(&octahedron, centre) && mci_star_shaped(&octahedron));
+    }
+    pentagram_bipyramid(&m);
+    CHECK(faces_away_from(&m, centre));
+    CHECK(!mci_star_shaped(&m) && oracle_crosses(&m));
+    mcsg_mesh_free(&m, NULL);
 }
 
 /* A turned mesh tested with the boxes of the mesh before the turn, grown by
@@ -343,6 +430,7 @@ int main(void)
 {
     RUN(agrees_with_every_pair_on_random_meshes);
     RUN(turned_meshes_tested_with_boxes_before_the_turn);
+    RUN(star_shaped_cases);
     RUN(known_cases);
     RUN(allocation_failures);
     return test_summary();

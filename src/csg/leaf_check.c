@@ -181,10 +181,17 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint
     mcsg_check_report report;
     uint32_t example[2];
     bool crosses = false;
-    uint32_t *twin = known ? NULL : twin_room(job, k);
-    mcsg_status st = known ? MCSG_OK
-                     : twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
-                            : mci_fail_nomem(err, "checking the leaves");
+    uint32_t *twin;
+    mcsg_status st;
+    if (mci_star_shaped(m)) {
+        mci_log(job->ctx, MCSG_LOG_DEBUG, "leaf %u: proven star-shaped: it does not cross "
+                "itself", t->leaf_source[k]);
+        return MCSG_OK;
+    }
+    twin = known ? NULL : twin_room(job, k);
+    st = known ? MCSG_OK
+         : twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
+                : mci_fail_nomem(err, "checking the leaves");
     if (st == MCSG_OK)
         st = mci_find_shell_crossing_boxed(job->ctx, m, t->leaf_shell[k], known ? known : twin,
                                            crossing_boxes(job, k, &boxes), &crosses, example,

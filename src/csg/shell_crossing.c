@@ -22,6 +22,9 @@
  * exact triangle-triangle test (mci_triangles_cross). On a scanned model 98% of the
  * triangles lie in proven patches, and the grid's cells inside one are skipped whole;
  * the grid over every triangle is most of the cost.
+ *
+ * A mesh proven star-shaped (mci_star_shaped, one pass: every convex mesh but the
+ * flattest) needs none of this; its callers try that first.
  */
 #include "csg/shell_crossing.h"
 #include "base/sort.h"
@@ -86,6 +89,64 @@ typedef struct test_state {
 static const double *corner(const mcsg_mesh *m, uint32_t t, uint32_t k)
 {
     return m->vertices + 3 * (size_t)m->triangles[3 * (size_t)t + k];
+}
+
+/* The mean of the corners of m's triangles, in doubles: a point inside any convex mesh
+ * but the flattest. */
+static void corner_mean(const mcsg_mesh *m, double o[3])
+{
+    double sum[3] = {0, 0, 0};
+    for (size_t i = 0; i < 3 * m->triangle_count; i++)
+        for (int k = 0; k < 3; k++)
+            sum[k] += m->vertices[3 * (size_t)m->triangles[i] + k];
+    for (int k = 0; k < 3; k++)
+        o[k] = sum[k] / (3 * (double)m->triangle_count);
+}
+
+/* Sign of det[u - o, v - o, d'] for the direction d' = (q - o) + e x + e^2 y + e^3 z
+ * with e infinitesimal: the first nonzero of the exact det[u - o, v - o, q - o] and the
+ * components of (u - o) x (v - o). Zero only where o lies on the line uv. */
+static int side_of_ray(const double *o, const double *q, const double *u, const double *v)
+{
+    int s = mci_orient3d_vertices(o, u, v, q);
+    if (s == 0)
+        s = mci_orient2d(u[1], u[2], v[1], v[2], o[1], o[2]);
+    if (s == 0)
+        s = mci_orient2d(u[2], u[0], v[2], v[0], o[2], o[0]);
+    if (s == 0)
+        s = mci_orient2d(u[0], u[1], v[0], v[1], o[0], o[1]);
+    return s;
+}
+
+/* m proven star-shaped from the mean of its corners: that point o lies
+ * strictly behind every triangle's plane (each seen from o turns one way, and has an
+ * area), and a ray from o crosses exactly one triangle (the cone from o over the
+ * triangle holds its direction, perturbed symbolically off every edge). Projected from
+ * o onto a sphere, the triangles then cover each direction as often as the ray's, since
+ * the edges are used as often one way as the other (the leaf contract): once. So their
+ * projections have disjoint interiors, and two triangles that met other than in common
+ * corners and edges would overlap there (a corner on another's edge included: the
+ * triangle on that edge's other side would cover the same directions as the corner's).
+ * Every convex mesh but the flattest passes; a scan mostly does not, cheaply. */
+bool mci_star_shaped(const mcsg_mesh *m)
+{
+    size_t n = m->triangle_count, hits = 0;
+    double o[3], q[3];
+    corner_mean(m, o);
+    q[0] = o[0] + (1 + fabs(o[0])), q[1] = o[1], q[2] = o[2];
+    if (!isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]) || !isfinite(q[0]))
+        return false;
+    for (size_t t = 0; t < n; t++)
+        if (mci_orient3d_vertices(corner(m, (uint32_t)t, 0), corner(m, (uint32_t)t, 1),
+                                  corner(m, (uint32_t)t, 2), o) >= 0)
+            return false;
+    for (size_t t = 0; t < n && hits < 2; t++) {
+        const double *a = corner(m, (uint32_t)t, 0), *b = corner(m, (uint32_t)t, 1),
+                     *c = corner(m, (uint32_t)t, 2);
+        hits += side_of_ray(o, q, a, b) > 0 && side_of_ray(o, q, b, c) > 0 &&
+                side_of_ray(o, q, c, a) > 0;
+    }
+    return hits == 1;
 }
 
 /* The facing of triangle abc: NO_FACING when it has no area. */

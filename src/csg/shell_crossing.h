@@ -18,6 +18,13 @@ typedef struct mci_shell_crossing_stats {
     size_t pairs_tested;     /* pairs decided by the exact triangle-triangle test */
 } mci_shell_crossing_stats;
 
+/* Whether m is proven star-shaped (exactly, in one pass): the mean of its triangles'
+ * corners lies strictly behind every triangle's plane, and a ray from it crosses exactly
+ * one triangle. Then, m being closed as a chain, no two of its triangles meet other than
+ * in the corners and edges they share. Every convex mesh but the flattest is; most scans
+ * are not (and are rejected within a pass). */
+bool mci_star_shaped(const mcsg_mesh *m);
+
 /* Whether two triangles of one shell of m cross or meet other than in the vertices and
  * edge they share (the rules of mci_triangles_cross, vertices identified by
  * coordinates): *crosses, and the first pair found in example[2] (triangle indices,
