@@ -613,7 +613,8 @@ typedef struct mcsg_eval_stats {
  * several shells, a negative or zero volume or an edge of more than two triangles, and
  * in every leaf when opts->check_self_intersections asks (it costs about a third of an
  * evaluation on scanned models); or when an internal consistency check trips on it, or
- * the result comes out open or misoriented (the leaves not yet tested are tested then,
+ * the result comes out open or misoriented, or with crossing triangles when
+ * opts->check_output_crossings counts them (the leaves not yet tested are tested then,
  * and the faces evaluated again, with a warning). Otherwise (one shell of
  * positive volume, not tested) its faces are not compared with each other and the
  * result is unspecified (a mesh that may not be the intended set; see

@@ -887,7 +887,7 @@ static const cli_option eval_options[] = {
      "one that crosses itself by its winding number (about a third of an evaluation's "
      "cost on scanned models; by default only leaves with several shells, a negative "
      "or zero volume or an edge of more than two triangles are tested, and the others "
-     "when the result would come out open)"},
+     "when the result would come out open, or with --check-crossings crossing)"},
     {"verbose", 'v', CLI_FLAG, NULL, 0, 0, VALUE(verbose),
      "also print the library's informational messages (what rounding did, why a step "
      "was retried)"},

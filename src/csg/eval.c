@@ -870,29 +870,38 @@ static mcsg_status evaluate_and_assemble(eval_state *e, const mcsg_tree *tree, m
     return st;
 }
 
-/* Rounding keeps a mesh closed and oriented (it joins vertices and drops what collapses),
- * and clean leaves give a closed exact result; a shell crossing itself that was not tested
- * (one shell enclosing a positive volume, like every clean leaf) does not. So when the
- * result is open or misoriented, the leaves not yet tested are, and if one crosses itself
- * the whole evaluation is done again with its faces intersected with each other: nothing
- * is paid for clean input. `before`: the stats before the faces were evaluated. */
-static mcsg_status evaluate_open_result_again(eval_state *e, const mcsg_tree *tree,
-                                              const mcsg_eval_stats *before, mcsg_mesh *out,
-                                              mcsg_provenance **provenance, mcsg_error *err)
+/* What in the result may come from a shell crossing itself that was not tested (one
+ * shell enclosing a positive volume, like every clean leaf): edges open or misoriented,
+ * which rounding never makes (it joins vertices and drops what collapses) and clean
+ * leaves never give; crossing triangles, when they were counted (rounding can make
+ * those too, but testing the leaves then costs less than the count did). NULL: none. */
+static const char *flaw_of_untested_leaf(const mcsg_output_check *c)
 {
-    const mcsg_output_check *c = &e->stats.output_check;
+    if (c->open_edges > 0 || c->misoriented_edges > 0)
+        return "open";
+    return c->crossing_pairs > 0 ? "with crossing triangles" : NULL;
+}
+
+/* When the result has such a flaw, the leaves not yet tested are, and if one crosses
+ * itself the whole evaluation is done again with its faces intersected with each other:
+ * nothing is paid for clean input. `before`: the stats before the faces were evaluated. */
+static mcsg_status evaluate_flawed_result_again(eval_state *e, const mcsg_tree *tree,
+                                                const mcsg_eval_stats *before, mcsg_mesh *out,
+                                                mcsg_provenance **provenance, mcsg_error *err)
+{
+    const char *flaw = flaw_of_untested_leaf(&e->stats.output_check);
     size_t marked = 0;
     mcsg_status st;
-    if ((c->open_edges == 0 && c->misoriented_edges == 0) || e->ctx.check_self_intersections)
+    if (!flaw || e->ctx.check_self_intersections)
         return MCSG_OK;
     st = mci_mark_untested_crossing_leaves(&e->ctx, tree, &e->tree, &marked, err);
     if (st != MCSG_OK || marked == 0)
         return st;
     /* A warning: the first evaluation's warnings, above it, no longer apply. */
-    mci_log(&e->ctx, MCSG_LOG_WARNING, "the result came out open because %zu primitives cross "
+    mci_log(&e->ctx, MCSG_LOG_WARNING, "the result came out %s because %zu primitives cross "
             "themselves (--check-inputs finds them first): evaluating again with their faces "
             "intersected with each other; warnings above this line were about the first result",
-            marked);
+            flaw, marked);
     mci_mesh_free(&e->ctx, out);
     if (provenance) {
         mci_free(&e->ctx, *provenance);
@@ -930,7 +939,7 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     before = e->stats;
     st = evaluate_and_assemble(e, tree, out, provenance, err);
     if (st == MCSG_OK)
-        st = evaluate_open_result_again(e, tree, &before, out, provenance, err);
+        st = evaluate_flawed_result_again(e, tree, &before, out, provenance, err);
     if (st != MCSG_OK)
         mci_mesh_free(&e->ctx, out);
     /* A round of evaluating a rounded result again only logs why it failed: the

@@ -16,7 +16,7 @@
  * for winding numbers (several shells, an inward volume, a shell meeting itself at an
  * edge: rare in clean input, so clean scenes pay nothing), in the leaves a tree asks
  * for (a frame's turned result), in the untested ones when the result comes out open
- * (mci_mark_untested_crossing_leaves), and, by the test that counts every pair, when
+ * or crossing itself (mci_mark_untested_crossing_leaves), and, by the test that counts every pair, when
  * evaluation stops on an internal consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
  * evaluated with their faces intersected with each other.
  */

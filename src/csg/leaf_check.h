@@ -25,7 +25,7 @@ mcsg_status mci_mark_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
 /* The fast test of mci_check_leaves (csg/shell_crossing.c) on every primitive that it
  * skipped (one shell enclosing a positive volume, without the options asking), marking
  * those with a shell that crosses itself; *marked: how many. For a result that came out
- * open: clean input cannot make one, a shell crossing itself can. */
+ * open (clean input cannot make one, a shell crossing itself can) or crossing itself. */
 mcsg_status mci_mark_untested_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
                                               mci_ptree *ptree, size_t *marked,
                                               mcsg_error *err);
