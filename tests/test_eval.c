@@ -1510,6 +1510,56 @@ TEST(open_result_tests_the_leaves_left_untested)
     mcsg_tree_free(tree);
 }
 
+typedef struct thread_log {
+    pthread_t caller;
+    int calls, foreign;
+    unsigned last_leaf;
+    bool in_order;
+} thread_log;
+
+static void note_thread(void *user, mcsg_log_level level, const char *message)
+{
+    thread_log *l = user;
+    unsigned leaf;
+    (void)level;
+    l->calls++;
+    l->foreign += !pthread_equal(pthread_self(), l->caller);
+    if (sscanf(message, "leaf %u:", &leaf) == 1) {
+        l->in_order = l->in_order && leaf >= l->last_leaf;
+        l->last_leaf = leaf;
+    }
+}
+
+/* The log callback is called from the caller's thread only (meshcsg.h), also for what
+ * the leaves' checks find while they run in parallel, and in leaf order: 24 spheres,
+ * each tested for crossing itself (a line each), on four threads. */
+TEST(leaf_messages_come_from_the_callers_thread)
+{
+    char text[4096];
+    size_t len = (size_t)snprintf(text, sizeof text, "union() {");
+    mcsg_options opts;
+    mcsg_mesh out;
+    mcsg_error err;
+    thread_log log = {pthread_self(), 0, 0, 0, true};
+    mcsg_tree *tree;
+    for (int i = 0; i < 24; i++)
+        len += (size_t)snprintf(text + len, sizeof text - len,
+                                " translate([%d, %d, 0]) sphere(1, $fn = 12);", i % 6 * 3, i / 6 * 3);
+    snprintf(text + len, sizeof text - len, " }");
+    tree = parse(text);
+    memset(&opts, 0, sizeof opts);
+    opts.threads = 4;
+    opts.check_self_intersections = 1;
+    opts.log = note_thread;
+    opts.log_user = &log;
+    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, NULL, &err), &err);
+    CHECK_MSG(log.calls >= 24 && log.foreign == 0 && log.in_order,
+              "%d calls, %d from other threads, in leaf order %d", log.calls, log.foreign,
+              log.in_order);
+    mcsg_mesh_free(&out, NULL);
+    mcsg_tree_free(tree);
+}
+
 /* With crossings counted, a result with crossing triangles also has the untested leaves
  * tested: a sphere with its top vertex pushed through its bottom (one shell, positive
  * volume) came back as given, crossing itself, and only the rounds of evaluating the
@@ -1671,6 +1721,7 @@ int main(void)
     RUN(leaves_crossing_themselves);
     RUN(open_result_tests_the_leaves_left_untested);
     RUN(crossing_result_tests_the_leaves_left_untested);
+    RUN(leaf_messages_come_from_the_callers_thread);
     RUN(repair_joins_overlapping_shells);
     return test_summary();
 }

@@ -27,6 +27,7 @@
 #include "mesh/validate.h"
 #include "mesh/zero_area.h"
 
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -34,7 +35,49 @@ typedef struct leaf_check_job {
     const mcsg_tree *tree;
     mci_ptree *ptree;
     const mci_ctx *ctx;
+    mci_buf *notes; /* per leaf: its messages, each a level byte and a line with its NUL */
 } leaf_check_job;
+
+/* A message about leaf k, kept until the leaves are done: the log callback is called
+ * from the caller's thread only (meshcsg.h), and in leaf order the log does not depend
+ * on the threads. False when out of memory. */
+static bool note(const leaf_check_job *job, size_t k, mcsg_log_level level, const char *fmt,
+                 ...) MCI_PRINTF(4, 5);
+
+static bool note(const leaf_check_job *job, size_t k, mcsg_log_level level, const char *fmt,
+                 ...)
+{
+    char line[1024];
+    unsigned char tag = (unsigned char)level;
+    va_list ap;
+    if (!job->ctx->log)
+        return true;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    return mci_buf_append(job->ctx, &job->notes[k], &tag, 1) &&
+           mci_buf_append(job->ctx, &job->notes[k], line, strlen(line) + 1);
+}
+
+/* fn over the leaves in parallel, then every leaf's messages logged, in leaf order. */
+static mcsg_status run_over_leaves(leaf_check_job *job, mci_task_fn fn, mcsg_error *err)
+{
+    size_t n = job->ptree->leaf_count;
+    mcsg_status st;
+    job->notes = mci_calloc_array(job->ctx, n + 1, sizeof *job->notes);
+    if (!job->notes)
+        return mci_fail_nomem(err, "checking the leaves");
+    st = mci_parallel_for(job->ctx, n, fn, job, err);
+    for (size_t k = 0; k < n; k++) {
+        const mci_buf *b = &job->notes[k];
+        for (size_t i = 0; i < b->len; i += strlen((const char *)b->data + i + 1) + 2)
+            mci_log(job->ctx, (mcsg_log_level)b->data[i], "%s", (const char *)b->data + i + 1);
+        mci_buf_free(job->ctx, &job->notes[k]);
+    }
+    mci_free(job->ctx, job->notes);
+    job->notes = NULL;
+    return st;
+}
 
 static void format_point(char *buf, size_t size, const mcsg_mesh *m, uint32_t v)
 {
@@ -107,13 +150,14 @@ static mcsg_status remove_zero_area(const leaf_check_job *job, size_t k, size_t 
     t->leaf_face_of[k] = face_of;
     t->leaf_mesh[k] = copy;
     *removed = res.removed;
-    mci_log(job->ctx, mci_tree_is_made(job->tree, t->leaf_source[k]) ? MCSG_LOG_INFO
-            : MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
-            "(they bound nothing), %zu triangle%s added by splitting neighbours at their "
-            "corners to keep the surface closed", t->leaf_source[k],
-            mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
-            mcsg_tree_node_label(job->tree, t->leaf_source[k]), res.removed,
-            res.removed == 1 ? "" : "s", res.split, res.split == 1 ? "" : "s");
+    if (!note(job, k, mci_tree_is_made(job->tree, t->leaf_source[k]) ? MCSG_LOG_INFO
+              : MCSG_LOG_WARNING, "leaf %u%s%s: %zu triangle%s of zero area removed "
+              "(they bound nothing), %zu triangle%s added by splitting neighbours at their "
+              "corners to keep the surface closed", t->leaf_source[k],
+              mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
+              mcsg_tree_node_label(job->tree, t->leaf_source[k]), res.removed,
+              res.removed == 1 ? "" : "s", res.split, res.split == 1 ? "" : "s"))
+        return mci_fail_nomem(err, "checking the leaves");
     return MCSG_OK;
 }
 
@@ -183,11 +227,11 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint
     bool crosses = false;
     uint32_t *twin;
     mcsg_status st;
-    if (mci_star_shaped(m)) {
-        mci_log(job->ctx, MCSG_LOG_DEBUG, "leaf %u: proven star-shaped: it does not cross "
-                "itself", t->leaf_source[k]);
-        return MCSG_OK;
-    }
+    if (mci_star_shaped(m))
+        return note(job, k, MCSG_LOG_DEBUG, "leaf %u: proven star-shaped: it does not cross "
+                    "itself", t->leaf_source[k])
+                   ? MCSG_OK
+                   : mci_fail_nomem(err, "checking the leaves");
     twin = known ? NULL : twin_room(job, k);
     st = known ? MCSG_OK
          : twin ? mci_mesh_check_shells(job->ctx, m, &report, NULL, twin, NULL, err)
@@ -199,18 +243,20 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint
     mci_free(job->ctx, twin);
     if (st != MCSG_OK)
         return st;
-    mci_log(job->ctx, MCSG_LOG_DEBUG, "leaf %u: tested for crossing itself: %zu of %zu triangles "
-            "in %zu patches proven apart, %zu pairs tested in a grid of %zu entries",
-            t->leaf_source[k], stats.proven_triangles, m->triangle_count,
-            stats.proven_patches, stats.pairs_tested, stats.grid_entries);
+    if (!note(job, k, MCSG_LOG_DEBUG, "leaf %u: tested for crossing itself: %zu of %zu "
+              "triangles in %zu patches proven apart, %zu pairs tested in a grid of %zu "
+              "entries", t->leaf_source[k], stats.proven_triangles, m->triangle_count,
+              stats.proven_patches, stats.pairs_tested, stats.grid_entries))
+        return mci_fail_nomem(err, "checking the leaves");
     if (!crosses)
         return MCSG_OK;
     t->leaf_crossing[k] = t->leaf_winding[k] = 1;
-    mci_log(job->ctx, MCSG_LOG_INFO, "leaf %u%s%s: a shell crosses itself (e.g. triangles %u "
-            "and %u): its solid is where its winding number is positive, and its faces are "
-            "intersected with each other", t->leaf_source[k],
-            mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
-            mcsg_tree_node_label(job->tree, t->leaf_source[k]), example[0], example[1]);
+    if (!note(job, k, MCSG_LOG_INFO, "leaf %u%s%s: a shell crosses itself (e.g. triangles %u "
+              "and %u): its solid is where its winding number is positive, and its faces are "
+              "intersected with each other", t->leaf_source[k],
+              mcsg_tree_node_label(job->tree, t->leaf_source[k])[0] ? ", " : "",
+              mcsg_tree_node_label(job->tree, t->leaf_source[k]), example[0], example[1]))
+        return mci_fail_nomem(err, "checking the leaves");
     return MCSG_OK;
 }
 
@@ -281,8 +327,8 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
 mcsg_status mci_check_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_ptree *ptree,
                              mcsg_error *err)
 {
-    leaf_check_job job = {tree, ptree, ctx};
-    return mci_parallel_for(ctx, ptree->leaf_count, check_one, &job, err);
+    leaf_check_job job = {tree, ptree, ctx, NULL};
+    return run_over_leaves(&job, check_one, err);
 }
 
 /* The crossing pairs of leaf k's mesh, within each of its shells (shells may cross each
@@ -379,14 +425,14 @@ mcsg_status mci_mark_untested_crossing_leaves(const mci_ctx *ctx, const mcsg_tre
                                               mci_ptree *ptree, size_t *marked,
                                               mcsg_error *err)
 {
-    leaf_check_job job = {tree, ptree, ctx};
+    leaf_check_job job = {tree, ptree, ctx, NULL};
     uint8_t *before = mci_malloc_array(ctx, ptree->leaf_count + 1, 1);
     mcsg_status st;
     *marked = 0;
     if (!before)
         return mci_fail_nomem(err, "checking the leaves");
     memcpy(before, ptree->leaf_crossing, ptree->leaf_count);
-    st = mci_parallel_for(ctx, ptree->leaf_count, test_untested_one, &job, err);
+    st = run_over_leaves(&job, test_untested_one, err);
     for (size_t k = 0; st == MCSG_OK && k < ptree->leaf_count; k++)
         *marked += ptree->leaf_crossing[k] && !before[k];
     mci_free(ctx, before);
