@@ -570,6 +570,19 @@ TEST(coincident_sheets_ordered_as_wholes)
     expect_clean_winding_leaf("rounding/sheets-across-flat-borders.off", 0x5bee7);
 }
 
+/* A sheet overlapping itself: a rounded result snapped to a grid (the first round of
+ * fuzz seed 0x73d613ec7db1be4a, six cubes turned by six-digit matrices; 320 triangles),
+ * where a sliver of one sheet lies over a fan of five faces of the same sheet about a
+ * vertex 1e-14 from the sliver's edge. Which of two faces of one sheet outputs their
+ * common part is decided face by face, but the fan's borders, flat, were no
+ * constraints of the sliver: its pieces straddled them, one was dropped between two
+ * kept ones, and the exact result had T-junctions (18 open edges once rounded). A face
+ * of the same leaf lying on a face now bounds it with every edge. */
+TEST(sheet_overlapping_itself_bounded_at_every_face_border)
+{
+    expect_clean_winding_leaf("rounding/sheet-overlapping-itself.off", 0x5e1f);
+}
+
 int main(void)
 {
     CHECK_MSG(csg_load_models(), "cannot read the models of tests/data/models");
@@ -578,6 +591,7 @@ int main(void)
     RUN(spindle_torus);
     RUN(repair_of_generated_imperfect_meshes);
     RUN(folded_slivers_keep_the_solid);
+    RUN(sheet_overlapping_itself_bounded_at_every_face_border);
     RUN(flat_fold_keeps_the_solid);
     RUN(needle_region_decided_from_neighbours);
     RUN(stacked_sheets_of_one_shell_output_once);

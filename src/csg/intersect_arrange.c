@@ -443,8 +443,13 @@ static bool add_hit(const arrange_job *j, mci_face_arr *arr, const mci_pair_hit 
         a = hit_end(j->ctx, s, j->vt, arr, h, 0);
         return a && mci_arr_add_point(j->ctx, arr, a);
     default:
+        /* A face of the same leaf lying on this one (a sheet overlapping itself, in a
+         * leaf crossing itself): which of the two outputs their common part is decided
+         * face by face (classify_labels.c, add_sheet), so every edge of the other face
+         * bounds where the decision may change, flat or not. */
         for (int i = 0; i < 3; i++)
-            crease[i] = (j->ff->crease[other] >> i) & 1;
+            crease[i] = ((j->ff->crease[other] >> i) & 1) ||
+                        s->octree.face_leaf[other] == s->octree.face_leaf[arr->face];
         return mci_arr_add_coplanar(j->ctx, arr, other, plane, crease,
                                     mci_scene_face_group(s, other));
     }
