@@ -623,7 +623,7 @@ typedef struct mcsg_eval_stats {
  * can break a guarantee where the exact result has features below the spacing of
  * doubles. Then, where triangles cross, their corners are moved by one unit in the last
  * place where that mends the crossings; otherwise the rounded mesh is snapped to a
- * coarser grid and evaluated again, alone, by its winding number (up to four rounds,
+ * coarser grid and evaluated again, alone, by its winding number (up to six rounds,
  * docs/robustness.md; the first candidate whose check passes replaces the result, its
  * provenance mapped back to the tree's leaves; stats->rounding_separated_vertices,
  * rounding_reevaluations, rounding_snap_grid). When none does, the first

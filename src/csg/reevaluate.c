@@ -31,12 +31,12 @@
 #include <math.h>
 #include <string.h>
 
-enum { REEVALUATION_ROUNDS = 3 };
+enum { REEVALUATION_ROUNDS = 5 };
 
 /* The grid each round's starting mesh is snapped to, in bits across the result's largest
  * coordinate (the last: the last round's result): finer first, each grid's points on the
  * next one's coarser grid. */
-static const int snap_bits[REEVALUATION_ROUNDS + 1] = {48, 44, 40, 36};
+static const int snap_bits[REEVALUATION_ROUNDS + 1] = {48, 44, 40, 36, 32, 28};
 
 static const double identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 

@@ -22,7 +22,7 @@ mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_
 
 /* out: mcsg_eval's result, whose check (stats->output_check) failed; provenance (may be
  * NULL) its per-triangle sources; touching[6 * i ..] the rounded ends of the edges where
- * the tree's exact result touches itself (mci_list_touching_edges). Up to four rounds,
+ * the tree's exact result touches itself (mci_list_touching_edges). Up to six rounds,
  * each snapping its starting mesh to a grid (finer first), evaluating the snapped mesh
  * and then the starting mesh alone, and checking each of these with ctx's options, where
  * only those edges (snapped alike) may have more than two triangles (a round's own exact
