@@ -15,10 +15,11 @@
  * of an evaluation on scanned models) when the options ask, in every primitive marked
  * for winding numbers (several shells, an inward volume, a shell meeting itself at an
  * edge: rare in clean input, so clean scenes pay nothing), in the leaves a tree asks
- * for (a frame's turned result), in the untested ones when the result comes out open
- * or crossing itself (mci_mark_untested_crossing_leaves), and, by the test that counts every pair, when
- * evaluation stops on an internal consistency check; the primitives with one are marked (mci_ptree.leaf_crossing) and
- * evaluated with their faces intersected with each other.
+ * for (a frame's turned result), in the others when the result comes out open or
+ * crossing itself (mci_mark_untested_crossing_leaves), and, by the test that counts every
+ * pair, when evaluation stops on an internal consistency check; the primitives with one
+ * are marked (mci_ptree.leaf_crossing) and evaluated with their faces intersected with
+ * each other.
  */
 #include "csg/leaf_check.h"
 #include "base/parallel.h"
@@ -260,6 +261,15 @@ static mcsg_status find_crossing(const leaf_check_job *job, size_t k, const uint
     return MCSG_OK;
 }
 
+/* Whether leaf k is tested for crossing itself before evaluation: every leaf when the
+ * options ask, one told by winding numbers, one the tree asks for. */
+static bool tested_up_front(const leaf_check_job *job, size_t k)
+{
+    const mci_ptree *t = job->ptree;
+    return job->ctx->check_self_intersections || t->leaf_winding[k] ||
+           mci_tree_tests_crossing(job->tree, t->leaf_source[k]);
+}
+
 /* The leaf's shells and kind from a report without problems: leaf_winding where only
  * winding numbers tell, leaf_crossing where its faces must be intersected with each
  * other. */
@@ -281,9 +291,7 @@ static mcsg_status mark_kind(const leaf_check_job *job, size_t k, const mcsg_che
      * shell folded through itself mostly encloses a negative volume, and a part nested
      * in another and joined to it at an edge overlaps it in their common faces. Such
      * leaves are always tested; every leaf when the options ask. */
-    if (t->leaf_crossing[k] ||
-        (!job->ctx->check_self_intersections && !t->leaf_winding[k] &&
-         !mci_tree_tests_crossing(job->tree, t->leaf_source[k])))
+    if (t->leaf_crossing[k] || !tested_up_front(job, k))
         return MCSG_OK;
     return find_crossing(job, k, twin, err);
 }
@@ -407,18 +415,12 @@ static mcsg_status scan_leaves(const mci_ctx *ctx, const mcsg_tree *tree, mci_pt
     return MCSG_OK;
 }
 
-/* Whether leaf k was tested for crossing itself by mci_check_leaves (mark_kind's rule). */
-static bool was_tested(const leaf_check_job *job, size_t k)
-{
-    const mci_ptree *t = job->ptree;
-    return job->ctx->check_self_intersections || t->leaf_crossing[k] || t->leaf_winding[k] ||
-           mci_tree_tests_crossing(job->tree, t->leaf_source[k]);
-}
-
 static mcsg_status test_untested_one(void *user, size_t k, mcsg_error *err)
 {
     leaf_check_job *job = user;
-    return was_tested(job, k) ? MCSG_OK : find_crossing(job, k, NULL, err);
+    return job->ptree->leaf_crossing[k] || tested_up_front(job, k)
+               ? MCSG_OK
+               : find_crossing(job, k, NULL, err);
 }
 
 mcsg_status mci_mark_untested_crossing_leaves(const mci_ctx *ctx, const mcsg_tree *tree,
