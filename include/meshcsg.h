@@ -132,6 +132,11 @@ typedef struct mcsg_options {
     int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
                                    triangles that cross each other (exact, costs about as
                                    much as an evaluation; see mcsg_output_check) */
+    int keep_all_vertices;    /* mcsg_eval: nonzero keeps every vertex of the exact
+                                 result. Zero (the default) removes the vertices that
+                                 carry no shape: inside a flat region, or inside a
+                                 straight edge between two flat regions (where curves
+                                 of the arrangement crossed); the shape is unchanged */
     mcsg_pool *pool;          /* NULL: each call starts its own workers. Else the calls
                                  made with these options use this pool's workers (all
                                  of them, whenever threads is not 1; worth it for many
@@ -534,6 +539,10 @@ typedef struct mcsg_eval_stats {
     size_t copied_primitives;   /* primitives that are the same mesh as an earlier one
                                    (same arrays): the earlier one is evaluated for both */
     size_t output_vertices, output_triangles;
+    double output_smallest_angle; /* the smallest angle of an output triangle, degrees */
+    size_t output_needles;        /* output triangles with an angle under 1 degree */
+    size_t flat_vertices_removed; /* vertices of the exact result inside a flat region or
+                                     a straight edge, removed (see keep_all_vertices) */
     size_t rounding_joined_vertices;   /* exact vertices joined into another one that
                                           rounds to the same doubles (the one kept is
                                           not counted) */
@@ -571,7 +580,7 @@ typedef struct mcsg_eval_stats {
                                        (output_check is then that candidate's) */
     double rounding_snap_grid;      /* when a round's result is kept: the spacing of the
                                        grid its vertices were snapped to (a power of two
-                                       2^-48 to 2^-36 times the result's size); else 0 */
+                                       2^-48 to 2^-28 times the result's size); else 0 */
     mcsg_intersect_stats intersect; /* the intersection stage (mcsg_intersect) */
     double seconds_tree;        /* positive tree and CSG lists */
     double seconds_check;       /* checking the leaves against the input contract */

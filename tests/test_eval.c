@@ -1280,7 +1280,17 @@ TEST(rounding_broken_result_is_evaluated_again)
              &err);
     if (!tree)
         return;
-    CHECK_OK(mcsg_eval(tree, NULL, &out, &prov, &st, &err), &err);
+    /* with its flat vertices removed, the result has no sliver for rounding to turn over
+     * and comes out clean even with crossings checked */
+    opts.check_output_crossings = 1;
+    CHECK_OK(mcsg_eval(tree, &opts, &out, NULL, &st, &err), &err);
+    CHECK(st.flat_vertices_removed > 0 && st.rounding_turned_triangles == 0);
+    CHECK(!mcsg_output_check_failed(&st.output_check) && st.output_check.crossings_checked);
+    mcsg_mesh_free(&out, NULL);
+    /* the exact result's every vertex, as the case was found */
+    opts.check_output_crossings = 0;
+    opts.keep_all_vertices = 1;
+    CHECK_OK(mcsg_eval(tree, &opts, &out, &prov, &st, &err), &err);
     CHECK_EQ_SIZE(st.rounding_separated_vertices, 4);
     CHECK(st.rounding_reevaluations == 0);
     CHECK(!mcsg_output_check_failed(&st.output_check));
@@ -1626,14 +1636,17 @@ TEST(zero_area_triangles_are_removed)
     mcsg_provenance *prov = NULL;
     mcsg_check_report r;
     mcsg_error err;
+    mcsg_options keep_all = {0};
     bool named[7] = {false};
+    keep_all.keep_all_vertices = 1;
     CHECK_OK(mcsg_tree_create(NULL, &tree, &err), &err);
     CHECK_OK(mcsg_make_cube(size, 1, NULL, &cube, &err), &err);
     CHECK_OK(mcsg_tree_add_leaf(tree, &cube, identity, "cube", &ids[0], &err), &err);
     CHECK_OK(mcsg_tree_add_leaf(tree, &sliver, identity, "sliver", &ids[1], &err), &err);
     CHECK_OK(mcsg_tree_add_op(tree, MCSG_NODE_UNION, ids, 2, NULL, &root, &err), &err);
     CHECK_OK(mcsg_tree_set_root(tree, root, &err), &err);
-    CHECK_OK(mcsg_eval(tree, NULL, &out, &prov, NULL, &err), &err);
+    /* every vertex kept: the two halves of the split side then name their faces */
+    CHECK_OK(mcsg_eval(tree, &keep_all, &out, &prov, NULL, &err), &err);
     CHECK_OK(mcsg_mesh_check(&out, NULL, &r, &err), &err);
     /* [-1,1]^3 and the tetrahedron x, y, z >= 0, x + y + z <= 2 (4/3) meet in 5/6. */
     CHECK(mcsg_check_report_is_valid(&r));

@@ -38,7 +38,7 @@ typedef struct cli_option {
 typedef struct cli_values {
     const char *output;
     const char *format;
-    int self_intersections, stats, check_inputs, check_crossings, verbose;
+    int self_intersections, stats, check_inputs, check_crossings, keep_all_vertices, verbose;
     long threads, spheres;
 } cli_values;
 

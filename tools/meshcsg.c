@@ -597,8 +597,11 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  classify         %8.3f s  (%zu regions, %zu rays, %zu local tests, "
            "%zu primitives dropped whole)\n", s->seconds_classify, s->regions, s->rays,
            s->local_tests, s->rejected_primitives);
-    printf("  assemble         %8.3f s  (%zu vertices, %zu triangles)\n", s->seconds_assemble,
-           s->output_vertices, s->output_triangles);
+    printf("  assemble         %8.3f s  (%zu vertices, %zu triangles; %zu flat vertices "
+           "removed)\n", s->seconds_assemble, s->output_vertices, s->output_triangles,
+           s->flat_vertices_removed);
+    printf("  output triangles %zu, smallest angle %.3g degrees, %zu with an angle under 1 "
+           "degree\n", s->output_triangles, s->output_smallest_angle, s->output_needles);
     if (s->rounding_joined_vertices + s->rounding_dropped_triangles +
         s->rounding_split_triangles + s->rounding_flat_triangles + s->rounding_turned_triangles)
         printf("  rounding to doubles: %zu vertices joined, %zu triangles collapsed or folded "
@@ -679,6 +682,7 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
     opts.threads = (int)v->threads;
     opts.check_self_intersections = v->check_inputs;
     opts.check_output_crossings = v->check_crossings;
+    opts.keep_all_vertices = v->keep_all_vertices;
     if (v->verbose) {
         static const mcsg_log_level info = MCSG_LOG_INFO;
         opts.log_user = (void *)&info;
@@ -888,6 +892,10 @@ static const cli_option eval_options[] = {
      "cost on scanned models; by default only leaves with several shells, a negative "
      "or zero volume or an edge of more than two triangles are tested, and the others "
      "when the result would come out open, or with --check-crossings crossing)"},
+    {"keep-all-vertices", 0, CLI_FLAG, NULL, 0, 0, VALUE(keep_all_vertices),
+     "keep every vertex of the exact result (by default the vertices inside a flat "
+     "region or a straight edge, where curves of the evaluation crossed, are removed "
+     "and the flat regions triangulated again; the shape is the same)"},
     {"verbose", 'v', CLI_FLAG, NULL, 0, 0, VALUE(verbose),
      "also print the library's informational messages (what rounding did, why a step "
      "was retried)"},

@@ -51,6 +51,7 @@ void mci_ctx_init(mci_ctx *ctx, const mcsg_options *opts)
         ctx->progress_user = opts->progress_user;
         ctx->check_self_intersections = opts->check_self_intersections;
         ctx->check_output_crossings = opts->check_output_crossings;
+        ctx->keep_all_vertices = opts->keep_all_vertices;
         ctx->pool = opts->pool;
     }
 }

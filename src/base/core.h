@@ -46,6 +46,7 @@ typedef struct mci_ctx {
     void *progress_user;
     int check_self_intersections;
     int check_output_crossings;
+    int keep_all_vertices;
     /* An evaluation of a rounded result again (csg/reevaluate.c): its rounding repair
      * looks for opposite twins after every change, which folds there need. */
     bool reevaluation_round;

@@ -76,6 +76,7 @@
  */
 #include "base/parallel.h"
 #include "csg/classify.h"
+#include "csg/flat_vertices.h"
 #include "csg/frames.h"
 #include "csg/leaf_check.h"
 #include "csg/manifold_split.h"
@@ -86,6 +87,7 @@
 #include "csg/void_shells.h"
 #include "csg/whole_faces.h"
 #include "mesh/tree.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -551,13 +553,124 @@ static mcsg_status fill_provenance(eval_state *e, const uint32_t *kept_tri, size
     return MCSG_OK;
 }
 
+/* What the removal of flat vertices reads: exact points by output vertex id (the
+ * arrangements' for the scene's numbers, explicit ones for the leaf vertices
+ * classification added), faces' corners and leaves. */
+typedef struct flat_points {
+    const eval_state *e;
+    const uint64_t *rep;
+    uint32_t *slot;     /* per leaf vertex added by classification: its point's, or NONE */
+    mci_point *added;   /* made on first use: the removal reads few of them */
+    size_t added_count;
+} flat_points;
+
+static const mci_point *flat_point(void *user, uint32_t id)
+{
+    flat_points *p = user;
+    const mci_scene *s = &p->e->scene;
+    uint32_t k = id - (uint32_t)s->point_count;
+    if (id < s->point_count)
+        return s->arrs[p->rep[id] >> 32].points[(uint32_t)p->rep[id]];
+    if (p->slot[k] == MCI_NONE) { /* a slot each: pointers handed out stay valid */
+        mci_point_explicit(&p->added[p->added_count], p->e->cl.new_vertex[k]);
+        p->slot[k] = (uint32_t)p->added_count++;
+    }
+    return &p->added[p->slot[k]];
+}
+
+static const double *flat_corner(const void *user, uint32_t f, int k)
+{
+    return mci_octree_face_vertex(&((const flat_points *)user)->e->scene.octree, f, k);
+}
+
+static bool flat_complemented(const void *user, uint32_t f)
+{
+    const eval_state *e = ((const flat_points *)user)->e;
+    uint32_t leaf = e->scene.octree.face_leaf[f];
+    return e->tree.nodes[e->tree.leaf_node[leaf]].complement;
+}
+
+static bool flat_touched(const void *user, uint32_t f)
+{
+    return ((const flat_points *)user)->e->scene.arr_of[f] != MCI_NONE;
+}
+
+/* Vertices that carry no shape leave the exact result (flat_vertices.h) unless the
+ * options keep them. */
+static mcsg_status remove_flat_vertices(eval_state *e, mcsg_error *err)
+{
+    const mci_scene *s = &e->scene;
+    size_t added = e->cl.new_vertex_count;
+    flat_points p = {e, NULL, NULL, NULL, 0};
+    mci_flat_source src = {flat_point, flat_corner, flat_complemented, flat_touched, &p,
+                           s->point_count + added};
+    mci_flat_stats fs;
+    mcsg_status st;
+    /* a round of evaluating a rounded result again is judged against the first
+     * result's touching edges, which its own vertices keep */
+    if (e->ctx.keep_all_vertices || e->ctx.reevaluation_round || e->kept.count == 0)
+        return MCSG_OK;
+    p.rep = point_representatives(e);
+    p.slot = mci_malloc_array(&e->ctx, added + 1, sizeof *p.slot);
+    p.added = mci_malloc_array(&e->ctx, added + 1, sizeof *p.added); /* untouched: no pages */
+    if (!p.rep || !p.slot || !p.added)
+        st = mci_fail_nomem(err, "removing flat vertices");
+    else {
+        memset(p.slot, 0xff, added * sizeof *p.slot);
+        st = mci_remove_flat_vertices(&e->ctx, &e->kept, &src, &fs, err);
+    }
+    if (st == MCSG_OK)
+        e->stats.flat_vertices_removed = fs.removed;
+    mci_free(&e->ctx, (void *)p.rep);
+    mci_free(&e->ctx, p.slot);
+    mci_free(&e->ctx, p.added);
+    return st;
+}
+
+/* The output's smallest angle and its triangles with an angle under 1 degree. A
+ * triangle's smallest angle faces its shortest side, and is at most 60 degrees: the
+ * square of its sine, the squared cross product of the two other sides over the product
+ * of their squared lengths, orders the triangles. */
+static void measure_angles(const mcsg_mesh *m, mcsg_eval_stats *stats)
+{
+    const double sin2_one_degree = 0.017452406437283512 * 0.017452406437283512;
+    double smallest = 1;
+    size_t needles = 0;
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const double *p[3];
+        double d[3][3], len[3], cross[3], sine2;
+        int shortest = 0;
+        for (int i = 0; i < 3; i++)
+            p[i] = m->vertices + 3 * (size_t)m->triangles[3 * t + i];
+        for (int i = 0; i < 3; i++) {
+            for (int k = 0; k < 3; k++)
+                d[i][k] = p[(i + 1) % 3][k] - p[i][k];
+            len[i] = d[i][0] * d[i][0] + d[i][1] * d[i][1] + d[i][2] * d[i][2];
+            shortest = len[i] < len[shortest] ? i : shortest;
+        }
+        for (int k = 0; k < 3; k++)
+            cross[k] = d[0][(k + 1) % 3] * d[1][(k + 2) % 3] -
+                       d[0][(k + 2) % 3] * d[1][(k + 1) % 3];
+        sine2 = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]) /
+                (len[(shortest + 1) % 3] * len[(shortest + 2) % 3]);
+        sine2 = sine2 == sine2 ? sine2 : 0; /* 0 / 0: a triangle with coincident corners */
+        smallest = sine2 < smallest ? sine2 : smallest;
+        needles += sine2 < sin2_one_degree;
+    }
+    stats->output_smallest_angle =
+        m->triangle_count ? asin(sqrt(smallest)) * (180 / 3.14159265358979323846) : 0;
+    stats->output_needles = needles;
+}
+
 static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **provenance,
                             mcsg_error *err)
 {
     double t0 = mci_seconds_now();
     rounded r = {NULL, NULL, NULL, 0};
     uint32_t *kept_tri = NULL;
-    mcsg_status st = round_vertices(e, &r, err);
+    mcsg_status st = remove_flat_vertices(e, err);
+    if (st == MCSG_OK)
+        st = round_vertices(e, &r, err);
     /* Once the vertices are rounded, only the kept triangles and the face indexing are
      * read: the arrangements and the octree's cells go before the output is built (the
      * assembly was the peak of the two-model scenes). */
@@ -577,6 +690,8 @@ static mcsg_status assemble(eval_state *e, mcsg_mesh *out, mcsg_provenance **pro
         st = check_output(e, out, err);
     if (st == MCSG_OK && provenance)
         st = fill_provenance(e, kept_tri, out->triangle_count, provenance, err);
+    if (st == MCSG_OK)
+        measure_angles(out, &e->stats);
     if (st != MCSG_OK)
         mci_mesh_free(&e->ctx, out);
     free_rounded(&e->ctx, &r);
@@ -986,8 +1101,11 @@ mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_
 
 /* Where rounding broke a guarantee, the rounded result evaluated again (reevaluate.h);
  * then what still fails is logged. */
+/* The rounded result against its guarantees: where it breaks one, triangles made to
+ * cross are moved apart, and (when `rounds`) the rounded result is evaluated again
+ * (mci_reevaluate_rounded). The check is logged when it passes or `rounds` was allowed. */
 static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenance **provenance,
-                                   mcsg_error *err)
+                                   bool rounds, mcsg_error *err)
 {
     double t0 = mci_seconds_now();
     mcsg_status st = MCSG_OK;
@@ -995,8 +1113,8 @@ static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenanc
         return MCSG_OK;
     st = mci_progress(&e->ctx, "evaluate rounded result again", 0, err);
     if (st == MCSG_OK)
-        st = mci_reevaluate_rounded(&e->ctx, e->touching, e->touching_count, out, provenance,
-                                    &e->stats, err);
+        st = mci_reevaluate_rounded(&e->ctx, e->touching, e->touching_count, rounds, out,
+                                    provenance, &e->stats, err);
     if (st == MCSG_OK)
         st = mci_progress(&e->ctx, "evaluate rounded result again", 1, err);
     if (st == MCSG_OK && e->stats.rounding_reevaluation_kept &&
@@ -1008,9 +1126,42 @@ static mcsg_status settle_rounding(eval_state *e, mcsg_mesh *out, mcsg_provenanc
                 "the rounded result, snapped to a grid of spacing %g (0: not snapped) and "
                 "evaluated again by its winding number %zu times, keeps them",
                 e->stats.rounding_snap_grid, e->stats.rounding_reevaluations);
-    if (st == MCSG_OK)
+    if (st == MCSG_OK && (rounds || !mcsg_output_check_failed(&e->stats.output_check)))
         mci_log_output_check(&e->ctx, &e->stats.output_check);
     e->stats.seconds_assemble += mci_seconds_now() - t0;
+    return st;
+}
+
+/* The evaluation with its rounding settled. A result whose flat vertices were removed
+ * and whose rounding still breaks a guarantee once crossing corners are moved apart (its
+ * longer edges leave slivers that rounding folds otherwise) is made again with every
+ * vertex, and the rounds of evaluating a rounded result again, if it needs them, start
+ * from that one, as they were made for. */
+static mcsg_status evaluate_settled(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
+                                    mcsg_provenance **provenance, mcsg_error *err)
+{
+    mci_ctx ctx = e->ctx;
+    mcsg_status st = evaluate(e, tree, out, provenance, err);
+    bool lean = e->stats.flat_vertices_removed > 0;
+    if (st == MCSG_OK)
+        st = settle_rounding(e, out, provenance, !lean, err);
+    if (st != MCSG_OK || !lean || !mcsg_output_check_failed(&e->stats.output_check))
+        return st;
+    mci_log(&e->ctx, MCSG_LOG_INFO, "rounding to doubles broke a guarantee of the result "
+            "without its %zu flat vertices: evaluating again with every vertex",
+            e->stats.flat_vertices_removed);
+    mci_mesh_free(&e->ctx, out);
+    if (provenance) {
+        mci_free(&e->ctx, *provenance);
+        *provenance = NULL;
+    }
+    mci_free(&e->ctx, e->touching);
+    memset(e, 0, sizeof *e);
+    e->ctx = ctx;
+    e->ctx.keep_all_vertices = 1;
+    st = evaluate(e, tree, out, provenance, err);
+    if (st == MCSG_OK)
+        st = settle_rounding(e, out, provenance, true, err);
     return st;
 }
 
@@ -1048,9 +1199,7 @@ mcsg_status mci_eval_flattened(const mcsg_tree *tree, const mcsg_options *opts, 
      * (exact/exact_cache.c) is allocated once per evaluation, not per loop, and the
      * points a step leaves in it may serve the next */
     scratch_entered = mci_scratch_enter(&scratch, &e.ctx.alloc);
-    st = evaluate(&e, tree, out, provenance, err);
-    if (st == MCSG_OK)
-        st = settle_rounding(&e, out, provenance, err);
+    st = evaluate_settled(&e, tree, out, provenance, err);
     if (st != MCSG_OK) {
         mci_mesh_free(&e.ctx, out);
         if (provenance) {

@@ -411,8 +411,9 @@ static mcsg_status move_crossing_corners(rounds *r, mcsg_error *err)
 }
 
 mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
-                                   size_t touching_count, mcsg_mesh *out,
-                                   mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                                   size_t touching_count, bool allow_rounds,
+                                   mcsg_mesh *out, mcsg_provenance **provenance,
+                                   mcsg_eval_stats *stats,
                                    mcsg_error *err)
 {
     int top = mci_snap_exponent(out, 0);
@@ -423,7 +424,8 @@ mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
     mcsg_status s = MCSG_OK;
     if (stats->output_check.crossing_pairs > 0)
         s = move_crossing_corners(&r, err);
-    for (int round = 0; s == MCSG_OK && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
+    for (int round = 0;
+         s == MCSG_OK && allow_rounds && !r.kept && round <= REEVALUATION_ROUNDS; round++) {
         round_state first = {*out, r.want_source ? *provenance : NULL, false};
         /* Where the last round left no start (its evaluations failed or were refused as
          * starts), the next grid is tried on the first result: coarser, it may join what

@@ -30,11 +30,14 @@ mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_
  * first that passes replaces out and *provenance (mapped back to the tree's leaves), with
  * stats->output_check, the output counts and stats->rounding_snap_grid. When none
  * passes, or the evaluations fail, out is left as it was. Counts the evaluations in
- * stats->rounding_reevaluations.
+ * stats->rounding_reevaluations. Before the rounds (and alone, when allow_rounds is
+ * false), the corners of triangles that rounding made cross are moved apart where that
+ * mends them.
  * Fails only when memory runs out or the check fails (out then as it was). */
 mcsg_status mci_reevaluate_rounded(const mci_ctx *ctx, const double *touching,
-                                   size_t touching_count, mcsg_mesh *out,
-                                   mcsg_provenance **provenance, mcsg_eval_stats *stats,
+                                   size_t touching_count, bool allow_rounds,
+                                   mcsg_mesh *out, mcsg_provenance **provenance,
+                                   mcsg_eval_stats *stats,
                                    mcsg_error *err);
 
 #endif

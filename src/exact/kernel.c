@@ -1616,7 +1616,8 @@ static int normal_sign_exact(const mci_plane *plane, int axis)
 
 int mci_plane_normal_sign(const mci_plane *plane, int axis)
 {
-    return normal_sign_exact(plane, axis);
+    int s = fv_sign(plane->n[axis]);
+    return s != MCI_UNCERTAIN ? s : normal_sign_exact(plane, axis);
 }
 
 int mci_plane_projection_axis(const mci_plane *plane, int *sign)

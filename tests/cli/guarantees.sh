@@ -7,29 +7,48 @@
 ROUNDING=${MCSG_TEST_DATA:?}/rounding
 
 # Rounding makes parts touch along four edges: vertex copies moved apart by one unit in
-# the last place, the result is clean.
-run 0 eval "$ROUNDING/example018-moved.scad" -o "$WORK/e18.off"
-lacks "warning"
-run 0 check "$WORK/e18.off"
-contains "ok: 160 vertices, 316 triangles, 1 component"
-# With crossings checked too: the sliver that rounding turned over is split away, and
-# the corners of the triangles still crossing are moved by one unit in the last place
-# (two more than the four copies above); the volume stays that of the exact result.
-rm -f "$WORK/e18.off"
-run 0 eval "$ROUNDING/example018-moved.scad" -o "$WORK/e18.off" --check-crossings --stats
-lacks "warning"
-contains "touching or crossing made by rounding: 6 vertices moved"
-run 0 check --self-intersections "$WORK/e18.off"
-contains "ok: 160 vertices, 316 triangles, 1 component, volume 175969.18382"
-contains "ok: no self-intersections"
+# the last place, the result is clean (118 vertices once the 42 inside its flat regions
+# and straight edges are removed; 160 with --keep-all-vertices).
+for keep in "" --keep-all-vertices; do
+    rm -f "$WORK/e18.off"
+    run 0 eval "$ROUNDING/example018-moved.scad" -o "$WORK/e18.off" $keep
+    lacks "warning"
+    run 0 check "$WORK/e18.off"
+    if [ -z "$keep" ]; then
+        contains "ok: 118 vertices, 232 triangles, 1 component"
+    else
+        contains "ok: 160 vertices, 316 triangles, 1 component"
+    fi
+done
+# With crossings checked too: the corners of triangles that rounding made cross are moved
+# by one unit in the last place (two more than the four copies above; with every vertex
+# kept, a sliver that rounding turned over is split away first); the volume stays that of
+# the exact result.
+for keep in "" --keep-all-vertices; do
+    rm -f "$WORK/e18.off"
+    run 0 eval "$ROUNDING/example018-moved.scad" -o "$WORK/e18.off" --check-crossings --stats \
+        $keep
+    lacks "warning"
+    contains "touching or crossing made by rounding: 6 vertices moved"
+    run 0 check --self-intersections "$WORK/e18.off"
+    contains "1 component, volume 175969.18382"
+    contains "ok: no self-intersections"
+done
 
-# Rounding makes three turned cubes cross: two corners moved by one unit in the last
-# place, the result has no crossing triangles.
+# Rounding makes three turned cubes cross (with every vertex kept): two corners moved by
+# one unit in the last place, the result has no crossing triangles. Without its flat
+# vertices, rounding makes none cross.
 run 0 eval "$ROUNDING/crossing-after-rounding-3-cubes/tree.scad" -o "$WORK/c3.off"
 lacks "warning"
-run 0 eval "$ROUNDING/crossing-after-rounding-3-cubes/tree.scad" -o "$WORK/c3.off" --check-crossings --stats
+run 0 eval "$ROUNDING/crossing-after-rounding-3-cubes/tree.scad" -o "$WORK/c3.off" \
+    --check-crossings --stats --keep-all-vertices
 lacks "warning"
 contains "touching or crossing made by rounding: 2 vertices moved by one unit in the last place"
+run 0 check --self-intersections "$WORK/c3.off"
+contains "ok: no self-intersections"
+run 0 eval "$ROUNDING/crossing-after-rounding-3-cubes/tree.scad" -o "$WORK/c3.off" \
+    --check-crossings
+lacks "warning"
 run 0 check --self-intersections "$WORK/c3.off"
 contains "ok: no self-intersections"
 
@@ -70,7 +89,7 @@ run 0 eval "$ROUNDING/menger-3-6digits.scad" -o "$WORK/m3.off" --stats
 lacks "warning"
 contains "frames"
 run 0 check "$WORK/m3.off"
-contains "ok: 14012 vertices, 30936 triangles, 1 component"
+contains "ok: 5087 vertices, 13086 triangles, 1 component"
 
 # The same sponge with every cube turned on its own (the matrices composed into each
 # leaf): rounding leaves edges of four triangles once welded, and a round's mesh, snapped
@@ -85,14 +104,22 @@ contains "ok: "
 run 1 check --self-intersections "$WORK/m3.off"
 contains "pairs of triangles intersect each other"
 
-# A turned group whose result, once turned, has triangles that cross: corners moved by a
-# unit in the last place mend them, and the result is clean.
+# A turned group whose result (with every vertex), once turned, has triangles that cross:
+# corners moved by a unit in the last place mend them, and the result is clean. Without
+# its flat vertices, the group's result has no such triangles.
 rm -f "$WORK/f5.off"
-run 0 eval "$ROUNDING/frame-turn-makes-crossings-5-leaves.scad" -o "$WORK/f5.off" -v
+run 0 eval "$ROUNDING/frame-turn-makes-crossings-5-leaves.scad" -o "$WORK/f5.off" -v \
+    --keep-all-vertices
 lacks "warning"
 contains "turning a group's result made"
 contains "corners moved by a unit in the last place mend them"
 run 0 check --self-intersections "$WORK/f5.off"
+contains "ok: no self-intersections"
+rm -f "$WORK/f5.off"
+run 0 eval "$ROUNDING/frame-turn-makes-crossings-5-leaves.scad" -o "$WORK/f5.off"
+lacks "warning"
+run 0 check --self-intersections "$WORK/f5.off"
+contains "ok: 22 vertices, 40 triangles"
 contains "ok: no self-intersections"
 
 # A turned group whose turned result folds slivers onto each other: evaluated as a leaf
@@ -100,13 +127,22 @@ contains "ok: no self-intersections"
 # coordinates (the search for a point inside it once gave up, and the tree was evaluated
 # with each leaf turned on its own); the result is clean (a fuzz tree of 70 leaves,
 # shrunk).
+# (With every vertex kept, as the case was found; without its flat vertices the group's
+# result folds nothing.)
 rm -f "$WORK/fb.off"
-run 0 eval "$ROUNDING/frame-fails-flattened-3-leaves.scad" -o "$WORK/fb.off" -v --stats
+run 0 eval "$ROUNDING/frame-fails-flattened-3-leaves.scad" -o "$WORK/fb.off" -v --stats \
+    --keep-all-vertices
 lacks "warning"
 contains "it is evaluated as a mesh that crosses itself"
 lacks "failed"
 run 0 check --self-intersections "$WORK/fb.off"
 contains "ok: 51 vertices, 98 triangles, 1 component, volume 92942.9425918635"
+contains "ok: no self-intersections"
+rm -f "$WORK/fb.off"
+run 0 eval "$ROUNDING/frame-fails-flattened-3-leaves.scad" -o "$WORK/fb.off"
+lacks "warning"
+run 0 check --self-intersections "$WORK/fb.off"
+contains "ok: 30 vertices, 56 triangles, 1 component, volume 92942.94259186"
 contains "ok: no self-intersections"
 
 printf 'union() { cube(1); translate([1, 1, 0]) cube(1); }\n' > "$WORK/touching.scad"
