@@ -603,7 +603,13 @@ typedef struct mcsg_eval_stats {
 /* Evaluate the CSG tree exactly: the boundary of the regularized result as a closed,
  * consistently oriented, edge-manifold triangle mesh whose vertices are the exact result
  * vertices rounded to double (only at the end). An empty result gives a mesh with no
- * triangles.
+ * triangles. Unless opts->keep_all_vertices, a vertex of a face that another surface met
+ * is left out where it carries no shape (inside a flat region, or inside a straight edge
+ * between two flat regions), decided exactly: its hole is triangulated again, each new
+ * triangle naming in provenance the face of one it replaced there (same plane, same
+ * facing; where a flat region spans coplanar faces of several leaves, either may be
+ * named). Where rounding then breaks a guarantee that moving crossing corners does not
+ * mend, the result is made again with every vertex (see below).
  * Input contract: every non-empty leaf the root reaches must be closed as a chain (with
  * vertices identified by coordinates, every edge used as often one way as the other;
  * mcsg_check_report: no boundary, inconsistent or unbalanced edges), with finite
