@@ -35,8 +35,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Holes with more corners are not ear-clipped (that costs the square of the corners): a
- * fan this large (a fan-triangulated face's centre) that no collapse fills is kept. */
+/* Fans with more triangles are left alone: filling their holes costs up to the square of
+ * their corners, and a fan this large is rare outside meshes made of fans. */
 enum { MAX_POLYGON = 1024 };
 
 /* Planes of recently used faces, by face id modulo the size: neighbouring vertices
@@ -388,7 +388,7 @@ static bool surely_three_planes(flat_state *s, uint32_t v)
 static bool removable_vertex(flat_state *s, uint32_t v, size_t *n, size_t at[2])
 {
     size_t changes;
-    if (surely_three_planes(s, v) || !walk_fan(s, v, n))
+    if (surely_three_planes(s, v) || !walk_fan(s, v, n) || *n > MAX_POLYGON)
         return false;
     changes = plane_changes(s, *n, at, 2);
     if (changes == 0)
@@ -533,82 +533,8 @@ static bool collapse_onto(flat_state *s, size_t n, size_t j, const hole side[2],
 
 enum { COLLAPSE_TRIES = 4 };
 
-/* Whether d lies inside the circle through a, b, c (counter-clockwise in hole h's
- * plane), judged on the points' approximations in doubles. Only a preference: it picks
- * which diagonal of a quadrilateral to keep, and every flip it asks for is checked
- * exactly (improve_hole), so a wrong answer costs quality, never validity (as in the
- * faces' triangulation, triangulate.c). */
-static bool roughly_in_circle(const flat_state *s, const hole *h, uint32_t a, uint32_t b,
-                              uint32_t c, uint32_t d)
-{
-    const mci_flat_source *src = s->src;
-    const uint32_t ids[4] = {a, b, c, d};
-    double q[4][3], x[3], y[3];
-    int i = (h->axis + 1) % 3, j = (h->axis + 2) % 3;
-    for (int k = 0; k < 4; k++)
-        mci_point_approx(src->point(src->user, ids[k]), q[k]);
-    for (int k = 0; k < 3; k++)
-        x[k] = q[k][i] - q[3][i], y[k] = q[k][j] - q[3][j];
-    double det = (x[0] * x[0] + y[0] * y[0]) * (x[1] * y[2] - x[2] * y[1]) -
-                 (x[1] * x[1] + y[1] * y[1]) * (x[0] * y[2] - x[2] * y[0]) +
-                 (x[2] * x[2] + y[2] * y[2]) * (x[0] * y[1] - x[1] * y[0]);
-    return h->sign * det > 0;
-}
-
-/* Flips per hole at most, per new triangle: the rough test could ask for a flip and its
- * undoing forever where four corners lie on one circle. */
-enum { FLIPS_PER_TRIANGLE = 4, IMPROVED_HOLE = 64 };
-
-/* The edge new triangles x and y share, x holding it as its side k (from corner k to
- * k + 1) and y the other way: true with *k set, else false. */
-static bool shared_side(const uint32_t *x, const uint32_t *y, int *k)
-{
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            if (x[i] == y[(j + 1) % 3] && x[(i + 1) % 3] == y[j]) {
-                *k = i;
-                return true;
-            }
-    return false;
-}
-
-/* Lawson's flips inside the hole's new triangles (s->fresh), between two on one side
- * (same face plane, facing the same way), towards the hole's constrained Delaunay
- * triangulation: joining a vertex onto a corner of its fan makes needles where the fan
- * was long. A flip is made only where the quadrilateral is strictly convex (exact
- * turns); each triangle keeps its slot's face. */
-static void improve_hole(flat_state *s)
-{
-    size_t m = s->fresh_count, flips = 0, budget = FLIPS_PER_TRIANGLE * m;
-    bool changed = m > 1 && m <= IMPROVED_HOLE;
-    while (changed && flips < budget) {
-        changed = false;
-        for (size_t x = 0; x < m && flips < budget; x++)
-            for (size_t y = x + 1; y < m && flips < budget; y++) {
-                uint32_t *t = s->fresh + 4 * x, *u = s->fresh + 4 * y;
-                hole h;
-                int k, l;
-                if (!shared_side(t, u, &k) || !same_flat(s, t[3], u[3]) ||
-                    !hole_of_face(s, t[3], &h))
-                    continue;
-                uint32_t a = t[k], b = t[(k + 1) % 3], c = t[(k + 2) % 3];
-                for (l = 0; l < 3 && u[l] != b; l++)
-                    ;
-                uint32_t d = u[(l + 2) % 3]; /* u = (b, a, d) */
-                if (!roughly_in_circle(s, &h, a, b, c, d) || turn(s, &h, c, a, d) <= 0 ||
-                    turn(s, &h, d, b, c) <= 0)
-                    continue;
-                t[0] = c, t[1] = a, t[2] = d;
-                u[0] = d, u[1] = b, u[2] = c;
-                flips++;
-                changed = true;
-            }
-    }
-}
-
 /* The triangles that fill v's hole, in s->fresh: a collapse onto a ring corner where one
- * is valid (onto an end of the straight edge for a vertex inside one), else ears; then
- * flipped towards Delaunay. */
+ * is valid (onto an end of the straight edge for a vertex inside one), else ears. */
 static bool fill_hole(flat_state *s, size_t n, const size_t at[2], size_t changes)
 {
     bool filled = false;
@@ -621,14 +547,12 @@ static bool fill_hole(flat_state *s, size_t n, const size_t at[2], size_t change
                  collapse_onto(s, n, at[1], side, at, changes);
     for (size_t j = 0; !changes && !filled && j < n && j < COLLAPSE_TRIES; j++)
         filled = collapse_onto(s, n, j, side, at, changes);
-    if (!filled && !s->nomem && n <= MAX_POLYGON) {
+    if (!filled && !s->nomem) {
         s->fresh_count = 0;
         filled = changes == 0 ? fill_side(s, n, 0, n)
                               : fill_side(s, n, at[0], (at[1] + n - at[0]) % n) &&
                                     fill_side(s, n, at[1], (at[0] + n - at[1]) % n);
     }
-    if (filled)
-        improve_hole(s);
     return filled;
 }
 
@@ -891,70 +815,6 @@ static bool size_grouping(flat_state *s, uint32_t **work)
     return true;
 }
 
-/* The triangle across side (a -> b) of a grouped triangle: the corner at b whose next
- * corner is a, in b's run; MCI_NONE unless exactly one. */
-static uint32_t across(const flat_state *s, uint32_t a, uint32_t b)
-{
-    uint32_t found = MCI_NONE;
-    for (uint32_t k = first_corner(s, b); k < end_corner(s, b); k++)
-        if (s->corners[k].next == a) {
-            if (found != MCI_NONE)
-                return MCI_NONE;
-            found = k;
-        }
-    return found;
-}
-
-/* Flips new triangle t's first side that Lawson's test asks for (see improve_hole), the
- * triangle across being new too and not yet changed in this sweep. */
-static bool flip_one(flat_state *s, uint32_t t)
-{
-    uint32_t *x = s->tris + 3 * (size_t)t;
-    for (int k = 0; k < 3; k++) {
-        uint32_t a = x[k], b = x[(k + 1) % 3], c = x[(k + 2) % 3], at = across(s, a, b), u, d;
-        hole h;
-        if (at == MCI_NONE)
-            continue;
-        u = s->corners[at].tri, d = s->corners[at].prev; /* u = (b, a, d) */
-        if (u < s->origin_count || s->taken[u] || !same_flat(s, s->faces[t], s->faces[u]) ||
-            !hole_of_face(s, s->faces[t], &h) || !roughly_in_circle(s, &h, a, b, c, d) ||
-            turn(s, &h, c, a, d) <= 0 || turn(s, &h, d, b, c) <= 0)
-            continue;
-        x[0] = c, x[1] = a, x[2] = d;
-        s->tris[3 * (size_t)u] = d, s->tris[3 * (size_t)u + 1] = b, s->tris[3 * (size_t)u + 2] = c;
-        s->taken[t] = s->taken[u] = 1;
-        return true;
-    }
-    return false;
-}
-
-enum { FLIP_SWEEPS = 16 };
-
-/* Lawson's flips between the new triangles of all the holes, in sweeps over them (each
- * grouping them again), towards the constrained Delaunay triangulation of their flat
- * regions: holes filled one after another in a row leave fans across each other. Same
- * rules as improve_hole; work has room for every triangle. */
-static void improve_new(flat_state *s, uint32_t *work)
-{
-    size_t budget = 0;
-    for (size_t t = s->origin_count; t < s->count; t++)
-        budget += FLIPS_PER_TRIANGLE * !s->dead[t];
-    for (int sweep = 0; sweep < FLIP_SWEEPS && budget > 0; sweep++) {
-        size_t n = 0, flips = 0;
-        for (size_t t = s->origin_count; t < s->count; t++)
-            if (!s->dead[t])
-                work[n++] = (uint32_t)t;
-        group_corners(s, work, n);
-        for (size_t w = 0; w < n; w++)
-            s->taken[work[w]] = 0;
-        for (size_t w = 0; w < n && flips < budget; w++)
-            flips += !s->taken[work[w]] && flip_one(s, work[w]);
-        if (flips == 0)
-            break;
-        budget -= flips;
-    }
-}
-
 /* Sides counted by undirected edge, in a table sized for the new triangles' edges. */
 typedef struct side_table {
     uint64_t *key;
@@ -1085,8 +945,6 @@ mcsg_status mci_remove_flat_vertices(const mci_ctx *ctx, mci_kept *kept,
         find_work(s, work, &count, 0);
         remove_marked(s, &work, count, stats);
     }
-    if (!s->nomem && stats->removed > 0)
-        improve_new(s, work);
     if (!s->nomem && stats->removed > 0) {
         bool shared = false;
         s->nomem = !new_edges_shared(s, kept, state, &shared);
