@@ -93,6 +93,7 @@
 
 typedef struct eval_state {
     mci_ctx ctx;
+    const mcsg_tree *source; /* the tree evaluated */
     mci_ptree tree;
     uint32_t *alias; /* per primitive: the earlier one it is a copy of, or itself; NULL if
                         no primitive is a copy */
@@ -595,6 +596,13 @@ static bool flat_touched(const void *user, uint32_t f)
     return ((const flat_points *)user)->e->scene.arr_of[f] != MCI_NONE;
 }
 
+static bool flat_own_plane(const void *user, uint32_t f)
+{
+    const flat_points *p = user;
+    uint32_t leaf = p->e->scene.octree.face_leaf[f];
+    return !mci_tree_is_made(p->e->source, p->e->tree.leaf_source[leaf]);
+}
+
 /* Vertices that carry no shape leave the exact result (flat_vertices.h) unless the
  * options keep them. */
 static mcsg_status remove_flat_vertices(eval_state *e, mcsg_error *err)
@@ -602,7 +610,8 @@ static mcsg_status remove_flat_vertices(eval_state *e, mcsg_error *err)
     const mci_scene *s = &e->scene;
     size_t added = e->cl.new_vertex_count;
     flat_points p = {e, NULL, NULL, NULL, 0};
-    mci_flat_source src = {flat_point, flat_corner, flat_complemented, flat_touched, &p,
+    mci_flat_source src = {flat_point,   flat_corner,    flat_complemented,
+                           flat_touched, flat_own_plane, &p,
                            s->point_count + added};
     mci_flat_stats fs;
     mcsg_status st;
@@ -1036,6 +1045,7 @@ static mcsg_status run(eval_state *e, const mcsg_tree *tree, mcsg_mesh *out,
     double t0 = mci_seconds_now();
     mcsg_eval_stats before;
     mcsg_status st = mci_ptree_build(&e->ctx, tree, &e->tree, err);
+    e->source = tree;
     e->stats.seconds_tree = mci_seconds_now() - t0;
     if (st != MCSG_OK)
         return st;

@@ -390,6 +390,9 @@ static bool removable_vertex(flat_state *s, uint32_t v, size_t *n, size_t at[2])
     size_t changes;
     if (surely_three_planes(s, v) || !walk_fan(s, v, n) || *n > MAX_POLYGON)
         return false;
+    for (size_t k = 0; k < *n; k++) /* new triangles take the faces of the fan's */
+        if (!s->src->own_plane(s->src->user, fan_face(s, k)))
+            return false;
     changes = plane_changes(s, *n, at, 2);
     if (changes == 0)
         return true;
@@ -590,6 +593,7 @@ static bool remove_vertex(flat_state *s, size_t n, const size_t at[2], size_t ch
 {
     if (!fill_hole(s, n, at, changes) || !reserve(s, s->count + s->fresh_count))
         return false;
+
     for (size_t k = 0; k < n; k++) {
         uint32_t t = fan_tri(s, k);
         s->dead[t] = s->taken[t] = 1;
@@ -953,6 +957,7 @@ mcsg_status mci_remove_flat_vertices(const mci_ctx *ctx, mci_kept *kept,
     }
     if (!s->nomem && stats->removed > 0)
         s->nomem = !write_back(s, kept);
+
     st = s->nomem ? mci_fail_nomem(err, "removing flat vertices") : MCSG_OK;
     mci_free(ctx, work);
     mci_free(ctx, state);

@@ -20,6 +20,10 @@ typedef struct mci_flat_source {
     /* Whether face f met another surface (was split): only vertices of such faces are
      * looked at, the others being the leaves' own. */
     bool (*touched)(const void *user, uint32_t f);
+    /* Whether face f's plane is that of the face provenance names for it: false for a
+     * leaf that is another evaluation's rounded result (a frame's), whose thin triangles
+     * lie in planes tilted from their sources'. Vertices with such faces are kept. */
+    bool (*own_plane)(const void *user, uint32_t f);
     void *user;
     size_t id_count; /* every vertex id is below it */
 } mci_flat_source;
