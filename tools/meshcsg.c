@@ -709,6 +709,7 @@ static int cmd_repair(const cli_values *v, int argc, char **argv)
     int code = 0;
     (void)argc;
     opts.threads = (int)v->threads;
+    opts.keep_all_vertices = v->keep_all_vertices;
     if (mcsg_mesh_read(argv[0], MCSG_FORMAT_AUTO, &opts, &in, &err) != MCSG_OK) {
         fail_line(&err);
         return EXIT_PROBLEM;
@@ -906,6 +907,8 @@ static const cli_option repair_options[] = {
     {"stats", 0, CLI_FLAG, NULL, 0, 0, VALUE(stats),
      "print the evaluation's steps and times, as eval --stats does"},
     THREADS,
+    {"keep-all-vertices", 0, CLI_FLAG, NULL, 0, 0, VALUE(keep_all_vertices),
+     "keep every vertex of the solid's exact boundary (as eval --keep-all-vertices)"},
     END_OF_OPTIONS};
 static const cli_option demo_options[] = {
     {"spheres", 'n', CLI_NUMBER, "N", 1, 10000, VALUE(spheres),

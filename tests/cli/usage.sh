@@ -25,7 +25,9 @@ help check --self-intersections "-o, --output FILE"
 help tree
 help convert "-f, --format F" "ply-binary-be" "default: from OUT's"
 help intersect "-o, --output FILE"
-help eval "-o, --output FILE" --stats "-t, --threads N" --check-inputs "default: one per"
+help eval "-o, --output FILE" --stats "-t, --threads N" --check-inputs "default: one per" \
+    --keep-all-vertices
+help repair "-o, --output FILE" --keep-all-vertices
 help demo "-n, --spheres N" "default: 200" "-o, --output FILE" "-t, --threads N"
 # --help wins over operands and other options: nothing is read.
 run 0 tree "$WORK/missing.scad" --help
@@ -64,6 +66,18 @@ contains "8 vertices, 12 triangles"
 cp "$WORK/c.scad" "$WORK/-dash.scad"
 (cd "$WORK" && "$CLI" eval -t 1 -- -dash.scad >/dev/null 2>&1) && passed=$((passed + 1)) ||
   { echo "FAIL: -- did not end the options"; failed=$((failed + 1)); }
+
+# Flat vertices: two cubes side by side are one box of 8 corners, or with every vertex
+# of the exact result 12 (the shared face's corners), for eval and repair alike.
+printf 'union() { cube(1); translate([1, 0, 0]) cube(1); }\n' > "$WORK/two.scad"
+run 0 eval "$WORK/two.scad" -o "$WORK/two.off" --stats
+contains "8 vertices, 12 triangles"
+contains "4 flat vertices removed"
+contains "output triangles 12, smallest angle"
+run 0 eval "$WORK/two.scad" --keep-all-vertices
+contains "12 vertices, 20 triangles"
+run 0 repair "$WORK/two.off" --keep-all-vertices
+contains "8 vertices, 12 triangles"
 
 # The README shows `meshcsg --help` verbatim: it must not drift from the tables.
 readme=${MCSG_TEST_DATA:?}/../../README.md
