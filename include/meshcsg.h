@@ -132,8 +132,9 @@ typedef struct mcsg_options {
     int check_output_crossings; /* mcsg_eval: nonzero also tests the result for pairs of
                                    triangles that cross each other (exact, costs about as
                                    much as an evaluation; see mcsg_output_check) */
-    int keep_all_vertices;    /* mcsg_eval: nonzero keeps every vertex of the exact
-                                 result. Zero (the default) removes the vertices that
+    int keep_all_vertices;    /* mcsg_eval, mcsg_mesh_repair: nonzero keeps every
+                                 vertex of the exact result. Zero (the default) removes
+                                 the vertices of faces that another surface met which
                                  carry no shape: inside a flat region, or inside a
                                  straight edge between two flat regions (where curves
                                  of the arrangement crossed); the shape is unchanged */

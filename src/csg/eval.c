@@ -37,6 +37,7 @@
  *     trimmed CSGlist         mci_csglist_trim_sparse     csgtree.c          §5.3
  *     output tessellation     mci_arr_retessellate        retessellate.c     §5.4
  *   assembly                  assemble                    eval.c             -
+ *     flat vertices removed   mci_remove_flat_vertices    flat_vertices.c    -
  *     rounding                mci_point_round             exact/kernel.c     -
  *     folds and flat ones     mci_cancel_opposite_triangles,
  *                             mci_split_flat_triangles    rounding_repair.c  -
@@ -1109,8 +1110,6 @@ mcsg_status mci_eval_in_context(const mcsg_tree *tree, const mci_ctx *ctx, mcsg_
     return st;
 }
 
-/* Where rounding broke a guarantee, the rounded result evaluated again (reevaluate.h);
- * then what still fails is logged. */
 /* The rounded result against its guarantees: where it breaks one, triangles made to
  * cross are moved apart, and (when `rounds`) the rounded result is evaluated again
  * (mci_reevaluate_rounded). The check is logged when it passes or `rounds` was allowed. */
