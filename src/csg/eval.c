@@ -631,6 +631,10 @@ static mcsg_status remove_flat_vertices(eval_state *e, mcsg_error *err)
     }
     if (st == MCSG_OK)
         e->stats.flat_vertices_removed = fs.removed;
+    if (st == MCSG_OK && fs.gave_up)
+        mci_log(&e->ctx, MCSG_LOG_INFO, "%zu flat vertices kept: removing them would give an "
+                "edge more than two triangles where parts of the result touch",
+                fs.removable);
     mci_free(&e->ctx, (void *)p.rep);
     mci_free(&e->ctx, p.slot);
     mci_free(&e->ctx, p.added);

@@ -593,7 +593,6 @@ static bool remove_vertex(flat_state *s, size_t n, const size_t at[2], size_t ch
 {
     if (!fill_hole(s, n, at, changes) || !reserve(s, s->count + s->fresh_count))
         return false;
-
     for (size_t k = 0; k < n; k++) {
         uint32_t t = fan_tri(s, k);
         s->dead[t] = s->taken[t] = 1;
@@ -608,10 +607,16 @@ static bool remove_vertex(flat_state *s, size_t n, const size_t at[2], size_t ch
     return true;
 }
 
+/* Whether triangle t of tris has a corner whose flag is `value`. */
+static bool corner_flagged(const uint32_t *tris, size_t t, const uint8_t *flag, uint8_t value)
+{
+    return flag[tris[3 * t]] == value || flag[tris[3 * t + 1]] == value ||
+           flag[tris[3 * t + 2]] == value;
+}
+
 static bool has_removable_corner(const flat_state *s, size_t t)
 {
-    return !s->dead[t] && (s->removable[s->tris[3 * t]] || s->removable[s->tris[3 * t + 1]] ||
-                           s->removable[s->tris[3 * t + 2]]);
+    return !s->dead[t] && corner_flagged(s->tris, t, s->removable, 1);
 }
 
 /* The live triangles with a corner still to be removed: those of the last work list
@@ -712,19 +717,17 @@ static bool find_candidates(flat_state *s, const mci_kept *kept, uint8_t *state)
     return true;
 }
 
-/* Copies the kept triangles with a corner marked in `mark` into the state (their index
- * in kept in s->origin); returns false when out of memory. */
-static bool take_work(flat_state *s, const mci_kept *kept, const uint8_t *mark, uint8_t value)
+/* Copies the kept triangles with a candidate corner (state) into the flat state (their
+ * index in kept in s->origin); returns false when out of memory. */
+static bool take_work(flat_state *s, const mci_kept *kept, const uint8_t *state)
 {
     size_t n = 0;
     for (size_t t = 0; t < kept->count; t++)
-        n += mark[kept->tris[3 * t]] == value || mark[kept->tris[3 * t + 1]] == value ||
-             mark[kept->tris[3 * t + 2]] == value;
+        n += corner_flagged(kept->tris, t, state, CANDIDATE);
     if (!reserve(s, n) || !(s->origin = mci_malloc_array(s->ctx, n + 1, sizeof *s->origin)))
         return false;
     for (size_t t = 0; t < kept->count; t++)
-        if (mark[kept->tris[3 * t]] == value || mark[kept->tris[3 * t + 1]] == value ||
-            mark[kept->tris[3 * t + 2]] == value) {
+        if (corner_flagged(kept->tris, t, state, CANDIDATE)) {
             for (int i = 0; i < 3; i++)
                 s->tris[3 * s->count + i] = kept->tris[3 * t + i];
             s->faces[s->count] = kept->faces[t];
@@ -782,7 +785,8 @@ static bool write_back(const flat_state *s, mci_kept *kept)
         }
     for (size_t t = s->origin_count; t < s->count; t++)
         if (!s->dead[t]) {
-            memcpy(kept->tris + 3 * n, s->tris + 3 * t, 3 * sizeof *kept->tris);
+            for (int i = 0; i < 3; i++)
+                kept->tris[3 * n + i] = s->tris[3 * t + i];
             kept->faces[n++] = s->faces[t];
         }
     kept->count = n;
@@ -936,7 +940,7 @@ mcsg_status mci_remove_flat_vertices(const mci_ctx *ctx, mci_kept *kept,
         s->plane_face[k] = MCI_NONE;
     memset(s->pair_key, 0xff, sizeof s->pair_key);
     s->nomem = !find_candidates(s, kept, state);
-    s->nomem = s->nomem || !take_work(s, kept, state, CANDIDATE);
+    s->nomem = s->nomem || !take_work(s, kept, state);
     if (!s->nomem && s->count > 0) {
         s->removable = mci_calloc_array(ctx, ids + 1, 1);
         s->local = mci_calloc_array(ctx, ids + 1, sizeof *s->local);
