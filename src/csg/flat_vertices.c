@@ -619,9 +619,21 @@ static bool has_removable_corner(const flat_state *s, size_t t)
     return !s->dead[t] && corner_flagged(s->tris, t, s->removable, 1);
 }
 
+/* How many triangles find_work lists. */
+static size_t count_work(const flat_state *s, const uint32_t *work, size_t count,
+                         size_t since)
+{
+    size_t n = 0;
+    for (size_t w = 0; w < count; w++)
+        n += has_removable_corner(s, work[w]);
+    for (size_t t = since; t < s->count; t++)
+        n += has_removable_corner(s, (uint32_t)t);
+    return n;
+}
+
 /* The live triangles with a corner still to be removed: those of the last work list
  * (*count of them) that still are, then the triangles added since `since` that are
- * (room for s->count in work). */
+ * (work has room for count_work's number). */
 static void find_work(const flat_state *s, uint32_t *work, size_t *count, size_t since)
 {
     size_t n = 0;
@@ -724,7 +736,8 @@ static bool take_work(flat_state *s, const mci_kept *kept, const uint8_t *state)
     size_t n = 0;
     for (size_t t = 0; t < kept->count; t++)
         n += corner_flagged(kept->tris, t, state, CANDIDATE);
-    if (!reserve(s, n) || !(s->origin = mci_malloc_array(s->ctx, n + 1, sizeof *s->origin)))
+    /* room for the new triangles too: pages not written cost nothing, a copy does */
+    if (!reserve(s, 2 * n) || !(s->origin = mci_malloc_array(s->ctx, n + 1, sizeof *s->origin)))
         return false;
     for (size_t t = 0; t < kept->count; t++)
         if (corner_flagged(kept->tris, t, state, CANDIDATE)) {
@@ -794,11 +807,12 @@ static bool write_back(const flat_state *s, mci_kept *kept)
     return true;
 }
 
-/* Room in the work list and the grouping for every triangle there is now (grown by
- * half again at least: rounds add triangles a few at a time). */
-static bool size_grouping(flat_state *s, uint32_t **work)
+/* Room in the work list and the grouping for `need` triangles. The live triangles at
+ * vertices still to go never grow in number (a hole of n corners takes n - 2 for n), so
+ * the first size, every copied triangle, almost always lasts: growing copies. */
+static bool size_grouping(flat_state *s, uint32_t **work, size_t need)
 {
-    size_t n = s->count + 1;
+    size_t n = need + 1;
     if (n <= s->group_cap)
         return true;
     n = n > s->group_cap + s->group_cap / 2 ? n : s->group_cap + s->group_cap / 2;
@@ -826,11 +840,11 @@ static bool size_grouping(flat_state *s, uint32_t **work)
 /* Sides counted by undirected edge, in a table sized for the new triangles' edges. */
 typedef struct side_table {
     uint64_t *key;
-    uint32_t *count;
+    uint8_t *count; /* stops at 3: more than two is all that matters */
     size_t mask;
 } side_table;
 
-static uint32_t *side_slot(side_table *h, uint64_t key, bool add)
+static uint8_t *side_slot(side_table *h, uint64_t key, bool add)
 {
     size_t i = (size_t)((key * UINT64_C(0x9E3779B97F4A7C15)) >> 20) & h->mask;
     while (h->key[i] != key) {
@@ -843,6 +857,11 @@ static uint32_t *side_slot(side_table *h, uint64_t key, bool add)
         i = (i + 1) & h->mask;
     }
     return &h->count[i];
+}
+
+static void count_side(uint8_t *count)
+{
+    *count += *count < 3;
 }
 
 static bool counts_ok(const side_table *h)
@@ -863,7 +882,7 @@ static bool new_edges_shared(const flat_state *s, const mci_kept *kept, uint8_t 
     side_table h = {NULL, NULL, 0};
     for (size_t t = s->origin_count; t < s->count; t++)
         fresh += !s->dead[t];
-    while (size < 8 * fresh)
+    while (size < 4 * fresh) /* fewer than 3 * fresh edges: never more than 3/4 full */
         size *= 2;
     h.mask = size - 1;
     h.key = mci_malloc_array(s->ctx, size, sizeof *h.key);
@@ -878,8 +897,8 @@ static bool new_edges_shared(const flat_state *s, const mci_kept *kept, uint8_t 
     for (size_t t = s->origin_count; t < s->count; t++)
         for (int i = 0; i < 3 && !s->dead[t]; i++) {
             near[s->tris[3 * t + i]] = 1;
-            (*side_slot(&h, mci_edge_key(s->tris[3 * t + i], s->tris[3 * t + (i + 1) % 3]),
-                        true))++;
+            count_side(side_slot(&h, mci_edge_key(s->tris[3 * t + i],
+                                                  s->tris[3 * t + (i + 1) % 3]), true));
         }
     /* the old triangles that stay: those not copied, and the copies not removed */
     for (size_t t = 0, o = 0; t < kept->count; t++) {
@@ -889,11 +908,11 @@ static bool new_edges_shared(const flat_state *s, const mci_kept *kept, uint8_t 
         if ((copied && s->dead[o - 1]) || near[c[0]] + near[c[1]] + near[c[2]] < 2)
             continue;
         for (int i = 0; i < 3; i++) {
-            uint32_t *n = near[c[i]] && near[c[(i + 1) % 3]]
+            uint8_t *n = near[c[i]] && near[c[(i + 1) % 3]]
                               ? side_slot(&h, mci_edge_key(c[i], c[(i + 1) % 3]), false)
                               : NULL;
             if (n)
-                (*n)++;
+                count_side(n);
         }
     }
     *shared = !counts_ok(&h);
@@ -911,7 +930,7 @@ static void remove_marked(flat_state *s, uint32_t **work, size_t count, mci_flat
         stats->rounds++;
         /* the first round walks the fans as the marking grouped them */
         stats->removed += removal_round(s, *work, count, stats->rounds == 1);
-        if (!size_grouping(s, work)) {
+        if (!size_grouping(s, work, count_work(s, *work, count, since))) {
             s->nomem = true;
             return;
         }
@@ -944,7 +963,7 @@ mcsg_status mci_remove_flat_vertices(const mci_ctx *ctx, mci_kept *kept,
     if (!s->nomem && s->count > 0) {
         s->removable = mci_calloc_array(ctx, ids + 1, 1);
         s->local = mci_calloc_array(ctx, ids + 1, sizeof *s->local);
-        s->nomem = !s->removable || !s->local || !size_grouping(s, &work);
+        s->nomem = !s->removable || !s->local || !size_grouping(s, &work, s->count);
     }
     if (!s->nomem && s->count > 0)
         stats->removable = mark_removable(s, state, work);
