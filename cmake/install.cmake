@@ -1,6 +1,7 @@
 # `make install PREFIX=DIR` (cmake --install): the tool, the header, the static and the
 # shared library, a pkg-config file, a CMake package (the imported target
-# meshcsg::meshcsg) and the manual page, in Debian's layout (libraries in DIR/lib).
+# meshcsg::meshcsg), the manual page and the Python package, in Debian's layout
+# (libraries in DIR/lib, Python in DIR/lib/python3/dist-packages).
 # The list of installed files goes to DIR/share/meshcsg/installed-files, which
 # `make uninstall` reads.
 include(CMakePackageConfigHelpers)
@@ -9,6 +10,11 @@ set(MCSG_INSTALL_CMAKEDIR lib/cmake/meshcsg)
 install(TARGETS meshcsg_cli RUNTIME DESTINATION bin)
 install(FILES ${CMAKE_SOURCE_DIR}/include/meshcsg.h DESTINATION include)
 install(FILES ${CMAKE_SOURCE_DIR}/docs/meshcsg.1 DESTINATION share/man/man1)
+# The Python package (on the shared library, found relative to it), in Debian's layout.
+if(MCSG_SHARED)
+  install(DIRECTORY ${CMAKE_SOURCE_DIR}/python/meshcsg DESTINATION lib/python3/dist-packages
+          FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
+endif()
 
 # meshcsg::meshcsg is the shared library; meshcsg::meshcsg_static the static one (which
 # needs GMP and the threads library at link time, as its interface says).

@@ -2,7 +2,8 @@
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
 #   tools/ensure-deps.sh          gcc, make, cmake, GMP headers, python3 (benchmark scenes),
-#                                 pkg-config (the install test),
+#                                 pkg-config (the install test), python3-numpy and
+#                                 python3-pytest (the Python interface's tests),
 #                                 and the de_DE.UTF-8 locale (test_numparse_locale checks
 #                                 that numbers ignore a decimal comma)
 #   tools/ensure-deps.sh clang    also clang (compile check; libFuzzer runtime for make fuzz)
@@ -15,6 +16,10 @@ have make  || missing+=(make)
 have cmake || missing+=(cmake)
 have python3 || missing+=(python3) # make bench and the optional shared-scene test
 have pkg-config || missing+=(pkg-config) # the install test builds as a user would
+# The Python interface's tests, on Debian's interpreter (the one apt's packages serve).
+python=/usr/bin/python3; [ -x "$python" ] || python=python3
+"$python" -c 'import numpy' >/dev/null 2>&1 || missing+=(python3-numpy)
+"$python" -c 'import pytest' >/dev/null 2>&1 || missing+=(python3-pytest)
 has_german_locale() { locale -a 2>/dev/null | grep -qix 'de_DE.utf-\{0,1\}8'; }
 # Optional (installed when root, otherwise the test that needs it is skipped):
 optional=()

@@ -20,6 +20,8 @@ for f in "${files[@]}"; do
     echo "removed $root/$f"
   fi
 done
-for d in lib/cmake/meshcsg share/meshcsg; do
+# Python writes its byte code next to the package on import: gone with it.
+rm -rf "$root/lib/python3/dist-packages/meshcsg/__pycache__"
+for d in lib/cmake/meshcsg share/meshcsg lib/python3/dist-packages/meshcsg; do
   rmdir "$root/$d" 2>/dev/null || true
 done

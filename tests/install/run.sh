@@ -2,8 +2,8 @@
 # Installs the build in $1 (cmake --install, as `make install` does) into a scratch
 # prefix and checks what a user gets: the files of docs/architecture.md's list, the
 # shared library's soname and exported symbols, a C program built with pkg-config, a
-# CMake project with find_package(meshcsg), the manual page against the tool's help,
-# DESTDIR, and an uninstall that leaves nothing behind.
+# CMake project with find_package(meshcsg), the README's Python example, the manual page
+# against the tool's help, DESTDIR, and an uninstall that leaves nothing behind.
 #   run.sh BUILD_DIR SOURCE_DIR SCRATCH_DIR
 set -euo pipefail
 build=$1 source=$2 scratch=$3
@@ -19,6 +19,7 @@ for f in bin/meshcsg include/meshcsg.h lib/libmeshcsg.a lib/libmeshcsg.so \
          lib/libmeshcsg.so.$major lib/libmeshcsg.so.$version lib/pkgconfig/meshcsg.pc \
          lib/cmake/meshcsg/meshcsgConfig.cmake lib/cmake/meshcsg/meshcsgConfigVersion.cmake \
          lib/cmake/meshcsg/meshcsgTargets.cmake share/man/man1/meshcsg.1 \
+         lib/python3/dist-packages/meshcsg/__init__.py \
          share/meshcsg/installed-files; do
   [ -e "$prefix/$f" ] || fail "$f not installed"
 done
@@ -63,6 +64,16 @@ for cmd in $("$prefix/bin/meshcsg" --help | sed -n 's/^  \([a-z]\+\) .*/\1/p'); 
   done
 done
 echo "ok   manual page covers every command and option"
+
+# The README's Python example, on the installed package and library alone.
+python=${MCSG_PYTHON:-python3}
+sed -n '/^## Python/,/^## /p' "$source/README.md" | sed -n '/^```python/,/^```/p' | sed '1d;$d' \
+  > "$scratch/example.py"
+[ -s "$scratch/example.py" ] || fail "no Python example in README.md"
+(cd "$scratch" && env -u MESHCSG_LIBRARY PYTHONPATH="$prefix/lib/python3/dist-packages" \
+   "$python" example.py) || fail "the README's Python example"
+[ -s "$scratch/part.stl" ] || fail "the Python example wrote no part.stl"
+echo "ok   Python example from the README"
 
 # DESTDIR: everything under it, and the relocatable pkg-config file still works there.
 DESTDIR=$scratch/stage cmake --install "$build" --prefix /opt/meshcsg >/dev/null
