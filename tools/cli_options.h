@@ -39,6 +39,7 @@ typedef struct cli_values {
     const char *output;
     const char *format;
     int self_intersections, stats, check_inputs, check_crossings, keep_all_vertices, verbose;
+    int quiet;
     long threads, spheres;
 } cli_values;
 

@@ -471,30 +471,62 @@ static int cmd_intersect(const cli_values *v, int argc, char **argv)
 /* demo                                                                                */
 
 /* ---------------------------------------------------------------------------------- */
-/* Progress: when stderr is a terminal, a line names the step that has been running for
- * more than a second (a ticker thread watches the step the library reports). */
+/* Progress: when stderr is a terminal and the work has run for more than a second, a
+ * line names the step under way, how far along the steps it is and the time so far (a
+ * ticker thread redraws it from the step the library last reported). */
 
 typedef struct progress_state {
     pthread_mutex_t lock;
     pthread_t thread;
     const char *step;
+    int step_number; /* 1.. among EVAL_STEPS, 0 for a step not in the list */
     double started;
     int shown, quit, running;
 } progress_state;
 
 static progress_state progress;
 
+/* mcsg_eval's steps in order (mcsg_progress_fn); a rounding round comes after them. */
+static const char *const EVAL_STEPS[] = {"check", "intersect", "triangulate", "classify",
+                                         "assemble"};
+#define EVAL_STEP_COUNT ((int)(sizeof EVAL_STEPS / sizeof *EVAL_STEPS))
+
+static int eval_step_number(const char *step)
+{
+    for (int k = 0; k < EVAL_STEP_COUNT; k++)
+        if (strcmp(step, EVAL_STEPS[k]) == 0)
+            return k + 1;
+    return 0;
+}
+
+static void clear_progress_line(void)
+{
+    if (progress.shown)
+        fprintf(stderr, "\r%72s\r", "");
+    progress.shown = 0;
+}
+
 static int on_progress(void *user, const char *step, int done)
 {
     (void)user;
     pthread_mutex_lock(&progress.lock);
-    if (progress.shown)
-        fprintf(stderr, "\r%60s\r", "");
-    progress.shown = 0;
+    clear_progress_line();
     progress.step = done ? NULL : step;
-    progress.started = now_seconds();
+    if (!done)
+        progress.step_number = eval_step_number(step);
     pthread_mutex_unlock(&progress.lock);
     return 0;
+}
+
+static void draw_progress(void)
+{
+    double seconds = now_seconds() - progress.started;
+    if (progress.step_number > 0)
+        fprintf(stderr, "\rmeshcsg: step %d of %d (%s), %.0f s ", progress.step_number,
+                EVAL_STEP_COUNT, progress.step, seconds);
+    else
+        fprintf(stderr, "\rmeshcsg: %s, %.0f s ", progress.step, seconds);
+    progress.shown = 1;
 }
 
 static void *progress_ticker(void *arg)
@@ -508,19 +540,20 @@ static void *progress_ticker(void *arg)
             pthread_mutex_unlock(&progress.lock);
             return NULL;
         }
-        if (progress.step && now_seconds() - progress.started > 1.0) {
-            fprintf(stderr, "\rmeshcsg: %s ... %.0f s ", progress.step,
-                    now_seconds() - progress.started);
-            progress.shown = 1;
-        }
+        if (progress.step && now_seconds() - progress.started > 1.0)
+            draw_progress();
         pthread_mutex_unlock(&progress.lock);
     }
 }
 
-static void start_progress(mcsg_options *opts)
+/* quiet: no progress line (--quiet). */
+static void start_progress(mcsg_options *opts, int quiet)
 {
-    if (!isatty(2) || pthread_mutex_init(&progress.lock, NULL) != 0)
+    if (quiet || !isatty(2) || pthread_mutex_init(&progress.lock, NULL) != 0)
         return;
+    progress.started = now_seconds();
+    progress.step = NULL;
+    progress.quit = 0;
     if (pthread_create(&progress.thread, NULL, progress_ticker, NULL) != 0) {
         pthread_mutex_destroy(&progress.lock);
         return;
@@ -535,8 +568,7 @@ static void stop_progress(void)
         return;
     pthread_mutex_lock(&progress.lock);
     progress.quit = 1;
-    if (progress.shown)
-        fprintf(stderr, "\r%60s\r", "");
+    clear_progress_line();
     pthread_mutex_unlock(&progress.lock);
     pthread_join(progress.thread, NULL);
     pthread_mutex_destroy(&progress.lock);
@@ -628,9 +660,10 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  total            %8.3f s\n", s->seconds_total);
 }
 
-/* Read, evaluate and write one CSG file with the given options. */
+/* Read, evaluate and write one CSG file with the given options (quiet: print nothing
+ * but errors and the requested stats). */
 static int eval_file(mcsg_options *opts, const char *in, const char *out,
-                     int show_stats)
+                     int show_stats, int quiet)
 {
     int ok;
     double read_seconds, write_seconds;
@@ -645,7 +678,7 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
         return EXIT_PROBLEM;
     }
     read_seconds = now_seconds() - read_seconds;
-    start_progress(opts);
+    start_progress(opts, quiet);
     st = mcsg_eval(tree, opts, &result, NULL, &stats, &err);
     stop_progress();
     if (st != MCSG_OK) {
@@ -663,7 +696,7 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
         printf("  write output     %8.3f s\n", write_seconds);
         printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
     }
-    else
+    else if (!quiet)
         printf("%zu vertices, %zu triangles\n", result.vertex_count, result.triangle_count);
     mcsg_mesh_free(&result, opts);
     mcsg_tree_free(tree);
@@ -683,6 +716,13 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
     opts.check_self_intersections = v->check_inputs;
     opts.check_output_crossings = v->check_crossings;
     opts.keep_all_vertices = v->keep_all_vertices;
+    if (v->quiet && v->verbose) {
+        fprintf(stderr, "meshcsg eval: --quiet and --verbose contradict each other (see "
+                        "meshcsg eval --help)\n");
+        return EXIT_USAGE;
+    }
+    if (v->quiet)
+        opts.log = NULL;
     if (v->verbose) {
         static const mcsg_log_level info = MCSG_LOG_INFO;
         opts.log_user = (void *)&info;
@@ -692,7 +732,7 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
      * threads to spare) every call runs as before. */
     if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK)
         opts.pool = pool;
-    code = eval_file(&opts, argv[0], v->output, v->stats);
+    code = eval_file(&opts, argv[0], v->output, v->stats, v->quiet);
     mcsg_pool_free(pool);
     return code;
 }
@@ -710,11 +750,13 @@ static int cmd_repair(const cli_values *v, int argc, char **argv)
     (void)argc;
     opts.threads = (int)v->threads;
     opts.keep_all_vertices = v->keep_all_vertices;
+    if (v->quiet)
+        opts.log = NULL;
     if (mcsg_mesh_read(argv[0], MCSG_FORMAT_AUTO, &opts, &in, &err) != MCSG_OK) {
         fail_line(&err);
         return EXIT_PROBLEM;
     }
-    start_progress(&opts);
+    start_progress(&opts, v->quiet);
     if (mcsg_mesh_repair(&in, &opts, &result, &st, &err) != MCSG_OK) {
         stop_progress();
         fail_line(&err);
@@ -728,7 +770,8 @@ static int cmd_repair(const cli_values *v, int argc, char **argv)
     }
     if (v->stats)
         print_eval_stats(&st.eval, -1);
-    printf("%zu shells in, %zu pairs of triangles meeting (shells crossing); %zu shells out "
+    if (!v->quiet)
+        printf("%zu shells in, %zu pairs of triangles meeting (shells crossing); %zu shells out "
            "(%zu cavities), %zu vertices, %zu triangles\n", st.shells_in, st.crossing_pairs,
            st.shells_out, st.cavities, result.vertex_count, result.triangle_count);
     mcsg_mesh_free(&result, &opts);
@@ -773,7 +816,7 @@ static int demo_evaluate(const mcsg_tree *tree, const mcsg_options *opts, const 
     int ok;
     mcsg_options with_progress = *opts;
     mcsg_status status;
-    start_progress(&with_progress);
+    start_progress(&with_progress, 0);
     status = mcsg_eval(tree, &with_progress, &result, NULL, &st, &err);
     stop_progress();
     if (status != MCSG_OK) {
@@ -861,6 +904,10 @@ static void keep_freed_memory(void)
     {"threads", 't', CLI_NUMBER, "N", 1, 1024, VALUE(threads),                           \
      "worker threads, 1 to 1024; the output is the same for any number (default: one "   \
      "per processor)"}
+#define QUIET                                                                             \
+    {"quiet", 'q', CLI_FLAG, NULL, 0, 0, VALUE(quiet),                                    \
+     "print nothing but errors: no counts, warnings or progress line (the exit status "  \
+     "still tells a broken guarantee; --stats still prints its table)"}
 #define END_OF_OPTIONS {NULL, 0, CLI_FLAG, NULL, 0, 0, 0, NULL}
 
 static const cli_option check_options[] = {
@@ -900,6 +947,7 @@ static const cli_option eval_options[] = {
     {"verbose", 'v', CLI_FLAG, NULL, 0, 0, VALUE(verbose),
      "also print the library's informational messages (what rounding did, why a step "
      "was retried)"},
+    QUIET,
     END_OF_OPTIONS};
 static const cli_option repair_options[] = {
     OUTPUT("write the repaired mesh to FILE, format from its extension (default: none, "
@@ -909,6 +957,7 @@ static const cli_option repair_options[] = {
     THREADS,
     {"keep-all-vertices", 0, CLI_FLAG, NULL, 0, 0, VALUE(keep_all_vertices),
      "keep every vertex of the solid's exact boundary (as eval --keep-all-vertices)"},
+    QUIET,
     END_OF_OPTIONS};
 static const cli_option demo_options[] = {
     {"spheres", 'n', CLI_NUMBER, "N", 1, 10000, VALUE(spheres),

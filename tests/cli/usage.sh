@@ -26,8 +26,8 @@ help tree
 help convert "-f, --format F" "ply-binary-be" "default: from OUT's"
 help intersect "-o, --output FILE"
 help eval "-o, --output FILE" --stats "-t, --threads N" --check-inputs "default: one per" \
-    --keep-all-vertices
-help repair "-o, --output FILE" --keep-all-vertices
+    --keep-all-vertices "-q, --quiet"
+help repair "-o, --output FILE" --keep-all-vertices "-q, --quiet"
 help demo "-n, --spheres N" "default: 200" "-o, --output FILE" "-t, --threads N"
 # --help wins over operands and other options: nothing is read.
 run 0 tree "$WORK/missing.scad" --help
@@ -78,6 +78,38 @@ run 0 eval "$WORK/two.scad" --keep-all-vertices
 contains "12 vertices, 20 triangles"
 run 0 repair "$WORK/two.off" --keep-all-vertices
 contains "8 vertices, 12 triangles"
+
+# --quiet: nothing but errors. The leaf's zero-area pair gives a warning without it.
+usage_error "--quiet and --verbose contradict each other" eval "$WORK/c.scad" -q -v
+printf 'cube(1); polyhedron(points = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.5, 0, 0]],
+  faces = [[0, 1, 2], [0, 2, 1], [0, 3, 1], [0, 1, 3]]);\n' > "$WORK/warn.scad"
+run 0 eval "$WORK/warn.scad"
+contains "warning: leaf 1"
+run 0 eval "$WORK/warn.scad" --quiet -o "$WORK/warn.off"
+[ -z "$OUT" ] && [ -s "$WORK/warn.off" ] && passed=$((passed + 1)) ||
+  { echo "FAIL: eval --quiet printed '$OUT' or wrote nothing"; failed=$((failed + 1)); }
+run 0 repair "$WORK/two.off" -q
+[ -z "$OUT" ] && passed=$((passed + 1)) || { echo "FAIL: repair -q printed '$OUT'"; failed=$((failed + 1)); }
+run 1 eval "$WORK/missing.scad" -q
+contains "missing.scad"
+
+# The progress line: on a terminal only (script(1) gives the program one), once the
+# work has run for a second; never with --quiet or into a pipe or file.
+if [ "${MCSG_FULL_SCENES:-1}" = 1 ] && command -v script >/dev/null; then
+  OUT=$(script -qec "'$CLI' demo -n 1500 -t 1" /dev/null 2>&1)
+  contains "meshcsg: step "
+  contains " of 5 ("
+  run 0 demo -n 1500 -t 1
+  lacks "meshcsg: step "
+  { echo 'union() {'
+    for i in $(seq 0 799); do echo "translate([$i * 1.5, 0, 0]) sphere(1, \$fn = 24);"; done
+    echo '}'; } > "$WORK/slow.scad"
+  OUT=$(script -qec "'$CLI' eval '$WORK/slow.scad' -t 1 --quiet; echo exit \$?" /dev/null 2>&1)
+  lacks "meshcsg: step "
+  contains "exit 0"
+  OUT=$(script -qec "'$CLI' eval '$WORK/slow.scad' -t 1" /dev/null 2>&1)
+  contains "meshcsg: step "
+fi
 
 # The README shows `meshcsg --help` verbatim: it must not drift from the tables.
 readme=${MCSG_TEST_DATA:?}/../../README.md

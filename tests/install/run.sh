@@ -41,8 +41,10 @@ export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
 [ "$(pkg-config --modversion meshcsg)" = "$version" ] || fail "pkg-config --modversion"
 cc -std=c11 -Wall -Werror "$source/tests/install/use.c" $(pkg-config --cflags --libs meshcsg) \
    -o "$scratch/use_pkgconfig"
-LD_LIBRARY_PATH=$prefix/lib ldd "$scratch/use_pkgconfig" |
-  grep -q "libmeshcsg.so.$major => $prefix/lib/" || fail "use_pkgconfig does not load libmeshcsg.so.$major"
+# (outputs captured before grep -q: under pipefail its early exit would fail the writer)
+loaded=$(LD_LIBRARY_PATH=$prefix/lib ldd "$scratch/use_pkgconfig")
+grep -q "libmeshcsg.so.$major => $prefix/lib/" <<< "$loaded" ||
+  fail "use_pkgconfig does not load libmeshcsg.so.$major"
 LD_LIBRARY_PATH=$prefix/lib "$scratch/use_pkgconfig" || fail "use_pkgconfig"
 echo "ok   pkg-config build"
 
@@ -52,7 +54,8 @@ cmake -S "$source/tests/install/cmake" -B "$scratch/cmake" -DCMAKE_PREFIX_PATH="
 cmake --build "$scratch/cmake" >/dev/null
 LD_LIBRARY_PATH=$prefix/lib "$scratch/cmake/use_shared" || fail "use_shared (CMake)"
 "$scratch/cmake/use_static" || fail "use_static (CMake)"
-readelf -d "$scratch/cmake/use_static" | grep -q libmeshcsg && fail "use_static links the shared library"
+dynamic=$(readelf -d "$scratch/cmake/use_static")
+grep -q libmeshcsg <<< "$dynamic" && fail "use_static links the shared library"
 echo "ok   CMake find_package build (meshcsg::meshcsg, meshcsg::meshcsg_static)"
 
 # The manual page names every command and every long option of the installed tool.
