@@ -38,6 +38,8 @@ typedef struct cli_option {
 typedef struct cli_values {
     const char *output;
     const char *format;
+    const char *picture, *view, *size; /* --picture FILE, --view V, --size WxH */
+    int edges;
     int self_intersections, stats, check_inputs, check_crossings, keep_all_vertices, verbose;
     int quiet;
     long threads, spheres;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
-#   tools/ensure-deps.sh          gcc, make, cmake, GMP headers, python3 (benchmark scenes),
+#   tools/ensure-deps.sh          gcc, make, cmake, GMP and libpng headers, python3
+#                                 (benchmark scenes),
 #                                 pkg-config (the install test), python3-numpy and
 #                                 python3-pytest (the Python interface's tests),
 #                                 and the de_DE.UTF-8 locale (test_numparse_locale checks
@@ -26,6 +27,9 @@ optional=()
 [ -e /usr/share/i18n/locales/de_DE ] || optional+=(locales)
 if ! have gcc || ! echo '#include <gmp.h>' | gcc -E -x c - >/dev/null 2>&1; then
   missing+=(libgmp-dev)
+fi
+if ! have gcc || ! echo '#include <png.h>' | gcc -E -x c - >/dev/null 2>&1; then
+  missing+=(libpng-dev) # the tool's pictures
 fi
 if [ "${1:-}" = clang ]; then
   have clang || missing+=(clang)

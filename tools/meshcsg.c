@@ -11,6 +11,7 @@
 
 #include "cli_options.h"
 #include "meshcsg.h"
+#include "picture.h"
 #include "scenes.h"
 
 #include <math.h>
@@ -70,6 +71,76 @@ static int is_csg_file(const char *path)
 static void fail_line(const mcsg_error *err)
 {
     fprintf(stderr, "meshcsg: %s\n", err->message);
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* pictures (picture, eval --picture)                                                  */
+
+typedef struct picture_request {
+    picture_view view;
+    int width, height;
+} picture_request;
+
+/* --view and --size of command `cmd`; false after a usage error. */
+static int picture_options(const char *cmd, const cli_values *v, picture_request *r)
+{
+    r->view = VIEW_ISO, r->width = 800, r->height = 600;
+    if (v->view && !picture_view_parse(v->view, &r->view)) {
+        fprintf(stderr, "meshcsg %s: --view takes iso, top, front or side: %s (see meshcsg "
+                "%s --help)\n", cmd, v->view, cmd);
+        return 0;
+    }
+    if (v->size && !picture_size_parse(v->size, &r->width, &r->height)) {
+        fprintf(stderr, "meshcsg %s: --size takes WxH, each from 16 to 8192: %s (see "
+                "meshcsg %s --help)\n", cmd, v->size, cmd);
+        return 0;
+    }
+    return 1;
+}
+
+/* Draws the mesh (faces coloured by group, NULL: one colour) into a PNG at path. */
+static int write_picture(const mcsg_mesh *mesh, const uint32_t *group,
+                         const picture_request *r, int edges, const char *path)
+{
+    picture pic;
+    char why[256];
+    if (!picture_draw(mesh, group, r->view, r->width, r->height, edges, &pic)) {
+        fprintf(stderr, "meshcsg: out of memory drawing %s\n", path);
+        return 0;
+    }
+    int ok = picture_write_png(&pic, path, why, sizeof why);
+    picture_free(&pic);
+    if (!ok)
+        fprintf(stderr, "meshcsg: %s: %s\n", path, why);
+    return ok;
+}
+
+/* The leaf of every triangle, from provenance (NULL when out of memory). */
+static uint32_t *leaf_groups(const mcsg_provenance *prov, size_t count)
+{
+    uint32_t *group = malloc((count ? count : 1) * sizeof *group);
+    for (size_t t = 0; group && t < count; t++)
+        group[t] = prov[t].leaf;
+    return group;
+}
+
+static int cmd_picture(const cli_values *v, int argc, char **argv)
+{
+    mcsg_options opts = cli_options();
+    picture_request r;
+    mcsg_mesh mesh;
+    mcsg_error err;
+    int ok;
+    (void)argc;
+    if (!picture_options("picture", v, &r))
+        return EXIT_USAGE;
+    if (mcsg_mesh_read(argv[0], MCSG_FORMAT_AUTO, &opts, &mesh, &err) != MCSG_OK) {
+        fail_line(&err);
+        return EXIT_PROBLEM;
+    }
+    ok = write_picture(&mesh, NULL, &r, v->edges, argv[1]);
+    mcsg_mesh_free(&mesh, &opts);
+    return ok ? 0 : EXIT_PROBLEM;
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -663,9 +734,11 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
 /* Read, evaluate and write one CSG file with the given options (quiet: print nothing
  * but errors and the requested stats). */
 static int eval_file(mcsg_options *opts, const char *in, const char *out,
-                     int show_stats, int quiet)
+                     int show_stats, int quiet, const cli_values *v,
+                     const picture_request *draw)
 {
     int ok;
+    mcsg_provenance *prov = NULL;
     double read_seconds, write_seconds;
     mcsg_status st;
     mcsg_tree *tree;
@@ -679,7 +752,7 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
     }
     read_seconds = now_seconds() - read_seconds;
     start_progress(opts, quiet);
-    st = mcsg_eval(tree, opts, &result, NULL, &stats, &err);
+    st = mcsg_eval(tree, opts, &result, v->picture ? &prov : NULL, &stats, &err);
     stop_progress();
     if (st != MCSG_OK) {
         fail_line(&err);
@@ -691,6 +764,12 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
     write_seconds = now_seconds() - write_seconds;
     if (!ok)
         fail_line(&err);
+    if (v->picture) { /* faces coloured by the leaf they lie on */
+        uint32_t *group = leaf_groups(prov, result.triangle_count);
+        ok = group && write_picture(&result, group, draw, v->edges, v->picture) && ok;
+        free(group);
+        mcsg_free(prov, opts);
+    }
     if (show_stats) {
         print_eval_stats(&stats, read_seconds);
         printf("  write output     %8.3f s\n", write_seconds);
@@ -709,6 +788,7 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
 static int cmd_eval(const cli_values *v, int argc, char **argv)
 {
     mcsg_options opts = cli_options();
+    picture_request draw;
     int code;
     mcsg_pool *pool = NULL;
     (void)argc;
@@ -732,7 +812,14 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
      * threads to spare) every call runs as before. */
     if (mcsg_pool_create(&opts, &pool, NULL) == MCSG_OK)
         opts.pool = pool;
-    code = eval_file(&opts, argv[0], v->output, v->stats, v->quiet);
+    if (!v->picture && (v->view || v->size || v->edges)) {
+        fprintf(stderr, "meshcsg eval: --view, --size and --edges go with --picture (see "
+                        "meshcsg eval --help)\n");
+        return EXIT_USAGE;
+    }
+    if (!picture_options("eval", v, &draw))
+        return EXIT_USAGE;
+    code = eval_file(&opts, argv[0], v->output, v->stats, v->quiet, v, &draw);
     mcsg_pool_free(pool);
     return code;
 }
@@ -908,6 +995,13 @@ static void keep_freed_memory(void)
     {"quiet", 'q', CLI_FLAG, NULL, 0, 0, VALUE(quiet),                                    \
      "print nothing but errors: no counts, warnings or progress line (the exit status "  \
      "still tells a broken guarantee; --stats still prints its table)"}
+#define PICTURE_OPTIONS                                                                   \
+    {"view", 0, CLI_STRING, "V", 0, 0, VALUE(view),                                       \
+     "the picture's view: iso (from the front, right and above), top, front or side "    \
+     "(from the right); the mesh fills it (default: iso)"},                              \
+    {"size", 0, CLI_STRING, "WxH", 0, 0, VALUE(size),                                      \
+     "the picture's size in pixels, each 16 to 8192 (default: 800x600)"},                \
+    {"edges", 0, CLI_FLAG, NULL, 0, 0, VALUE(edges), "draw the triangles' edges"}
 #define END_OF_OPTIONS {NULL, 0, CLI_FLAG, NULL, 0, 0, 0, NULL}
 
 static const cli_option check_options[] = {
@@ -948,7 +1042,12 @@ static const cli_option eval_options[] = {
      "also print the library's informational messages (what rounding did, why a step "
      "was retried)"},
     QUIET,
+    {"picture", 0, CLI_STRING, "FILE", 0, 0, VALUE(picture),
+     "also draw the result into a PNG picture, each face coloured by the leaf it comes "
+     "from (default: none)"},
+    PICTURE_OPTIONS,
     END_OF_OPTIONS};
+static const cli_option picture_options_table[] = {PICTURE_OPTIONS, END_OF_OPTIONS};
 static const cli_option repair_options[] = {
     OUTPUT("write the repaired mesh to FILE, format from its extension (default: none, "
            "only counts are printed)"),
@@ -995,6 +1094,9 @@ static const cli_command commands[] = {
      "resolves; zero-area triangles are removed with a warning. The exit status is 3\n"
      "when rounding to doubles broke a guarantee, as for eval.",
      repair_options, 1, 1, cmd_repair},
+    {"picture", "MESH OUT", "draw a mesh (.off .obj .stl .ply) into a PNG picture",
+     "A software rasterizer: shaded faces, hidden ones removed; no display needed.",
+     picture_options_table, 2, 2, cmd_picture},
     {"demo", "", "evaluate the built-in scene (the paper's ring with spheres), print the "
      "step timings and compare with the reference volume", NULL, demo_options, 0, 0,
      cmd_demo},

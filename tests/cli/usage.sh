@@ -4,7 +4,7 @@
 . "$(dirname "$0")/common.bash"
 
 run 0 --help
-for cmd in check tree convert intersect eval demo; do contains "  $cmd "; done
+for cmd in check tree convert intersect eval picture demo; do contains "  $cmd "; done
 contains "--version"
 run 0 --version
 contains "meshcsg "
@@ -28,6 +28,7 @@ help intersect "-o, --output FILE"
 help eval "-o, --output FILE" --stats "-t, --threads N" --check-inputs "default: one per" \
     --keep-all-vertices "-q, --quiet"
 help repair "-o, --output FILE" --keep-all-vertices "-q, --quiet"
+help picture "--view V" "--size WxH" --edges "default: 800x600"
 help demo "-n, --spheres N" "default: 200" "-o, --output FILE" "-t, --threads N"
 # --help wins over operands and other options: nothing is read.
 run 0 tree "$WORK/missing.scad" --help
@@ -78,6 +79,20 @@ run 0 eval "$WORK/two.scad" --keep-all-vertices
 contains "12 vertices, 20 triangles"
 run 0 repair "$WORK/two.off" --keep-all-vertices
 contains "8 vertices, 12 triangles"
+
+# Pictures: PNG files (their pixels are test_picture's); bad views and sizes are usage
+# errors named as such.
+run 0 picture "$MODELS/cube.obj" "$WORK/cube.png" --view top --size 64x32 --edges
+[ "$(head -c 8 "$WORK/cube.png" | od -An -tx1 | tr -d ' ')" = 89504e470d0a1a0a ] &&
+  passed=$((passed + 1)) || { echo "FAIL: picture wrote no PNG"; failed=$((failed + 1)); }
+run 0 eval "$WORK/two.scad" --picture "$WORK/two.png" -q
+[ -s "$WORK/two.png" ] && [ -z "$OUT" ] && passed=$((passed + 1)) ||
+  { echo "FAIL: eval --picture"; failed=$((failed + 1)); }
+usage_error "--view takes iso, top, front or side: below" picture "$MODELS/cube.obj" "$WORK/x.png" --view below
+usage_error "--size takes WxH, each from 16 to 8192: 8x8" eval "$WORK/c.scad" --picture "$WORK/x.png" --size 8x8
+usage_error "--view, --size and --edges go with --picture" eval "$WORK/c.scad" --edges
+run 1 picture "$MODELS/cube.obj" "$WORK/no/such/dir.png"
+contains "cannot create"
 
 # --quiet: nothing but errors. The leaf's zero-area pair gives a warning without it.
 usage_error "--quiet and --verbose contradict each other" eval "$WORK/c.scad" -q -v
