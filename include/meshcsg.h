@@ -72,7 +72,8 @@ typedef struct mcsg_error {
 
 /* Custom allocator. Either all three functions are set, or none (then the C library's
  * malloc/realloc/free are used). realloc_fn(user, NULL, n) must behave like malloc_fn.
- * The library never calls free_fn with NULL. */
+ * The library never calls free_fn with NULL. The libraries behind 3MF (libzip, expat)
+ * take no allocator: their own working memory comes from malloc. */
 typedef struct mcsg_allocator {
     void *(*malloc_fn)(void *user, size_t size);
     void *(*realloc_fn)(void *user, void *ptr, size_t size);
@@ -201,13 +202,15 @@ typedef enum mcsg_format {
     MCSG_FORMAT_STL_BINARY, /* 80-byte header, float32 little-endian */
     MCSG_FORMAT_PLY_ASCII,
     MCSG_FORMAT_PLY_BINARY_LE,
-    MCSG_FORMAT_PLY_BINARY_BE
+    MCSG_FORMAT_PLY_BINARY_BE,
+    MCSG_FORMAT_3MF         /* 3MF (zip + XML): as one mesh, every build item's shells
+                               side by side; mcsg_3mf_read keeps them apart */
 } mcsg_format;
 
 /* Human-readable name of a format ("OFF", "binary STL", ...). Never NULL. */
 const char *mcsg_format_name(mcsg_format format);
 
-/* Format implied by a file name's extension (case-insensitive): .off .obj .stl .ply.
+/* Format implied by a file name's extension (case-insensitive): .off .obj .stl .ply .3mf.
  * For .stl this is MCSG_FORMAT_STL_BINARY and for .ply MCSG_FORMAT_PLY_BINARY_LE (the
  * compact choices for writing; reading detects the variant from the content).
  * MCSG_FORMAT_AUTO if the extension is not recognised. */
@@ -241,6 +244,31 @@ mcsg_status mcsg_mesh_write(const char *path, mcsg_format format, const mcsg_mes
 mcsg_status mcsg_mesh_write_memory(mcsg_format format, const mcsg_mesh *mesh,
                                    const mcsg_options *opts, void **data, size_t *size,
                                    mcsg_error *err);
+
+/* A 3MF file (core specification: a zip container, XML model) as one mesh per build
+ * item: objects made of components are put together, the components' and items'
+ * transforms applied (each rounding coordinates, as mcsg_mesh_transform does), and
+ * coordinates converted to millimetres from the model's unit. Materials, colours and
+ * extensions are ignored. On success *meshes holds *count meshes (at least one) and,
+ * when `names` is not NULL, *names the name of the object each item places ("" for
+ * none); release both with mcsg_3mf_free. Errors name the file, the model part and the
+ * XML line. */
+mcsg_status mcsg_3mf_read(const char *path, const mcsg_options *opts, mcsg_mesh **meshes,
+                          char ***names, size_t *count, mcsg_error *err);
+
+/* The same from memory; `name` (may be NULL) is used in messages. */
+mcsg_status mcsg_3mf_read_memory(const void *data, size_t size, const char *name,
+                                 const mcsg_options *opts, mcsg_mesh **meshes,
+                                 char ***names, size_t *count, mcsg_error *err);
+
+/* Release what mcsg_3mf_read returned (names may be NULL). */
+void mcsg_3mf_free(mcsg_mesh *meshes, char **names, size_t count, const mcsg_options *opts);
+
+/* Write `count` meshes (at least one) as a 3MF file, in millimetres: one object
+ * ("object 1", ...) and one build item each. Written under a temporary name and
+ * renamed, as mcsg_mesh_write does. */
+mcsg_status mcsg_3mf_write(const char *path, const mcsg_mesh *meshes, size_t count,
+                           const mcsg_options *opts, mcsg_error *err);
 
 /* ------------------------------------------------------------------------------------ */
 /* Validation                                                                            */

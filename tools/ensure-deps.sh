@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
-#   tools/ensure-deps.sh          gcc, make, cmake, GMP and libpng headers, python3
+#   tools/ensure-deps.sh          gcc, make, cmake, GMP, libpng, libzip and expat headers,
+#                                 python3
 #                                 (benchmark scenes),
 #                                 pkg-config (the install test), python3-numpy and
 #                                 python3-pytest (the Python interface's tests),
@@ -30,6 +31,12 @@ if ! have gcc || ! echo '#include <gmp.h>' | gcc -E -x c - >/dev/null 2>&1; then
 fi
 if ! have gcc || ! echo '#include <png.h>' | gcc -E -x c - >/dev/null 2>&1; then
   missing+=(libpng-dev) # the tool's pictures
+fi
+if ! have gcc || ! echo '#include <zip.h>' | gcc -E -x c - >/dev/null 2>&1; then
+  missing+=(libzip-dev) # 3MF's container
+fi
+if ! have gcc || ! echo '#include <expat.h>' | gcc -E -x c - >/dev/null 2>&1; then
+  missing+=(libexpat1-dev) # 3MF's XML
 fi
 if [ "${1:-}" = clang ]; then
   have clang || missing+=(clang)

@@ -416,6 +416,7 @@ static const struct {
     {"ply-binary", MCSG_FORMAT_PLY_BINARY_LE},
     {"ply-binary-be", MCSG_FORMAT_PLY_BINARY_BE},
     {"ply-ascii", MCSG_FORMAT_PLY_ASCII},
+    {"3mf", MCSG_FORMAT_3MF},
 };
 
 static int parse_format(const char *name, mcsg_format *out)
@@ -439,12 +440,12 @@ static int cmd_convert(const cli_values *v, int argc, char **argv)
     (void)argc;
     if (v->format && !parse_format(v->format, &format)) {
         fprintf(stderr, "meshcsg convert: unknown format '%s' (off, obj, stl, stl-ascii, "
-                "stl-binary, ply, ply-ascii, ply-binary, ply-binary-be)\n", v->format);
+                "stl-binary, ply, ply-ascii, ply-binary, ply-binary-be, 3mf)\n", v->format);
         return EXIT_USAGE;
     }
     if (format == MCSG_FORMAT_AUTO && mcsg_format_from_path(paths[1]) == MCSG_FORMAT_AUTO) {
         fprintf(stderr, "meshcsg: %s: cannot tell the output format from the extension; "
-                "use .off .obj .stl .ply or --format\n", paths[1]);
+                "use .off .obj .stl .ply .3mf or --format\n", paths[1]);
         return EXIT_USAGE;
     }
     if (mcsg_mesh_read(paths[0], MCSG_FORMAT_AUTO, &opts, &mesh, &err) != MCSG_OK) {
@@ -1014,13 +1015,13 @@ static const cli_option no_options[] = {END_OF_OPTIONS};
 static const cli_option convert_options[] = {
     {"format", 'f', CLI_STRING, "F", 0, 0, VALUE(format),
      "output format: off, obj, stl (binary), stl-ascii, stl-binary, ply (binary, little "
-     "endian), ply-ascii, ply-binary, ply-binary-be (default: from OUT's extension)"},
+     "endian), ply-ascii, ply-binary, ply-binary-be, 3mf (default: from OUT's extension)"},
     END_OF_OPTIONS};
 static const cli_option intersect_options[] = {
     OUTPUT("write the curves as OBJ points and lines to FILE (default: none)"),
     END_OF_OPTIONS};
 static const cli_option eval_options[] = {
-    OUTPUT("write the result to FILE, format from its extension: .off .obj .stl .ply "
+    OUTPUT("write the result to FILE, format from its extension: .off .obj .stl .ply .3mf "
            "(default: none, only counts are printed)"),
     {"stats", 0, CLI_FLAG, NULL, 0, 0, VALUE(stats),
      "print the paper's Table 1 columns: faces, primitives, time per step, peak memory"},
@@ -1066,7 +1067,7 @@ static const cli_option demo_options[] = {
     END_OF_OPTIONS};
 
 static const cli_command commands[] = {
-    {"check", "FILE...", "validate meshes (.off .obj .stl .ply) or every leaf of a CSG file "
+    {"check", "FILE...", "validate meshes (.off .obj .stl .ply .3mf) or every leaf of a CSG file "
      "(.scad .csg)",
      "Prints one line per file when the mesh is a closed, consistently oriented,\n"
      "edge-manifold mesh, and one line per kind of problem otherwise.",
@@ -1094,7 +1095,7 @@ static const cli_command commands[] = {
      "resolves; zero-area triangles are removed with a warning. The exit status is 3\n"
      "when rounding to doubles broke a guarantee, as for eval.",
      repair_options, 1, 1, cmd_repair},
-    {"picture", "MESH OUT", "draw a mesh (.off .obj .stl .ply) into a PNG picture",
+    {"picture", "MESH OUT", "draw a mesh (.off .obj .stl .ply .3mf) into a PNG picture",
      "A software rasterizer: shaded faces, hidden ones removed; no display needed.",
      picture_options_table, 2, 2, cmd_picture},
     {"demo", "", "evaluate the built-in scene (the paper's ring with spheres), print the "

@@ -32,7 +32,7 @@ __all__ = ["Mesh", "Tree", "Error", "CancelledError", "read", "cube", "sphere", 
 _LOG = logging.getLogger("meshcsg")
 _LEVELS = {0: logging.DEBUG, 1: logging.INFO, 2: logging.WARNING}
 _FORMATS = {None: 0, "off": 1, "obj": 2, "stl-ascii": 3, "stl": 4, "stl-binary": 4,
-            "ply-ascii": 5, "ply": 6, "ply-binary": 6, "ply-binary-be": 7}
+            "ply-ascii": 5, "ply": 6, "ply-binary": 6, "ply-binary-be": 7, "3mf": 8}
 _UNION, _INTERSECTION, _DIFFERENCE = 1, 2, 3
 
 
@@ -217,8 +217,8 @@ class Mesh:
 
     def write(self, path, format=None):
         """Write the mesh to `path`; the format comes from the extension (.off .obj .stl
-        .ply) unless `format` names one: off, obj, stl (binary), stl-ascii, ply (binary
-        little-endian), ply-ascii, ply-binary-be."""
+        .ply .3mf) unless `format` names one: off, obj, stl (binary), stl-ascii, ply
+        (binary little-endian), ply-ascii, ply-binary-be, 3mf."""
         if format not in _FORMATS:
             raise ValueError("unknown format %r; known: %s" %
                              (format, ", ".join(f for f in _FORMATS if f)))
@@ -296,7 +296,8 @@ def transform(mesh, matrix):
 
 
 def read(path):
-    """Read a mesh file (.off .obj .stl .ply, detected from the content and the name)."""
+    """Read a mesh file (.off .obj .stl .ply .3mf, detected from the content and the
+    name); a 3MF file's build items come as one mesh, their shells side by side."""
     owned, err = _Owned(), _capi.ErrorInfo()
     _capi.check(_capi.lib.mcsg_mesh_read(os.fsencode(path), 0, None, ctypes.byref(owned.mesh),
                                          ctypes.byref(err)), err)

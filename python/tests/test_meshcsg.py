@@ -198,7 +198,7 @@ def test_evaluate_scad_path_and_errors(tmp_path):
 
 def test_read_write_round_trip(tmp_path):
     m = meshcsg.difference(unit_cube(2), unit_cube(1, offset=(0.5, 0.5, 0.5)))
-    for name in ("r.off", "r.obj", "r.stl", "r.ply"):
+    for name in ("r.off", "r.obj", "r.stl", "r.ply", "r.3mf"):
         m.write(tmp_path / name)
         back = meshcsg.read(tmp_path / name)
         assert back.volume == m.volume and back.is_closed

@@ -9,6 +9,7 @@
  * token. Messages are "NAME:LINE: ..." for text and "NAME: byte OFFSET: ..." for binary.
  */
 #include "io/mesh_io.h"
+#include "io/threemf.h"
 #include "base/parallel.h"
 
 
@@ -480,6 +481,7 @@ const char *mcsg_format_name(mcsg_format format)
     case MCSG_FORMAT_PLY_ASCII: return "ASCII PLY";
     case MCSG_FORMAT_PLY_BINARY_LE: return "binary little-endian PLY";
     case MCSG_FORMAT_PLY_BINARY_BE: return "binary big-endian PLY";
+    case MCSG_FORMAT_3MF: return "3MF";
     }
     return "unknown format";
 }
@@ -504,6 +506,8 @@ mcsg_format mcsg_format_from_path(const char *path)
         return MCSG_FORMAT_STL_BINARY;
     if (has_extension(path, ".ply"))
         return MCSG_FORMAT_PLY_BINARY_LE;
+    if (has_extension(path, ".3mf"))
+        return MCSG_FORMAT_3MF;
     return MCSG_FORMAT_AUTO;
 }
 
@@ -545,6 +549,8 @@ static mcsg_status read_detected(const mci_io_source *src, mcsg_mesh *out)
     mcsg_format by_name = mcsg_format_from_path(src->name);
     if (is_ply_magic(src))
         return mci_ply_read(src, out);
+    if (by_name == MCSG_FORMAT_3MF || (src->size >= 4 && memcmp(src->text, "PK\3\4", 4) == 0))
+        return mci_3mf_read_merged(src, out); /* a zip archive */
     if (has_token && mci_off_is_keyword(begin, stop))
         return mci_off_read(src, out);
     if (by_name == MCSG_FORMAT_OFF)
@@ -560,7 +566,7 @@ static mcsg_status read_detected(const mci_io_source *src, mcsg_mesh *out)
     if (has_token && looks_like_obj(begin, stop))
         return mci_obj_read(src, out);
     return mci_fail(src->err, MCSG_ERR_FORMAT,
-                    "%s: unknown mesh format (not OFF, OBJ, STL or PLY by content or name)",
+                    "%s: unknown mesh format (not OFF, OBJ, STL, PLY or 3MF by content or name)",
                     src->name);
 }
 
@@ -576,6 +582,7 @@ static mcsg_status read_source(const mci_io_source *src, mcsg_format format,
     case MCSG_FORMAT_PLY_ASCII:
     case MCSG_FORMAT_PLY_BINARY_LE:
     case MCSG_FORMAT_PLY_BINARY_BE: return mci_ply_read(src, out);
+    case MCSG_FORMAT_3MF: return mci_3mf_read_merged(src, out);
     }
     return mci_fail(src->err, MCSG_ERR_INVALID_ARG, "%s: invalid format code %d", src->name,
                     (int)format);
@@ -583,6 +590,17 @@ static mcsg_status read_source(const mci_io_source *src, mcsg_format format,
 
 /* ---------------------------------------------------------------------------------- */
 /* Public entry points                                                                 */
+
+static void init_source(mci_io_source *src, const mci_ctx *ctx, const void *data,
+                        size_t size, const char *name, mcsg_error *err)
+{
+    src->ctx = ctx;
+    src->name = name ? name : "<memory>";
+    src->text = size ? (const char *)data : ""; /* never offset a NULL pointer */
+    src->bytes = (const unsigned char *)src->text;
+    src->size = size;
+    src->err = err;
+}
 
 mcsg_status mcsg_mesh_read_memory(const void *data, size_t size, mcsg_format format,
                                   const char *name, const mcsg_options *opts,
@@ -596,12 +614,7 @@ mcsg_status mcsg_mesh_read_memory(const void *data, size_t size, mcsg_format for
     memset(out, 0, sizeof *out);
     if (!data && size)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_mesh_read_memory: NULL data");
-    src.ctx = &ctx;
-    src.name = name ? name : "<memory>";
-    src.text = size ? (const char *)data : ""; /* never offset a NULL pointer */
-    src.bytes = (const unsigned char *)src.text;
-    src.size = size;
-    src.err = err;
+    init_source(&src, &ctx, data, size, name, err);
     return read_source(&src, format, out);
 }
 
@@ -655,6 +668,7 @@ static mcsg_status write_format(const mci_ctx *ctx, mcsg_format format,
     case MCSG_FORMAT_PLY_ASCII:
     case MCSG_FORMAT_PLY_BINARY_LE:
     case MCSG_FORMAT_PLY_BINARY_BE: return mci_ply_write(ctx, mesh, format, out);
+    case MCSG_FORMAT_3MF: return mci_3mf_write(ctx, mesh, 1, out);
     case MCSG_FORMAT_AUTO: break;
     }
     return MCSG_ERR_INVALID_ARG;
@@ -667,7 +681,7 @@ static mcsg_status write_to_buffer(const mci_ctx *ctx, mcsg_format format,
 {
     mcsg_status status;
     memset(out, 0, sizeof *out);
-    if ((int)format <= (int)MCSG_FORMAT_AUTO || (int)format > (int)MCSG_FORMAT_PLY_BINARY_BE)
+    if ((int)format <= (int)MCSG_FORMAT_AUTO || (int)format > (int)MCSG_FORMAT_3MF)
         return mci_fail(err, MCSG_ERR_INVALID_ARG, "%s: invalid output format code %d", name,
                         (int)format);
     status = check_writable(mesh, name, err);
@@ -715,10 +729,94 @@ mcsg_status mcsg_mesh_write(const char *path, mcsg_format format, const mcsg_mes
         format = mcsg_format_from_path(path);
     if (format == MCSG_FORMAT_AUTO)
         return mci_fail(err, MCSG_ERR_FORMAT, "%s: cannot tell the mesh format from the "
-                        "file name (use .off, .obj, .stl or .ply)", path);
+                        "file name (use .off, .obj, .stl, .ply or .3mf)", path);
     status = write_to_buffer(&ctx, format, mesh, path, &buf, err);
     if (status != MCSG_OK)
         return status;
+    status = mci_write_file_atomic(path, buf.data, buf.len, err);
+    mci_buf_free(&ctx, &buf);
+    return status;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* 3MF, one mesh per build item                                                         */
+
+mcsg_status mcsg_3mf_read_memory(const void *data, size_t size, const char *name,
+                                 const mcsg_options *opts, mcsg_mesh **meshes,
+                                 char ***names, size_t *count, mcsg_error *err)
+{
+    mci_ctx ctx;
+    mci_io_source src;
+    mci_3mf_items items;
+    mcsg_status status;
+    mci_ctx_init(&ctx, opts);
+    if (!meshes || !count)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_3mf_read: NULL output");
+    *meshes = NULL, *count = 0;
+    if (names)
+        *names = NULL;
+    if (!data && size)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_3mf_read: NULL data");
+    init_source(&src, &ctx, data, size, name, err);
+    status = mci_3mf_read(&src, &items);
+    if (status != MCSG_OK)
+        return status;
+    *meshes = items.meshes, *count = items.count;
+    if (names)
+        *names = items.names;
+    else {
+        for (size_t k = 0; k < items.count; k++)
+            mci_free(&ctx, items.names[k]);
+        mci_free(&ctx, items.names);
+    }
+    return MCSG_OK;
+}
+
+mcsg_status mcsg_3mf_read(const char *path, const mcsg_options *opts, mcsg_mesh **meshes,
+                          char ***names, size_t *count, mcsg_error *err)
+{
+    mci_ctx ctx;
+    unsigned char *data;
+    size_t size;
+    mcsg_status status;
+    mci_ctx_init(&ctx, opts);
+    if (!path)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_3mf_read: NULL path");
+    status = mci_read_file(&ctx, path, &data, &size, err);
+    if (status != MCSG_OK)
+        return status;
+    status = mcsg_3mf_read_memory(data, size, path, opts, meshes, names, count, err);
+    mci_free(&ctx, data);
+    return status;
+}
+
+void mcsg_3mf_free(mcsg_mesh *meshes, char **names, size_t count, const mcsg_options *opts)
+{
+    mci_ctx ctx;
+    mci_3mf_items items = {meshes, names, count};
+    mci_ctx_init(&ctx, opts);
+    mci_3mf_items_free(&ctx, &items);
+}
+
+mcsg_status mcsg_3mf_write(const char *path, const mcsg_mesh *meshes, size_t count,
+                           const mcsg_options *opts, mcsg_error *err)
+{
+    mci_ctx ctx;
+    mci_buf buf = {0};
+    mcsg_status status;
+    mci_ctx_init(&ctx, opts);
+    if (!path || !meshes || count == 0)
+        return mci_fail(err, MCSG_ERR_INVALID_ARG, "mcsg_3mf_write: %s",
+                        !path ? "NULL path" : "no meshes");
+    for (size_t k = 0; k < count; k++) {
+        status = check_writable(&meshes[k], path, err);
+        if (status != MCSG_OK)
+            return status;
+    }
+    if (mci_3mf_write(&ctx, meshes, count, &buf) != MCSG_OK) {
+        mci_buf_free(&ctx, &buf);
+        return mci_fail(err, MCSG_ERR_NOMEM, "%s: out of memory while writing 3MF", path);
+    }
     status = mci_write_file_atomic(path, buf.data, buf.len, err);
     mci_buf_free(&ctx, &buf);
     return status;

@@ -666,6 +666,51 @@ static mcsg_status import_path(scad_context *sc, const call_args *ca, const char
     return MCSG_OK;
 }
 
+/* A 3MF file's build items, one leaf each ("import("f.3mf") item 2 (Cylinder)"), under
+ * a union when there are several. */
+static mcsg_status import_3mf(scad_context *sc, const call_args *ca, const scad_transform *t,
+                              const char *file, uint32_t file_len, const char *path,
+                              mcsg_node_id *node, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    mcsg_error read_err = {MCSG_OK, ""};
+    mcsg_mesh *meshes;
+    char **names;
+    size_t count;
+    mcsg_node_id *leaves = NULL;
+    mci_buf label = {0};
+    mcsg_status st = mcsg_3mf_read(path, sc->opts, &meshes, &names, &count, &read_err);
+    if (st != MCSG_OK)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                            "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+    if (!(leaves = mci_malloc_array(ctx, count, sizeof *leaves)))
+        st = mci_fail_nomem(err, "reading CSG text");
+    for (size_t k = 0; st == MCSG_OK && k < count; k++) {
+        label.len = 0;
+        if (!mci_buf_printf(ctx, &label, "import(\"%.*s\") item %zu%s%s%s", (int)file_len, file,
+                            k + 1, names[k][0] ? " (" : "", names[k], names[k][0] ? ")" : ""))
+            st = mci_fail_nomem(err, "reading CSG text");
+        else
+            st = add_leaf(sc, ca, t, &meshes[k], &label, &leaves[k], err);
+        memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
+    }
+    if (st == MCSG_OK && count == 1)
+        *node = leaves[0];
+    else if (st == MCSG_OK) {
+        label.len = 0;
+        if (!mci_buf_printf(ctx, &label, "import(\"%.*s\") at %s:%u:%u", (int)file_len, file,
+                            sc->name, ca->stmt->line, ca->stmt->col))
+            st = mci_fail_nomem(err, "reading CSG text");
+        else
+            st = mcsg_tree_add_op(sc->tree, MCSG_NODE_UNION, leaves, count,
+                                  (const char *)label.data, node, err);
+    }
+    mci_buf_free(ctx, &label);
+    mci_free(ctx, leaves);
+    mcsg_3mf_free(meshes, names, count, sc->opts);
+    return st;
+}
+
 static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad_transform *t,
                                mci_buf *label, mcsg_node_id *node, mcsg_error *err)
 {
@@ -676,6 +721,11 @@ static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad
     mcsg_mesh mesh;
     bool prefetched = false;
     mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
+    if (st == MCSG_OK && scad_is_3mf_name(file, file_len)) {
+        st = import_3mf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
+        mci_buf_free(sc->ev.ctx, &path);
+        return st;
+    }
     if (st == MCSG_OK)
         st = scad_prefetch_take(sc, (const char *)path.data, &mesh, &prefetched, err);
     if (st == MCSG_OK && !prefetched) {

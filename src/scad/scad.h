@@ -227,6 +227,10 @@ typedef struct scad_context {
     scad_prefetch prefetch;
 } scad_context;
 
+/* Whether an import() file name ends in .3mf (case-insensitive): such a file gives a
+ * leaf per build item, read by import() itself, not prefetched as one mesh. */
+bool scad_is_3mf_name(const char *file, uint32_t len);
+
 /* Read the files of every import() call with a literal file name, on the options'
  * threads, into sc->prefetch (failed reads are kept as failures, not reported). */
 mcsg_status scad_prefetch_imports(scad_context *sc, mcsg_error *err);

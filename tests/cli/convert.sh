@@ -1,7 +1,7 @@
 # meshcsg convert: every format round-trips Spot (tests/data/models/spot.obj) with its counts and stays valid.
 . "$(dirname "$0")/common.bash"
 
-for fmt in off obj stl-ascii stl-binary ply-ascii ply-binary ply-binary-be; do
+for fmt in off obj stl-ascii stl-binary ply-ascii ply-binary ply-binary-be 3mf; do
   ext=${fmt%%-*}
   run 0 convert "$MODELS/spot.obj" "$WORK/spot-$fmt.$ext" --format "$fmt"
   contains "2930 vertices, 5856 triangles"
@@ -9,9 +9,9 @@ for fmt in off obj stl-ascii stl-binary ply-ascii ply-binary ply-binary-be; do
   contains "ok: 2930 vertices, 5856 triangles, 1 component"
   run 0 convert "$WORK/spot-$fmt.$ext" "$WORK/back-$fmt.off"
 done
-# OFF, OBJ and PLY keep doubles exactly: converting back gives the same OFF text.
+# OFF, OBJ, PLY and 3MF keep doubles exactly: converting back gives the same OFF text.
 run 0 convert "$MODELS/spot.obj" "$WORK/ref.off"
-for fmt in obj ply-ascii ply-binary ply-binary-be; do
+for fmt in obj ply-ascii ply-binary ply-binary-be 3mf; do
   if cmp -s "$WORK/ref.off" "$WORK/back-$fmt.off"; then passed=$((passed + 1))
   else echo "FAIL: $fmt round trip changed the mesh"; failed=$((failed + 1)); fi
 done
