@@ -732,12 +732,12 @@ static void print_eval_stats(const mcsg_eval_stats *s, double read_seconds)
     printf("  total            %8.3f s\n", s->seconds_total);
 }
 
-/* Read, evaluate and write one CSG file with the given options (quiet: print nothing
- * but errors and the requested stats). */
-static int eval_file(mcsg_options *opts, const char *in, const char *out,
-                     int show_stats, int quiet, const cli_values *v,
+/* Read, evaluate and write one CSG file with the given options and eval's command-line
+ * values (--quiet: print nothing but errors and the requested stats). */
+static int eval_file(mcsg_options *opts, const char *in, const cli_values *v,
                      const picture_request *draw)
 {
+    const char *out = v->output;
     int ok;
     mcsg_provenance *prov = NULL;
     double read_seconds, write_seconds;
@@ -752,7 +752,7 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
         return EXIT_PROBLEM;
     }
     read_seconds = now_seconds() - read_seconds;
-    start_progress(opts, quiet);
+    start_progress(opts, v->quiet);
     st = mcsg_eval(tree, opts, &result, v->picture ? &prov : NULL, &stats, &err);
     stop_progress();
     if (st != MCSG_OK) {
@@ -771,12 +771,12 @@ static int eval_file(mcsg_options *opts, const char *in, const char *out,
         free(group);
         mcsg_free(prov, opts);
     }
-    if (show_stats) {
+    if (v->stats) {
         print_eval_stats(&stats, read_seconds);
         printf("  write output     %8.3f s\n", write_seconds);
         printf("  peak memory      %8.1f MiB\n", peak_memory_mib());
     }
-    else if (!quiet)
+    else if (!v->quiet)
         printf("%zu vertices, %zu triangles\n", result.vertex_count, result.triangle_count);
     mcsg_mesh_free(&result, opts);
     mcsg_tree_free(tree);
@@ -820,7 +820,7 @@ static int cmd_eval(const cli_values *v, int argc, char **argv)
     }
     if (!picture_options("eval", v, &draw))
         return EXIT_USAGE;
-    code = eval_file(&opts, argv[0], v->output, v->stats, v->quiet, v, &draw);
+    code = eval_file(&opts, argv[0], v, &draw);
     mcsg_pool_free(pool);
     return code;
 }

@@ -909,8 +909,8 @@ static bool new_edges_shared(const flat_state *s, const mci_kept *kept, uint8_t 
             continue;
         for (int i = 0; i < 3; i++) {
             uint8_t *n = near[c[i]] && near[c[(i + 1) % 3]]
-                              ? side_slot(&h, mci_edge_key(c[i], c[(i + 1) % 3]), false)
-                              : NULL;
+                             ? side_slot(&h, mci_edge_key(c[i], c[(i + 1) % 3]), false)
+                             : NULL;
             if (n)
                 count_side(n);
         }
