@@ -246,7 +246,23 @@ TEST(errors_name_file_part_and_line)
                "objectid 7 names no object");
     read_error("itself.3mf", MODEL_OPEN "><resources><object id=\"1\"><components>"
                "<component objectid=\"1\"/></components></object></resources>"
-               "<build><item objectid=\"1\"/></build></model>", "nested deeper than 32");
+               "<build><item objectid=\"1\"/></build></model>", "within themselves");
+    /* 16 levels of 16 placements: 16^16 tetrahedra from a few hundred bytes */
+    {
+        char xml[16384]; /* about 8.5 KB */
+        int at = snprintf(xml, sizeof xml, "%s><resources>" TETRA, MODEL_OPEN);
+        for (int level = 2; level <= 17; level++) {
+            at += snprintf(xml + at, sizeof xml - (size_t)at, "<object id=\"%d\"><components>",
+                           level);
+            for (int k = 0; k < 16; k++)
+                at += snprintf(xml + at, sizeof xml - (size_t)at,
+                               "<component objectid=\"%d\"/>", level - 1);
+            at += snprintf(xml + at, sizeof xml - (size_t)at, "</components></object>");
+        }
+        snprintf(xml + at, sizeof xml - (size_t)at,
+                 "</resources><build><item objectid=\"17\"/></build></model>");
+        read_error("bomb.3mf", xml, "expand to more than 2^32-1");
+    }
     read_error("transform.3mf", MODEL_OPEN "><resources>" TETRA "</resources><build><item "
                "objectid=\"1\" transform=\"1 0 0\"/></build></model>", "is not 12 numbers");
     CHECK(mcsg_3mf_read_memory("PK\3\4 not a zip", 14, "junk.3mf", NULL, &items, NULL, &count,

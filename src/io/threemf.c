@@ -244,10 +244,13 @@ static void start_object(model_state *s, const char **atts)
 static void add_vertex(model_state *s, const char **atts)
 {
     double x, y, z;
-    if (number(s, atts, "x", &x) && number(s, atts, "y", &y) && number(s, atts, "z", &z) &&
-        mci_io_add_vertex(&s->pool, x, y, z) != MCSG_OK)
-        stop(s, MCSG_ERR_LIMIT, "too many vertices");
-    else if (s->status == MCSG_OK)
+    mcsg_status st;
+    if (!number(s, atts, "x", &x) || !number(s, atts, "y", &y) || !number(s, atts, "z", &z))
+        return;
+    st = mci_io_add_vertex(&s->pool, x, y, z);
+    if (st != MCSG_OK)
+        stop(s, st, st == MCSG_ERR_NOMEM ? "out of memory" : "more than 2^32-1 vertices");
+    else
         s->current->vertex_count++;
 }
 
@@ -258,8 +261,9 @@ static void add_triangle(model_state *s, const char **atts)
     if (!index_of(s, atts, "v1", n, &v[0]) || !index_of(s, atts, "v2", n, &v[1]) ||
         !index_of(s, atts, "v3", n, &v[2]))
         return;
-    if (mci_io_add_triangle(&s->pool, v[0], v[1], v[2]) != MCSG_OK)
-        stop(s, MCSG_ERR_LIMIT, "too many triangles");
+    mcsg_status st = mci_io_add_triangle(&s->pool, v[0], v[1], v[2]);
+    if (st != MCSG_OK)
+        stop(s, st, st == MCSG_ERR_NOMEM ? "out of memory" : "more than 2^32-1 triangles");
     else
         s->current->triangle_count++;
 }
@@ -395,6 +399,50 @@ static mcsg_status flatten(model_state *s, uint32_t o, int depth, mcsg_mesh *out
     return MCSG_OK;
 }
 
+#define EXPANSION_CAP ((uint64_t)1 << 40)
+#define VISITING UINT64_MAX
+/* Each placement of a component counts as this many elements: empty objects placed
+ * billions of times would cost the time without the memory. */
+#define INSTANCE_WEIGHT 256
+
+/* The vertices and triangles object o expands to with its components (and placements),
+ * saturating at EXPANSION_CAP, each object counted once (memo: 0 unknown, else the count
+ * + 1); an object within its own components, or nesting deeper than MAX_NESTING, gives
+ * the cap. */
+static uint64_t expanded_size(const model_state *s, uint32_t o, int depth, uint64_t *memo)
+{
+    const object *ob = &s->objects[o];
+    uint64_t n = ob->vertex_count + ob->triangle_count;
+    if (memo[o] == VISITING || depth > MAX_NESTING)
+        return EXPANSION_CAP;
+    if (memo[o])
+        return memo[o] - 1;
+    memo[o] = VISITING;
+    for (size_t k = 0; k < ob->part_count && n < EXPANSION_CAP; k++) /* a placement */
+        n += INSTANCE_WEIGHT + expanded_size(s, ob->parts[k].object, depth + 1, memo);
+    n = n < EXPANSION_CAP ? n : EXPANSION_CAP;
+    memo[o] = n + 1;
+    return n;
+}
+
+/* A few bytes of components can place a part a billion times: what all the items
+ * expand to is counted before anything is built. */
+static mcsg_status check_expansion(model_state *s)
+{
+    uint64_t *memo = mci_calloc_array(s->src->ctx, s->object_count + 1, sizeof *memo);
+    uint64_t total = 0;
+    if (!memo)
+        return mci_fail(s->src->err, MCSG_ERR_NOMEM, "%s: out of memory", s->src->name);
+    for (size_t k = 0; k < s->item_count && total <= UINT32_MAX; k++)
+        total += INSTANCE_WEIGHT + expanded_size(s, s->items[k].object, 0, memo);
+    mci_free(s->src->ctx, memo);
+    if (total > UINT32_MAX)
+        return mci_fail(s->src->err, MCSG_ERR_LIMIT, "%s: %s: the build items expand to more "
+                        "than 2^32-1 vertices and triangles, or components are nested deeper "
+                        "than %d or within themselves", s->src->name, s->part, MAX_NESTING);
+    return MCSG_OK;
+}
+
 static mcsg_status item_mesh(model_state *s, const item *it, mcsg_mesh *out)
 {
     mcsg_status st = flatten(s, it->object, 0, out);
@@ -469,6 +517,8 @@ mcsg_status mci_3mf_read(const mci_io_source *src, mci_3mf_items *out)
     mci_free(src->ctx, xml);
     if (s.status == MCSG_OK && s.item_count == 0)
         s.status = mci_fail(src->err, MCSG_ERR_PARSE, "%s: %s: no build item", src->name, part);
+    if (s.status == MCSG_OK)
+        s.status = check_expansion(&s);
     if (s.status == MCSG_OK && (!(out->meshes = mci_calloc_array(src->ctx, s.item_count,
                                                                   sizeof *out->meshes)) ||
                                 !(out->names = mci_calloc_array(src->ctx, s.item_count,
