@@ -767,6 +767,8 @@ static int eval_file(mcsg_options *opts, const char *in, const cli_values *v,
         fail_line(&err);
     if (v->picture) { /* faces coloured by the leaf they lie on */
         uint32_t *group = leaf_groups(prov, result.triangle_count);
+        if (!group)
+            fprintf(stderr, "meshcsg: out of memory drawing %s\n", v->picture);
         ok = group && write_picture(&result, group, draw, v->edges, v->picture) && ok;
         free(group);
         mcsg_free(prov, opts);

@@ -18,6 +18,7 @@
 
 typedef struct camera {
     double right[3], up[3], toward[3]; /* toward: from the scene to the viewer */
+    double light[3];                   /* unit, from above the viewer's left shoulder */
     double scale, offset_x, offset_y;  /* screen = scale * (p . right) + offset */
 } camera;
 
@@ -161,11 +162,19 @@ static void fill(picture *p, const screen_triangle *s, int edges)
         }
 }
 
+static void place_light(camera *c)
+{
+    static const double in_view[3] = {-0.35, 0.45, 0.82}; /* right, up, toward */
+    double len = sqrt(dot(in_view, in_view));
+    for (int k = 0; k < 3; k++)
+        c->light[k] = (in_view[0] * c->right[k] + in_view[1] * c->up[k] +
+                       in_view[2] * c->toward[k]) / len;
+}
+
 static void project(const mcsg_mesh *mesh, size_t t, const camera *c, const uint32_t *group,
                     screen_triangle *s)
 {
-    static const double light_dir[3] = {-0.35, 0.45, 0.82}; /* in the camera's axes */
-    double n[3], e1[3], e2[3], len, light[3], lambert;
+    double n[3], e1[3], e2[3], len, lambert;
     const double *v[3];
     uint8_t base[3];
     for (int k = 0; k < 3; k++) {
@@ -180,10 +189,7 @@ static void project(const mcsg_mesh *mesh, size_t t, const camera *c, const uint
     n[1] = e1[2] * e2[0] - e1[0] * e2[2];
     n[2] = e1[0] * e2[1] - e1[1] * e2[0];
     len = sqrt(dot(n, n));
-    for (int k = 0; k < 3; k++)
-        light[k] = light_dir[0] * c->right[k] + light_dir[1] * c->up[k] +
-                   light_dir[2] * c->toward[k];
-    lambert = len > 0 ? fabs(dot(n, light)) / (len * sqrt(dot(light, light))) : 0;
+    lambert = len > 0 ? fabs(dot(n, c->light)) / len : 0;
     picture_group_colour(group ? group[t] : 0, base);
     for (int k = 0; k < 3; k++)
         s->rgb[k] = (uint8_t)lround(base[k] * (AMBIENT + (1 - AMBIENT) * lambert));
@@ -205,6 +211,7 @@ int picture_draw(const mcsg_mesh *mesh, const uint32_t *group, picture_view view
     for (size_t i = 0; i < pixels; i++)
         out->depth[i] = -INFINITY;
     view_axes(view, &c);
+    place_light(&c);
     fit(mesh, width, height, &c);
     for (size_t t = 0; t < mesh->triangle_count; t++) {
         screen_triangle s;

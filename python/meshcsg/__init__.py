@@ -105,14 +105,15 @@ class _Provenance:
             _capi.lib.mcsg_free(self.pointer, None)
 
 
-def _view(address, count, ctype, dtype, owner):
-    """A numpy array over memory the library owns (no copy); `owner` lives as long."""
-    if count == 0:
-        return np.zeros((0, 3), dtype)
-    buffer_type = type("buffer", (ctype * (3 * count),), {})
-    buffer = buffer_type.from_address(address)
+def _library_array(pointer, ctype, length, dtype, owner):
+    """A flat numpy array over `length` ctype elements the library owns at `pointer` (no
+    copy); `owner`, which frees them, lives as long as the array."""
+    if length == 0:
+        return np.zeros(0, dtype)
+    buffer_type = type("buffer", (ctype * length,), {})  # a subclass takes attributes
+    buffer = buffer_type.from_address(ctypes.cast(pointer, ctypes.c_void_p).value)
     buffer.owner = owner
-    return np.frombuffer(buffer, dtype=dtype).reshape(count, 3)
+    return np.frombuffer(buffer, dtype=dtype)
 
 
 def _read_only(array):
@@ -149,10 +150,9 @@ class Mesh:
     @classmethod
     def _from_library(cls, owned):
         m = owned.mesh
-        return cls(_view(ctypes.cast(m.vertices, ctypes.c_void_p).value, m.vertex_count,
-                         ctypes.c_double, np.float64, owned),
-                   _view(ctypes.cast(m.triangles, ctypes.c_void_p).value, m.triangle_count,
-                         ctypes.c_uint32, np.uint32, owned))
+        v = _library_array(m.vertices, ctypes.c_double, 3 * m.vertex_count, np.float64, owned)
+        t = _library_array(m.triangles, ctypes.c_uint32, 3 * m.triangle_count, np.uint32, owned)
+        return cls(v.reshape(-1, 3), t.reshape(-1, 3))
 
     def _c_mesh(self):
         m = _capi.Mesh()
@@ -416,13 +416,8 @@ def _evaluate(tree, call, provenance):
     mesh = Mesh._from_library(owned)
     if not provenance:
         return mesh
-    count = owned.mesh.triangle_count
-    if count == 0:
-        return mesh, np.zeros(0, np.uint32), np.zeros(0, np.uint32)
-    buffer_type = type("buffer", (_capi.Provenance * count,), {})
-    buffer = buffer_type.from_address(ctypes.cast(origin.pointer, ctypes.c_void_p).value)
-    buffer.owner = origin
-    pairs = np.frombuffer(buffer, dtype=np.dtype([("leaf", np.uint32), ("face", np.uint32)]))
+    pairs = _library_array(origin.pointer, _capi.Provenance, owned.mesh.triangle_count,
+                           np.dtype([("leaf", np.uint32), ("face", np.uint32)]), origin)
     return mesh, pairs["leaf"], pairs["face"]
 
 

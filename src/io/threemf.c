@@ -104,23 +104,19 @@ static void model_part(const mci_ctx *ctx, zip_t *zip, char *part, size_t size)
 
 /* ---- the model -------------------------------------------------------------------- */
 
-typedef struct component {
+/* An object placed by a transform: a component of another object, or a build item. */
+typedef struct placement {
     uint32_t object; /* index in objects */
     double m[12];
-} component;
+} placement;
 
 typedef struct object {
     uint32_t id;
     char *name;
     size_t first_vertex, vertex_count, first_triangle, triangle_count; /* in the pools */
-    component *parts;
+    placement *parts;
     size_t part_count, part_cap;
 } object;
-
-typedef struct item {
-    uint32_t object;
-    double m[12];
-} item;
 
 typedef struct model_state {
     const mci_io_source *src;
@@ -130,7 +126,7 @@ typedef struct model_state {
     double unit;
     object *objects;
     size_t object_count, object_cap;
-    item *items;
+    placement *items;
     size_t item_count, item_cap;
     mci_io_builder pool; /* every object's vertices and triangles, one after another */
     object *current;
@@ -268,35 +264,20 @@ static void add_triangle(model_state *s, const char **atts)
         s->current->triangle_count++;
 }
 
-static void add_component(model_state *s, const char **atts)
-{
-    object *part = find_object(s, atts);
-    component c;
-    if (!part || !transform(s, atts, c.m))
-        return;
-    c.object = (uint32_t)(part - s->objects);
-    object *o = s->current;
-    if (!mci_grow_array(s->src->ctx, (void **)&o->parts, &o->part_cap, o->part_count + 1,
-                        sizeof *o->parts, 4)) {
-        stop(s, MCSG_ERR_NOMEM, "out of memory");
-        return;
-    }
-    o->parts[o->part_count++] = c;
-}
-
-static void add_item(model_state *s, const char **atts)
+/* A placement (objectid, transform) appended to *list. */
+static void add_placement(model_state *s, const char **atts, placement **list, size_t *count,
+                          size_t *cap)
 {
     object *o = find_object(s, atts);
-    item it;
-    if (!o || !transform(s, atts, it.m))
+    placement p;
+    if (!o || !transform(s, atts, p.m))
         return;
-    it.object = (uint32_t)(o - s->objects);
-    if (!mci_grow_array(s->src->ctx, (void **)&s->items, &s->item_cap, s->item_count + 1,
-                        sizeof *s->items, 8)) {
+    p.object = (uint32_t)(o - s->objects);
+    if (!mci_grow_array(s->src->ctx, (void **)list, cap, *count + 1, sizeof **list, 8)) {
         stop(s, MCSG_ERR_NOMEM, "out of memory");
         return;
     }
-    s->items[s->item_count++] = it;
+    (*list)[(*count)++] = p;
 }
 
 static double unit_millimetres(const char *unit)
@@ -330,11 +311,12 @@ static void model_start(void *user, const char *full, const char **atts)
     else if (strcmp(name, "triangle") == 0 && s->in_mesh)
         add_triangle(s, atts);
     else if (strcmp(name, "component") == 0 && s->current)
-        add_component(s, atts);
+        add_placement(s, atts, &s->current->parts, &s->current->part_count,
+                      &s->current->part_cap);
     else if (strcmp(name, "build") == 0)
         s->in_build = 1;
     else if (strcmp(name, "item") == 0 && s->in_build)
-        add_item(s, atts);
+        add_placement(s, atts, &s->items, &s->item_count, &s->item_cap);
 }
 
 static void model_end(void *user, const char *full)
@@ -351,6 +333,20 @@ static void model_end(void *user, const char *full)
 
 /* ---- build items as meshes ------------------------------------------------------- */
 
+/* Appends vertices and triangles (indices into those vertices) to b. */
+static mcsg_status append(mci_io_builder *b, const double *vertices, size_t vertex_count,
+                          const uint32_t *triangles, size_t triangle_count)
+{
+    uint32_t base = (uint32_t)b->vertex_count;
+    mcsg_status st = MCSG_OK;
+    for (size_t v = 0; st == MCSG_OK && v < vertex_count; v++)
+        st = mci_io_add_vertex(b, vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]);
+    for (size_t t = 0; st == MCSG_OK && t < triangle_count; t++)
+        st = mci_io_add_triangle(b, base + triangles[3 * t], base + triangles[3 * t + 1],
+                                 base + triangles[3 * t + 2]);
+    return st;
+}
+
 /* Object o with its components, each mapped by its transform, into *out. */
 static mcsg_status flatten(model_state *s, uint32_t o, int depth, mcsg_mesh *out)
 {
@@ -362,14 +358,9 @@ static mcsg_status flatten(model_state *s, uint32_t o, int depth, mcsg_mesh *out
                         "%d (or an object made of itself)", s->src->name, s->part, MAX_NESTING);
     mci_io_builder_init(&b, s->src->ctx);
     st = mci_io_reserve(&b, ob->vertex_count, ob->triangle_count);
-    for (size_t v = 0; st == MCSG_OK && v < ob->vertex_count; v++) {
-        const double *p = s->pool.vertices + 3 * (ob->first_vertex + v);
-        st = mci_io_add_vertex(&b, p[0], p[1], p[2]);
-    }
-    for (size_t t = 0; st == MCSG_OK && t < ob->triangle_count; t++) {
-        const uint32_t *c = s->pool.triangles + 3 * (ob->first_triangle + t);
-        st = mci_io_add_triangle(&b, c[0], c[1], c[2]);
-    }
+    if (st == MCSG_OK)
+        st = append(&b, s->pool.vertices + 3 * ob->first_vertex, ob->vertex_count,
+                    s->pool.triangles + 3 * ob->first_triangle, ob->triangle_count);
     for (size_t k = 0; st == MCSG_OK && k < ob->part_count; k++) {
         mcsg_mesh part;
         st = flatten(s, ob->parts[k].object, depth + 1, &part);
@@ -378,14 +369,7 @@ static mcsg_status flatten(model_state *s, uint32_t o, int depth, mcsg_mesh *out
             return st;
         }
         mcsg_mesh_transform(&part, ob->parts[k].m);
-        uint32_t base = (uint32_t)b.vertex_count;
-        for (size_t v = 0; st == MCSG_OK && v < part.vertex_count; v++)
-            st = mci_io_add_vertex(&b, part.vertices[3 * v], part.vertices[3 * v + 1],
-                                   part.vertices[3 * v + 2]);
-        for (size_t t = 0; st == MCSG_OK && t < part.triangle_count; t++)
-            st = mci_io_add_triangle(&b, base + part.triangles[3 * t],
-                                     base + part.triangles[3 * t + 1],
-                                     base + part.triangles[3 * t + 2]);
+        st = append(&b, part.vertices, part.vertex_count, part.triangles, part.triangle_count);
         mci_free(s->src->ctx, part.vertices);
         mci_free(s->src->ctx, part.triangles);
     }
@@ -443,7 +427,7 @@ static mcsg_status check_expansion(model_state *s)
     return MCSG_OK;
 }
 
-static mcsg_status item_mesh(model_state *s, const item *it, mcsg_mesh *out)
+static mcsg_status item_mesh(model_state *s, const placement *it, mcsg_mesh *out)
 {
     mcsg_status st = flatten(s, it->object, 0, out);
     if (st != MCSG_OK)
@@ -560,14 +544,7 @@ mcsg_status mci_3mf_read_merged(const mci_io_source *src, mcsg_mesh *out)
     mci_io_builder_init(&b, src->ctx);
     for (size_t k = 0; st == MCSG_OK && k < items.count; k++) {
         const mcsg_mesh *m = &items.meshes[k];
-        uint32_t base = (uint32_t)b.vertex_count;
-        for (size_t v = 0; st == MCSG_OK && v < m->vertex_count; v++)
-            st = mci_io_add_vertex(&b, m->vertices[3 * v], m->vertices[3 * v + 1],
-                                   m->vertices[3 * v + 2]);
-        for (size_t t = 0; st == MCSG_OK && t < m->triangle_count; t++)
-            st = mci_io_add_triangle(&b, base + m->triangles[3 * t],
-                                     base + m->triangles[3 * t + 1],
-                                     base + m->triangles[3 * t + 2]);
+        st = append(&b, m->vertices, m->vertex_count, m->triangles, m->triangle_count);
     }
     mci_3mf_items_free(src->ctx, &items);
     if (st != MCSG_OK) {
