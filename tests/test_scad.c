@@ -716,8 +716,8 @@ TEST(unsupported_constructs)
     expect_error("if (true) cube(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`if`");
     expect_error("use <lib.scad>", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`use`");
     expect_error("include <lib.scad>", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`include`");
-    expect_error("linear_extrude(1) square(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:",
-                 "`linear_extrude` is not supported");
+    expect_error("offset(1) square(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:",
+                 "`offset` is not supported");
     expect_error("union() { hull() { cube(1); } }", MCSG_ERR_UNSUPPORTED, "t.scad:1:11:",
                  "`hull`");
     expect_error("x = 5;", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "assignment to `x`");

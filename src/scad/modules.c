@@ -30,11 +30,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#define MAX_PARAMS 14
 #define F_MINIMUM 0.01
 
 /* Each module's parameter list in OpenSCAD's order (required, then optional). */
-static const char *const module_params[MOD_COUNT][MAX_PARAMS] = {
+static const char *const module_params[MOD_COUNT][SCAD_MAX_PARAMS] = {
     [MOD_UNION] = {NULL},
     [MOD_DIFFERENCE] = {NULL},
     [MOD_INTERSECTION] = {NULL},
@@ -52,6 +51,12 @@ static const char *const module_params[MOD_COUNT][MAX_PARAMS] = {
     [MOD_POLYHEDRON] = {"points", "faces", "convexity", "triangles", NULL},
     [MOD_IMPORT] = {"file", "layer", "convexity", "origin", "scale", "width", "height",
                     "filename", "layername", "center", "dpi", "id", "timestamp", NULL},
+    [MOD_CIRCLE] = {"r", "d", NULL},
+    [MOD_SQUARE] = {"size", "center", NULL},
+    [MOD_POLYGON] = {"points", "paths", "convexity", NULL},
+    [MOD_LINEAR_EXTRUDE] = {"file", "layer", "height", "origin", "scale", "center", "twist",
+                            "slices", "convexity", NULL},
+    [MOD_ROTATE_EXTRUDE] = {"file", "layer", "origin", "scale", "convexity", "angle", NULL},
 };
 
 enum { CUBE_SIZE, CUBE_CENTER };
@@ -59,19 +64,6 @@ enum { SPHERE_R, SPHERE_D };
 enum { CYL_H, CYL_R1, CYL_R2, CYL_CENTER, CYL_R, CYL_D, CYL_D1, CYL_D2 };
 enum { POLY_POINTS, POLY_FACES, POLY_CONVEXITY, POLY_TRIANGLES };
 enum { IMPORT_FILE, IMPORT_FILENAME = 7 };
-
-typedef struct bound_arg {
-    scad_value value; /* undef when not given */
-    uint32_t line, col;
-    bool named;
-} bound_arg;
-
-/* A call's arguments bound to its module's parameters. */
-typedef struct call_args {
-    const scad_stmt *stmt;
-    const char *module;
-    bound_arg slot[MAX_PARAMS];
-} call_args;
 
 mcsg_status scad_fail_at(const char *name, uint32_t line, uint32_t col, mcsg_error *err,
                          mcsg_status status, const char *fmt, ...)
@@ -107,9 +99,9 @@ static int param_slot(scad_module module, const char *name, uint32_t len)
 }
 
 /* The next parameter a positional argument fills, or -1. */
-static int next_positional(const call_args *ca, scad_module module, int *position)
+static int next_positional(const scad_call_args *ca, scad_module module, int *position)
 {
-    while (*position < MAX_PARAMS && module_params[module][*position]) {
+    while (*position < SCAD_MAX_PARAMS && module_params[module][*position]) {
         int slot = (*position)++;
         if (!ca->slot[slot].named)
             return slot;
@@ -118,7 +110,7 @@ static int next_positional(const call_args *ca, scad_module module, int *positio
 }
 
 /* Put a named argument's value in its parameter slot (or warn that it has none). */
-static void bind_named(scad_context *sc, call_args *ca, const scad_arg *arg,
+static void bind_named(scad_context *sc, scad_call_args *ca, const scad_arg *arg,
                        const scad_value *value)
 {
     const char *name = sc->prog->text + arg->name_start;
@@ -142,7 +134,7 @@ static void bind_named(scad_context *sc, call_args *ca, const scad_arg *arg,
 /* Evaluate and bind every argument of the call; $-arguments are bound as special
  * variables once all arguments are evaluated (they are evaluated in the caller's scope,
  * like the others). */
-static mcsg_status bind_arguments(scad_context *sc, const scad_stmt *stmt, call_args *ca,
+mcsg_status scad_bind_arguments(scad_context *sc, const scad_stmt *stmt, scad_call_args *ca,
                                   mcsg_error *err)
 {
     const scad_arg *args = stmt->arg_count ? sc->prog->args + stmt->arg_begin : NULL;
@@ -193,17 +185,17 @@ static mcsg_status bind_arguments(scad_context *sc, const scad_stmt *stmt, call_
 /* ---------------------------------------------------------------------------------- */
 /* Argument access */
 
-static bool given(const call_args *ca, int slot) { return ca->slot[slot].value.type != VAL_UNDEF; }
+bool scad_given(const scad_call_args *ca, int slot) { return ca->slot[slot].value.type != VAL_UNDEF; }
 
-static const scad_value *element(const scad_context *sc, const scad_value *v, uint32_t i)
+const scad_value *scad_element(const scad_context *sc, const scad_value *v, uint32_t i)
 {
     return &sc->ev.heap[v->start + i];
 }
 
-static mcsg_status wrong_type(const scad_context *sc, const call_args *ca, int slot,
+mcsg_status scad_wrong_type(const scad_context *sc, const scad_call_args *ca, int slot,
                               const char *expected, mcsg_error *err)
 {
-    const bound_arg *a = &ca->slot[slot];
+    const scad_bound_arg *a = &ca->slot[slot];
     bool missing = a->line == 0; /* not given at all: point at the call */
     return scad_fail_at(sc->name, missing ? ca->stmt->line : a->line,
                         missing ? ca->stmt->col : a->col, err, MCSG_ERR_PARSE,
@@ -213,48 +205,48 @@ static mcsg_status wrong_type(const scad_context *sc, const call_args *ca, int s
 }
 
 /* A number, if given (else *x is left alone). */
-static mcsg_status arg_number(const scad_context *sc, const call_args *ca, int slot, double *x,
+mcsg_status scad_arg_number(const scad_context *sc, const scad_call_args *ca, int slot, double *x,
                               mcsg_error *err)
 {
-    if (!given(ca, slot))
+    if (!scad_given(ca, slot))
         return MCSG_OK;
     if (ca->slot[slot].value.type != VAL_NUMBER)
-        return wrong_type(sc, ca, slot, "a number", err);
+        return scad_wrong_type(sc, ca, slot, "a number", err);
     *x = ca->slot[slot].value.number;
     return MCSG_OK;
 }
 
-static mcsg_status arg_bool(const scad_context *sc, const call_args *ca, int slot, bool *b,
+mcsg_status scad_arg_bool(const scad_context *sc, const scad_call_args *ca, int slot, bool *b,
                             mcsg_error *err)
 {
-    if (!given(ca, slot))
+    if (!scad_given(ca, slot))
         return MCSG_OK;
     if (ca->slot[slot].value.type != VAL_BOOL)
-        return wrong_type(sc, ca, slot, "true or false", err);
+        return scad_wrong_type(sc, ca, slot, "true or false", err);
     *b = ca->slot[slot].value.number != 0;
     return MCSG_OK;
 }
 
 /* A vector of 3 numbers, or of 2 when two_ok (the third is then `z`). */
-static bool get_vec3(const scad_context *sc, const scad_value *v, bool two_ok, double z,
+bool scad_get_vec3(const scad_context *sc, const scad_value *v, bool two_ok, double z,
                      double out[3])
 {
     if (v->type != VAL_VECTOR || !(v->count == 3 || (two_ok && v->count == 2)))
         return false;
     for (uint32_t i = 0; i < v->count; i++) {
-        if (element(sc, v, i)->type != VAL_NUMBER)
+        if (scad_element(sc, v, i)->type != VAL_NUMBER)
             return false;
     }
     for (uint32_t i = 0; i < 3; i++)
-        out[i] = i < v->count ? element(sc, v, i)->number : z;
+        out[i] = i < v->count ? scad_element(sc, v, i)->number : z;
     return true;
 }
 
-static mcsg_status arg_finite_vec3(const scad_context *sc, const call_args *ca, int slot,
+mcsg_status scad_arg_finite_vec3(const scad_context *sc, const scad_call_args *ca, int slot,
                                    double z, double out[3], mcsg_error *err)
 {
-    if (!get_vec3(sc, &ca->slot[slot].value, true, z, out))
-        return wrong_type(sc, ca, slot, "a vector of 2 or 3 numbers", err);
+    if (!scad_get_vec3(sc, &ca->slot[slot].value, true, z, out))
+        return scad_wrong_type(sc, ca, slot, "a vector of 2 or 3 numbers", err);
     if (!isfinite(out[0]) || !isfinite(out[1]) || !isfinite(out[2]))
         return scad_fail_at(sc->name, ca->slot[slot].line, ca->slot[slot].col, err,
                             MCSG_ERR_PARSE, "%s(): `%s` must be finite", ca->module,
@@ -263,17 +255,17 @@ static mcsg_status arg_finite_vec3(const scad_context *sc, const call_args *ca, 
 }
 
 /* OpenSCAD's lookup_radius: the diameter, halved, if given; else the radius. */
-static mcsg_status arg_radius(const scad_context *sc, const call_args *ca, int d_slot,
+mcsg_status scad_arg_radius(const scad_context *sc, const scad_call_args *ca, int d_slot,
                               int r_slot, double *r, bool *defined, mcsg_error *err)
 {
     double d = 0;
-    mcsg_status st = arg_number(sc, ca, d_slot, &d, err);
+    mcsg_status st = scad_arg_number(sc, ca, d_slot, &d, err);
     if (st == MCSG_OK)
-        st = arg_number(sc, ca, r_slot, r, err);
-    *defined = given(ca, d_slot) || given(ca, r_slot);
-    if (st != MCSG_OK || !given(ca, d_slot))
+        st = scad_arg_number(sc, ca, r_slot, r, err);
+    *defined = scad_given(ca, d_slot) || scad_given(ca, r_slot);
+    if (st != MCSG_OK || !scad_given(ca, d_slot))
         return st;
-    if (given(ca, r_slot))
+    if (scad_given(ca, r_slot))
         scad_warn_at(sc->ev.ctx, sc->name, ca->slot[r_slot].line, ca->slot[r_slot].col,
                      "%s(): ignoring `%s` as `%s` is given too", ca->module,
                      module_params[ca->stmt->module][r_slot],
@@ -283,7 +275,7 @@ static mcsg_status arg_radius(const scad_context *sc, const call_args *ca, int d
 }
 
 /* $fn, $fa, $fs in scope, with OpenSCAD's clamping of $fa and $fs. */
-static mcsg_status get_resolution(scad_context *sc, const call_args *ca, mcsg_resolution *res,
+mcsg_status scad_get_resolution(scad_context *sc, const scad_call_args *ca, mcsg_resolution *res,
                                   mcsg_error *err)
 {
     static const uint32_t vars[3] = {VAR_FN, VAR_FA, VAR_FS};
@@ -311,21 +303,21 @@ static mcsg_status get_resolution(scad_context *sc, const call_args *ca, mcsg_re
 /* ---------------------------------------------------------------------------------- */
 /* Labels and leaves */
 
-static bool put_number(const mci_ctx *ctx, mci_buf *buf, const char *prefix, double x)
+bool scad_put_number(const mci_ctx *ctx, mci_buf *buf, const char *prefix, double x)
 {
     char text[MCI_DOUBLE_TEXT_MAX];
     mci_format_double(text, x);
     return mci_buf_printf(ctx, buf, "%s%s", prefix, text);
 }
 
-static bool put_resolution(const mci_ctx *ctx, mci_buf *buf, const mcsg_resolution *res)
+bool scad_put_resolution(const mci_ctx *ctx, mci_buf *buf, const mcsg_resolution *res)
 {
     if (res->fn > 0)
-        return put_number(ctx, buf, ", $fn=", res->fn);
-    return put_number(ctx, buf, ", $fa=", res->fa) && put_number(ctx, buf, ", $fs=", res->fs);
+        return scad_put_number(ctx, buf, ", $fn=", res->fn);
+    return scad_put_number(ctx, buf, ", $fa=", res->fa) && scad_put_number(ctx, buf, ", $fs=", res->fs);
 }
 
-static bool is_identity(const double m[12])
+bool scad_is_identity(const double m[12])
 {
     static const double id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     for (int i = 0; i < 12; i++) {
@@ -337,7 +329,7 @@ static bool is_identity(const double m[12])
 
 /* Give a failure from a library call (a size limit, say) the call's position; an
  * allocation failure keeps its plain message. */
-static mcsg_status at_call(const scad_context *sc, const call_args *ca, mcsg_status st,
+mcsg_status scad_at_call(const scad_context *sc, const scad_call_args *ca, mcsg_status st,
                            mcsg_error *err)
 {
     char message[MCSG_ERROR_MESSAGE_SIZE];
@@ -363,13 +355,13 @@ static mcsg_status frame_local_mesh(const mci_ctx *ctx, const scad_transform *t,
         return st;
     memcpy(local->vertices, mesh->vertices, mesh->vertex_count * 3 * sizeof(double));
     memcpy(local->triangles, mesh->triangles, mesh->triangle_count * 3 * sizeof(uint32_t));
-    if (!is_identity(t->rel))
+    if (!scad_is_identity(t->rel))
         mcsg_mesh_transform(local, t->rel);
     return MCSG_OK;
 }
 
 /* Add the transformed leaf, and its local mesh inside a frame (both taken). */
-static mcsg_status add_framed_leaf(scad_context *sc, const call_args *ca, mcsg_mesh *mesh,
+static mcsg_status add_framed_leaf(scad_context *sc, const scad_call_args *ca, mcsg_mesh *mesh,
                                    mcsg_mesh *local, const char *label, mcsg_node_id *node,
                                    mcsg_error *err)
 {
@@ -377,12 +369,12 @@ static mcsg_status add_framed_leaf(scad_context *sc, const call_args *ca, mcsg_m
     if (st == MCSG_OK && local->vertices)
         mci_tree_set_local(sc->tree, *node, local);
     mci_mesh_free(sc->ev.ctx, local);
-    return at_call(sc, ca, st, err);
+    return scad_at_call(sc, ca, st, err);
 }
 
 /* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
  * an empty mesh or a flattening transform gives the empty set instead. */
-static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_transform *t,
+mcsg_status scad_add_leaf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                             mcsg_mesh *mesh, mci_buf *label, mcsg_node_id *node,
                             mcsg_error *err)
 {
@@ -403,7 +395,7 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
             mci_mesh_free(ctx, mesh);
             return st;
         }
-        if (!is_identity(t->m))
+        if (!scad_is_identity(t->m))
             mcsg_mesh_transform(mesh, t->m);
         for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
             if (!isfinite(mesh->vertices[i])) {
@@ -412,7 +404,7 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
                 return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err,
                                     MCSG_ERR_PARSE, "%.*s: vertex %zu is not finite%s",
                                     call_len, (const char *)label->data, i / 3,
-                                    is_identity(t->m) ? ""
+                                    scad_is_identity(t->m) ? ""
                                     : " after the transforms above it");
             }
         }
@@ -424,16 +416,16 @@ static mcsg_status add_leaf(scad_context *sc, const call_args *ca, const scad_tr
     mci_mesh_free(ctx, mesh);
     st = mcsg_tree_add_op(sc->tree, MCSG_NODE_UNION, NULL, 0, (const char *)label->data, node,
                           err);
-    return at_call(sc, ca, st, err);
+    return scad_at_call(sc, ca, st, err);
 }
 
-static mcsg_status nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *err)
+mcsg_status scad_nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *err)
 {
     mci_mesh_free(ctx, mesh);
     return mci_fail_nomem(err, "reading CSG text");
 }
 
-static mcsg_status make_cube(scad_context *sc, const call_args *ca, const scad_transform *t,
+static mcsg_status make_cube(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                              mci_buf *label, mcsg_node_id *node, mcsg_error *err)
 {
     const scad_value *size = &ca->slot[CUBE_SIZE].value;
@@ -443,52 +435,52 @@ static mcsg_status make_cube(scad_context *sc, const call_args *ca, const scad_t
     mcsg_status st = MCSG_OK;
     if (size->type == VAL_NUMBER)
         s[0] = s[1] = s[2] = size->number;
-    else if (given(ca, CUBE_SIZE) && !get_vec3(sc, size, false, 0, s))
-        st = wrong_type(sc, ca, CUBE_SIZE, "a number or a vector of 3 numbers", err);
+    else if (scad_given(ca, CUBE_SIZE) && !scad_get_vec3(sc, size, false, 0, s))
+        st = scad_wrong_type(sc, ca, CUBE_SIZE, "a number or a vector of 3 numbers", err);
     if (st == MCSG_OK)
-        st = arg_bool(sc, ca, CUBE_CENTER, &center, err);
+        st = scad_arg_bool(sc, ca, CUBE_CENTER, &center, err);
     if (st == MCSG_OK)
-        st = at_call(sc, ca, mcsg_make_cube(s, center, sc->opts, &mesh, err), err);
+        st = scad_at_call(sc, ca, mcsg_make_cube(s, center, sc->opts, &mesh, err), err);
     if (st != MCSG_OK)
         return st;
-    if (!put_number(sc->ev.ctx, label, "cube(size=[", s[0]) ||
-        !put_number(sc->ev.ctx, label, ", ", s[1]) || !put_number(sc->ev.ctx, label, ", ", s[2]) ||
+    if (!scad_put_number(sc->ev.ctx, label, "cube(size=[", s[0]) ||
+        !scad_put_number(sc->ev.ctx, label, ", ", s[1]) || !scad_put_number(sc->ev.ctx, label, ", ", s[2]) ||
         !mci_buf_printf(sc->ev.ctx, label, "], center=%s)", center ? "true" : "false"))
-        return nomem_label(&mesh, sc->ev.ctx, err);
-    return add_leaf(sc, ca, t, &mesh, label, node, err);
+        return scad_nomem_label(&mesh, sc->ev.ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
-static mcsg_status make_sphere(scad_context *sc, const call_args *ca, const scad_transform *t,
+static mcsg_status make_sphere(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                                mci_buf *label, mcsg_node_id *node, mcsg_error *err)
 {
     double r = 1;
     bool defined;
     mcsg_resolution res;
     mcsg_mesh mesh;
-    mcsg_status st = arg_radius(sc, ca, SPHERE_D, SPHERE_R, &r, &defined, err);
+    mcsg_status st = scad_arg_radius(sc, ca, SPHERE_D, SPHERE_R, &r, &defined, err);
     if (st == MCSG_OK)
-        st = get_resolution(sc, ca, &res, err);
+        st = scad_get_resolution(sc, ca, &res, err);
     if (st == MCSG_OK)
-        st = at_call(sc, ca, mcsg_make_sphere(r, res, sc->opts, &mesh, err), err);
+        st = scad_at_call(sc, ca, mcsg_make_sphere(r, res, sc->opts, &mesh, err), err);
     if (st != MCSG_OK)
         return st;
-    if (!put_number(sc->ev.ctx, label, "sphere(r=", r) ||
-        !put_resolution(sc->ev.ctx, label, &res) || !mci_buf_printf(sc->ev.ctx, label, ")"))
-        return nomem_label(&mesh, sc->ev.ctx, err);
-    return add_leaf(sc, ca, t, &mesh, label, node, err);
+    if (!scad_put_number(sc->ev.ctx, label, "sphere(r=", r) ||
+        !scad_put_resolution(sc->ev.ctx, label, &res) || !mci_buf_printf(sc->ev.ctx, label, ")"))
+        return scad_nomem_label(&mesh, sc->ev.ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
 /* OpenSCAD's cylinder radii: r sets both, r1/d1 and r2/d2 override it. */
-static mcsg_status cylinder_radii(scad_context *sc, const call_args *ca, double *r1,
+static mcsg_status cylinder_radii(scad_context *sc, const scad_call_args *ca, double *r1,
                                   double *r2, mcsg_error *err)
 {
     double r = 1, one = 1, two = 1;
     bool has_r, has_r1, has_r2;
-    mcsg_status st = arg_radius(sc, ca, CYL_D, CYL_R, &r, &has_r, err);
+    mcsg_status st = scad_arg_radius(sc, ca, CYL_D, CYL_R, &r, &has_r, err);
     if (st == MCSG_OK)
-        st = arg_radius(sc, ca, CYL_D1, CYL_R1, &one, &has_r1, err);
+        st = scad_arg_radius(sc, ca, CYL_D1, CYL_R1, &one, &has_r1, err);
     if (st == MCSG_OK)
-        st = arg_radius(sc, ca, CYL_D2, CYL_R2, &two, &has_r2, err);
+        st = scad_arg_radius(sc, ca, CYL_D2, CYL_R2, &two, &has_r2, err);
     if (st != MCSG_OK)
         return st;
     if (has_r && (has_r1 || has_r2))
@@ -499,7 +491,7 @@ static mcsg_status cylinder_radii(scad_context *sc, const call_args *ca, double 
     return MCSG_OK;
 }
 
-static mcsg_status make_cylinder(scad_context *sc, const call_args *ca,
+static mcsg_status make_cylinder(scad_context *sc, const scad_call_args *ca,
                                  const scad_transform *t, mci_buf *label, mcsg_node_id *node,
                                  mcsg_error *err)
 {
@@ -508,36 +500,36 @@ static mcsg_status make_cylinder(scad_context *sc, const call_args *ca,
     bool center = false;
     mcsg_resolution res;
     mcsg_mesh mesh;
-    mcsg_status st = arg_number(sc, ca, CYL_H, &h, err);
+    mcsg_status st = scad_arg_number(sc, ca, CYL_H, &h, err);
     if (st == MCSG_OK)
         st = cylinder_radii(sc, ca, &r1, &r2, err);
     if (st == MCSG_OK)
-        st = arg_bool(sc, ca, CYL_CENTER, &center, err);
+        st = scad_arg_bool(sc, ca, CYL_CENTER, &center, err);
     if (st == MCSG_OK)
-        st = get_resolution(sc, ca, &res, err);
+        st = scad_get_resolution(sc, ca, &res, err);
     if (st == MCSG_OK)
-        st = at_call(sc, ca, mcsg_make_cylinder(h, r1, r2, center, res, sc->opts, &mesh, err),
+        st = scad_at_call(sc, ca, mcsg_make_cylinder(h, r1, r2, center, res, sc->opts, &mesh, err),
                      err);
     if (st != MCSG_OK)
         return st;
-    if (!put_number(ctx, label, "cylinder(h=", h) || !put_number(ctx, label, ", r1=", r1) ||
-        !put_number(ctx, label, ", r2=", r2) ||
+    if (!scad_put_number(ctx, label, "cylinder(h=", h) || !scad_put_number(ctx, label, ", r1=", r1) ||
+        !scad_put_number(ctx, label, ", r2=", r2) ||
         !mci_buf_printf(ctx, label, ", center=%s", center ? "true" : "false") ||
-        !put_resolution(ctx, label, &res) || !mci_buf_printf(ctx, label, ")"))
-        return nomem_label(&mesh, ctx, err);
-    return add_leaf(sc, ca, t, &mesh, label, node, err);
+        !scad_put_resolution(ctx, label, &res) || !mci_buf_printf(ctx, label, ")"))
+        return scad_nomem_label(&mesh, ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
 /* ---------------------------------------------------------------------------------- */
 /* polyhedron and import */
 
-static mcsg_status polyhedron_points(scad_context *sc, const call_args *ca, mcsg_mesh *mesh,
+static mcsg_status polyhedron_points(scad_context *sc, const scad_call_args *ca, mcsg_mesh *mesh,
                                      mcsg_error *err)
 {
-    const bound_arg *a = &ca->slot[POLY_POINTS];
+    const scad_bound_arg *a = &ca->slot[POLY_POINTS];
     for (uint32_t i = 0; i < a->value.count; i++) {
         double *p = mesh->vertices + 3 * (size_t)i;
-        if (!get_vec3(sc, element(sc, &a->value, i), true, 0.0, p) || !isfinite(p[0]) ||
+        if (!scad_get_vec3(sc, scad_element(sc, &a->value, i), true, 0.0, p) || !isfinite(p[0]) ||
             !isfinite(p[1]) || !isfinite(p[2]))
             return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE,
                                 "polyhedron(): points[%u] is not a vector of 2 or 3 finite "
@@ -547,16 +539,16 @@ static mcsg_status polyhedron_points(scad_context *sc, const call_args *ca, mcsg
 }
 
 /* Check one face's indices; *corners receives its size. */
-static mcsg_status polyhedron_face(scad_context *sc, const bound_arg *a, uint32_t f,
+static mcsg_status polyhedron_face(scad_context *sc, const scad_bound_arg *a, uint32_t f,
                                    uint32_t points, uint32_t *corners, mcsg_error *err)
 {
-    const scad_value *face = element(sc, &a->value, f);
+    const scad_value *face = scad_element(sc, &a->value, f);
     if (face->type != VAL_VECTOR)
         return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE, "polyhedron(): "
                             "faces[%u] is %s, not a vector of point indices", f,
                             scad_type_name((scad_type)face->type));
     for (uint32_t k = 0; k < face->count; k++) {
-        const scad_value *index = element(sc, face, k);
+        const scad_value *index = scad_element(sc, face, k);
         double x = index->number;
         if (index->type != VAL_NUMBER || !(x >= 0 && x < points) || x != floor(x)) {
             char text[MCI_DOUBLE_TEXT_MAX] = "";
@@ -574,24 +566,24 @@ static mcsg_status polyhedron_face(scad_context *sc, const bound_arg *a, uint32_
 }
 
 /* Fan-triangulate the reversed faces (OpenSCAD's faces are clockwise from outside). */
-static void polyhedron_triangles(scad_context *sc, const bound_arg *a, mcsg_mesh *mesh)
+static void polyhedron_triangles(scad_context *sc, const scad_bound_arg *a, mcsg_mesh *mesh)
 {
     uint32_t *t = mesh->triangles;
     for (uint32_t f = 0; f < a->value.count; f++) {
-        const scad_value *face = element(sc, &a->value, f);
+        const scad_value *face = scad_element(sc, &a->value, f);
         uint32_t n = face->count;
         for (uint32_t k = 1; n >= 3 && k + 1 < n; k++) {
-            t[0] = (uint32_t)element(sc, face, n - 1)->number;
-            t[1] = (uint32_t)element(sc, face, n - 1 - k)->number;
-            t[2] = (uint32_t)element(sc, face, n - 2 - k)->number;
+            t[0] = (uint32_t)scad_element(sc, face, n - 1)->number;
+            t[1] = (uint32_t)scad_element(sc, face, n - 1 - k)->number;
+            t[2] = (uint32_t)scad_element(sc, face, n - 2 - k)->number;
             t += 3;
         }
     }
 }
 
-static const bound_arg *polyhedron_faces_arg(scad_context *sc, const call_args *ca)
+static const scad_bound_arg *polyhedron_faces_arg(scad_context *sc, const scad_call_args *ca)
 {
-    if (!given(ca, POLY_FACES) && given(ca, POLY_TRIANGLES)) {
+    if (!scad_given(ca, POLY_FACES) && scad_given(ca, POLY_TRIANGLES)) {
         scad_warn_at(sc->ev.ctx, sc->name, ca->slot[POLY_TRIANGLES].line,
                      ca->slot[POLY_TRIANGLES].col, "polyhedron(): `triangles` is deprecated, "
                      "use `faces`");
@@ -600,18 +592,18 @@ static const bound_arg *polyhedron_faces_arg(scad_context *sc, const call_args *
     return &ca->slot[POLY_FACES];
 }
 
-static mcsg_status make_polyhedron(scad_context *sc, const call_args *ca,
+static mcsg_status make_polyhedron(scad_context *sc, const scad_call_args *ca,
                                    const scad_transform *t, mci_buf *label, mcsg_node_id *node,
                                    mcsg_error *err)
 {
-    const bound_arg *faces = polyhedron_faces_arg(sc, ca);
+    const scad_bound_arg *faces = polyhedron_faces_arg(sc, ca);
     uint64_t triangles = 0;
     mcsg_mesh mesh;
     mcsg_status st = MCSG_OK;
     if (ca->slot[POLY_POINTS].value.type != VAL_VECTOR)
-        return wrong_type(sc, ca, POLY_POINTS, "a vector of points", err);
+        return scad_wrong_type(sc, ca, POLY_POINTS, "a vector of points", err);
     if (faces->value.type != VAL_VECTOR)
-        return wrong_type(sc, ca, (int)(faces - ca->slot), "a vector of faces", err);
+        return scad_wrong_type(sc, ca, (int)(faces - ca->slot), "a vector of faces", err);
     for (uint32_t f = 0; f < faces->value.count && st == MCSG_OK; f++) {
         uint32_t corners = 0;
         st = polyhedron_face(sc, faces, f, ca->slot[POLY_POINTS].value.count, &corners, err);
@@ -624,7 +616,7 @@ static mcsg_status make_polyhedron(scad_context *sc, const call_args *ca,
         st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, MCSG_ERR_LIMIT,
                           "polyhedron(): more than %u triangles", UINT32_MAX);
     if (st == MCSG_OK)
-        st = at_call(sc, ca, mci_mesh_alloc(sc->ev.ctx, &mesh, ca->slot[POLY_POINTS].value.count,
+        st = scad_at_call(sc, ca, mci_mesh_alloc(sc->ev.ctx, &mesh, ca->slot[POLY_POINTS].value.count,
                                             (size_t)triangles, err), err);
     if (st != MCSG_OK)
         return st;
@@ -636,21 +628,21 @@ static mcsg_status make_polyhedron(scad_context *sc, const call_args *ca,
     polyhedron_triangles(sc, faces, &mesh);
     if (!mci_buf_printf(sc->ev.ctx, label, "polyhedron(%zu points, %u faces)",
                         mesh.vertex_count, faces->value.count))
-        return nomem_label(&mesh, sc->ev.ctx, err);
-    return add_leaf(sc, ca, t, &mesh, label, node, err);
+        return scad_nomem_label(&mesh, sc->ev.ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
 /* The file to import, resolved against the base directory, into `path`. */
-static mcsg_status import_path(scad_context *sc, const call_args *ca, const char **file,
+static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const char **file,
                                uint32_t *file_len, mci_buf *path, mcsg_error *err)
 {
-    int slot = !given(ca, IMPORT_FILE) && given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
+    int slot = !scad_given(ca, IMPORT_FILE) && scad_given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
                                                                       : IMPORT_FILE;
     const scad_value *v = &ca->slot[slot].value;
     const char *dir = sc->base_dir;
     size_t dir_len = dir ? strlen(dir) : 0;
     if (v->type != VAL_STRING)
-        return wrong_type(sc, ca, slot, "a file name (a string)", err);
+        return scad_wrong_type(sc, ca, slot, "a file name (a string)", err);
     *file = scad_string(sc->prog, v);
     *file_len = v->count;
     if (v->count == 0 || memchr(*file, 0, v->count))
@@ -668,7 +660,7 @@ static mcsg_status import_path(scad_context *sc, const call_args *ca, const char
 
 /* A 3MF file's build items, one leaf each ("import("f.3mf") item 2 (Cylinder)"), under
  * a union when there are several. */
-static mcsg_status import_3mf(scad_context *sc, const call_args *ca, const scad_transform *t,
+static mcsg_status import_3mf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                               const char *file, uint32_t file_len, const char *path,
                               mcsg_node_id *node, mcsg_error *err)
 {
@@ -691,7 +683,7 @@ static mcsg_status import_3mf(scad_context *sc, const call_args *ca, const scad_
                             k + 1, names[k][0] ? " (" : "", names[k], names[k][0] ? ")" : ""))
             st = mci_fail_nomem(err, "reading CSG text");
         else
-            st = add_leaf(sc, ca, t, &meshes[k], &label, &leaves[k], err);
+            st = scad_add_leaf(sc, ca, t, &meshes[k], &label, &leaves[k], err);
         memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
     }
     if (st == MCSG_OK && count == 1)
@@ -711,7 +703,7 @@ static mcsg_status import_3mf(scad_context *sc, const call_args *ca, const scad_
     return st;
 }
 
-static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad_transform *t,
+static mcsg_status make_import(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                                mci_buf *label, mcsg_node_id *node, mcsg_error *err)
 {
     mci_buf path = {0};
@@ -739,8 +731,8 @@ static mcsg_status make_import(scad_context *sc, const call_args *ca, const scad
     if (st != MCSG_OK)
         return st;
     if (!mci_buf_printf(sc->ev.ctx, label, "import(\"%.*s\")", (int)file_len, file))
-        return nomem_label(&mesh, sc->ev.ctx, err);
-    return add_leaf(sc, ca, t, &mesh, label, node, err);
+        return scad_nomem_label(&mesh, sc->ev.ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -755,14 +747,14 @@ static void set_linear(double m[12], const double l[9], const double t[3])
     }
 }
 
-static mcsg_status translate_matrix(scad_context *sc, const call_args *ca, double m[12],
+static mcsg_status translate_matrix(scad_context *sc, const scad_call_args *ca, double m[12],
                                     mcsg_error *err)
 {
     static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     double v[3] = {0, 0, 0};
     mcsg_status st = MCSG_OK;
-    if (given(ca, 0))
-        st = arg_finite_vec3(sc, ca, 0, 0.0, v, err);
+    if (scad_given(ca, 0))
+        st = scad_arg_finite_vec3(sc, ca, 0, 0.0, v, err);
     else
         scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
                      "translate(): no vector given");
@@ -771,21 +763,21 @@ static mcsg_status translate_matrix(scad_context *sc, const call_args *ca, doubl
 }
 
 /* rotate(a=[x, y, z]): OpenSCAD's Rz * Ry * Rx, written out term by term. */
-static mcsg_status rotate_euler(scad_context *sc, const call_args *ca, double l[9],
+static mcsg_status rotate_euler(scad_context *sc, const scad_call_args *ca, double l[9],
                                 mcsg_error *err)
 {
     const scad_value *a = &ca->slot[0].value;
     double s[3] = {0, 0, 0}, c[3] = {1, 1, 1};
     if (a->count > 3)
-        return wrong_type(sc, ca, 0, "a number or a vector of up to 3 numbers", err);
+        return scad_wrong_type(sc, ca, 0, "a number or a vector of up to 3 numbers", err);
     for (uint32_t i = 0; i < a->count; i++) {
-        const scad_value *angle = element(sc, a, i);
+        const scad_value *angle = scad_element(sc, a, i);
         if (angle->type != VAL_NUMBER || !isfinite(angle->number))
-            return wrong_type(sc, ca, 0, "a number or a vector of up to 3 finite numbers", err);
+            return scad_wrong_type(sc, ca, 0, "a number or a vector of up to 3 finite numbers", err);
         s[i] = mci_sin_degrees(angle->number);
         c[i] = mci_cos_degrees(angle->number);
     }
-    if (given(ca, 1))
+    if (scad_given(ca, 1))
         scad_warn_at(sc->ev.ctx, sc->name, ca->slot[1].line, ca->slot[1].col,
                      "rotate(): `v` is ignored when `a` is a vector");
     l[0] = c[1] * c[2];
@@ -800,7 +792,7 @@ static mcsg_status rotate_euler(scad_context *sc, const call_args *ca, double l[
     return MCSG_OK;
 }
 
-static mcsg_status rotate_matrix(scad_context *sc, const call_args *ca, double m[12],
+static mcsg_status rotate_matrix(scad_context *sc, const scad_call_args *ca, double m[12],
                                  mcsg_error *err)
 {
     double l[9], a = 0, axis[3] = {0, 0, 1};
@@ -808,34 +800,34 @@ static mcsg_status rotate_matrix(scad_context *sc, const call_args *ca, double m
     if (ca->slot[0].value.type == VAL_VECTOR) {
         st = rotate_euler(sc, ca, l, err);
     } else {
-        if (!given(ca, 0))
+        if (!scad_given(ca, 0))
             scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
                          "rotate(): no angle given");
-        st = arg_number(sc, ca, 0, &a, err);
+        st = scad_arg_number(sc, ca, 0, &a, err);
         if (st == MCSG_OK && !isfinite(a))
-            st = wrong_type(sc, ca, 0, "a finite number", err);
-        if (st == MCSG_OK && given(ca, 1))
-            st = arg_finite_vec3(sc, ca, 1, 0.0, axis, err);
+            st = scad_wrong_type(sc, ca, 0, "a finite number", err);
+        if (st == MCSG_OK && scad_given(ca, 1))
+            st = scad_arg_finite_vec3(sc, ca, 1, 0.0, axis, err);
         mci_angle_axis_degrees(a, axis, l);
     }
     set_linear(m, l, NULL);
     return st;
 }
 
-static mcsg_status scale_matrix(scad_context *sc, const call_args *ca, double m[12],
+static mcsg_status scale_matrix(scad_context *sc, const scad_call_args *ca, double m[12],
                                 mcsg_error *err)
 {
     double v[3] = {1, 1, 1}, l[9] = {0};
     mcsg_status st = MCSG_OK;
     if (ca->slot[0].value.type == VAL_NUMBER)
         v[0] = v[1] = v[2] = ca->slot[0].value.number;
-    else if (given(ca, 0))
-        st = arg_finite_vec3(sc, ca, 0, 1.0, v, err);
+    else if (scad_given(ca, 0))
+        st = scad_arg_finite_vec3(sc, ca, 0, 1.0, v, err);
     else
         scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
                      "scale(): no factor given");
     if (st == MCSG_OK && !(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2])))
-        st = wrong_type(sc, ca, 0, "finite", err);
+        st = scad_wrong_type(sc, ca, 0, "finite", err);
     l[0] = v[0];
     l[4] = v[1];
     l[8] = v[2];
@@ -844,13 +836,13 @@ static mcsg_status scale_matrix(scad_context *sc, const call_args *ca, double m[
 }
 
 /* Reflection through the plane through the origin normal to v (identity for v = 0). */
-static mcsg_status mirror_matrix(scad_context *sc, const call_args *ca, double m[12],
+static mcsg_status mirror_matrix(scad_context *sc, const scad_call_args *ca, double m[12],
                                  mcsg_error *err)
 {
     double v[3] = {1, 0, 0}, l[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, a;
     mcsg_status st = MCSG_OK;
-    if (given(ca, 0))
-        st = arg_finite_vec3(sc, ca, 0, 0.0, v, err);
+    if (scad_given(ca, 0))
+        st = scad_arg_finite_vec3(sc, ca, 0, 0.0, v, err);
     else
         scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
                      "mirror(): no vector given, mirroring x");
@@ -868,24 +860,24 @@ static mcsg_status mirror_matrix(scad_context *sc, const call_args *ca, double m
 
 /* multmatrix(m): up to 4 rows of up to 4 numbers over the identity, then divided by
  * m[3][3] when that is not 1; the bottom row is otherwise ignored (an affine map). */
-static mcsg_status multmatrix_matrix(scad_context *sc, const call_args *ca, double m[12],
+static mcsg_status multmatrix_matrix(scad_context *sc, const scad_call_args *ca, double m[12],
                                      mcsg_error *err)
 {
     const scad_value *rows = &ca->slot[0].value;
     double full[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, w;
-    if (!given(ca, 0))
+    if (!scad_given(ca, 0))
         scad_warn_at(sc->ev.ctx, sc->name, ca->stmt->line, ca->stmt->col,
                      "multmatrix(): no matrix given");
     else if (rows->type != VAL_VECTOR || rows->count > 4)
-        return wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
-    for (uint32_t r = 0; given(ca, 0) && r < rows->count; r++) {
-        const scad_value *row = element(sc, rows, r);
+        return scad_wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
+    for (uint32_t r = 0; scad_given(ca, 0) && r < rows->count; r++) {
+        const scad_value *row = scad_element(sc, rows, r);
         if (row->type != VAL_VECTOR || row->count > 4)
-            return wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
+            return scad_wrong_type(sc, ca, 0, "a matrix of up to 4 rows of up to 4 numbers", err);
         for (uint32_t c = 0; c < row->count; c++) {
-            if (element(sc, row, c)->type != VAL_NUMBER)
-                return wrong_type(sc, ca, 0, "a matrix of numbers", err);
-            full[4 * r + c] = element(sc, row, c)->number;
+            if (scad_element(sc, row, c)->type != VAL_NUMBER)
+                return scad_wrong_type(sc, ca, 0, "a matrix of numbers", err);
+            full[4 * r + c] = scad_element(sc, row, c)->number;
         }
     }
     w = full[15];
@@ -929,7 +921,7 @@ static double determinant(const double m[12])
 }
 
 /* The transform for the children of a transform module. */
-static mcsg_status child_transform(scad_context *sc, const call_args *ca,
+static mcsg_status child_transform(scad_context *sc, const scad_call_args *ca,
                                    const scad_transform *parent, scad_transform *child,
                                    mcsg_error *err)
 {
@@ -967,13 +959,14 @@ static mcsg_status child_transform(scad_context *sc, const call_args *ca,
 
 mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transform *parent,
                              scad_transform *child, scad_role *role, mcsg_node_id *node,
-                             mcsg_error *err)
+                             scad_dim *dim, mcsg_error *err)
 {
     const scad_stmt *s = &sc->prog->stmts[stmt];
-    call_args ca;
+    scad_call_args ca;
     mci_buf label = {0};
-    mcsg_status st = bind_arguments(sc, s, &ca, err);
+    mcsg_status st = scad_bind_arguments(sc, s, &ca, err);
     *node = MCSG_NO_NODE;
+    *dim = s->module >= MOD_CIRCLE && s->module <= MOD_POLYGON ? DIM_2D : DIM_3D;
     *role = (s->module <= MOD_INTERSECTION) ? ROLE_OP : ROLE_GROUP;
     if (st != MCSG_OK)
         return st;
@@ -983,6 +976,9 @@ mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transfo
     case MOD_CYLINDER: st = make_cylinder(sc, &ca, parent, &label, node, err); break;
     case MOD_POLYHEDRON: st = make_polyhedron(sc, &ca, parent, &label, node, err); break;
     case MOD_IMPORT: st = make_import(sc, &ca, parent, &label, node, err); break;
+    case MOD_CIRCLE:
+    case MOD_SQUARE:
+    case MOD_POLYGON: st = scad_make_shape2d(sc, &ca, parent, node, err); break;
     default: st = child_transform(sc, &ca, parent, child, err); break;
     }
     mci_buf_free(sc->ev.ctx, &label);

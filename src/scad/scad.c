@@ -27,6 +27,9 @@ typedef struct walk_frame {
     uint32_t bindings;  /* binding-stack height before the call's arguments */
     uint32_t heap;      /* value-heap height before the call's arguments */
     uint32_t transform; /* index of the children's transform */
+    uint32_t geom;      /* a module using its children's geometry: its index in
+                           walker.geoms (its children are built in a tree of their own);
+                           else SCAD_NONE */
     bool own_transform; /* that transform was pushed for this frame */
     uint8_t role;       /* scad_role */
 } walk_frame;
@@ -38,7 +41,10 @@ typedef struct walker {
     scad_transform *transforms;
     uint32_t transform_len, transform_cap;
     mcsg_node_id *results;
-    uint32_t result_len, result_cap;
+    uint8_t *dims;           /* each result's scad_dim */
+    uint32_t result_len, result_cap, dim_cap;
+    scad_geometry_op *geoms; /* open geometry modules, outermost first */
+    uint32_t geom_len, geom_cap;
     uint32_t *seen_in_scope; /* var -> serial of the last scope that assigned it */
     uint32_t *last_assign;   /* var -> that scope's last assignment to it */
     uint32_t scope_serial;
@@ -64,12 +70,16 @@ static bool room(const mci_ctx *ctx, void **data, uint32_t *cap, uint32_t len, s
     return true;
 }
 
-static mcsg_status push_result(walker *w, mcsg_node_id id, mcsg_error *err)
+static mcsg_status push_result(walker *w, mcsg_node_id id, scad_dim dim, mcsg_error *err)
 {
-    void *data = w->results;
-    if (!room(w->sc->ev.ctx, &data, &w->result_cap, w->result_len, sizeof *w->results))
-        return mci_fail_nomem(err, "reading CSG text");
+    void *data = w->results, *dims = w->dims;
+    bool ok = room(w->sc->ev.ctx, &data, &w->result_cap, w->result_len, sizeof *w->results);
     w->results = data;
+    ok = ok && room(w->sc->ev.ctx, &dims, &w->dim_cap, w->result_len, sizeof *w->dims);
+    w->dims = dims;
+    if (!ok)
+        return mci_fail_nomem(err, "reading CSG text");
+    w->dims[w->result_len] = (uint8_t)dim;
     w->results[w->result_len++] = id;
     return MCSG_OK;
 }
@@ -121,6 +131,7 @@ static mcsg_status push_frame(walker *w, uint32_t stmt, uint32_t bindings, uint3
     f->heap = heap;
     f->transform = transform;
     f->own_transform = own_transform;
+    f->geom = SCAD_NONE;
     f->role = (uint8_t)role;
     return enter_scope(w, stmt, err);
 }
@@ -137,6 +148,39 @@ static mcsg_status push_transform(walker *w, const scad_transform *t, mcsg_error
     return MCSG_OK;
 }
 
+/* A module that uses its children's geometry: its arguments are read, and its children
+ * go into a tree of their own, in their own coordinates. */
+static mcsg_status enter_geometry(walker *w, uint32_t stmt, uint32_t bindings, uint32_t heap,
+                                  mcsg_error *err)
+{
+    static const scad_transform identity = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {0}, false, false, false};
+    scad_context *sc = w->sc;
+    void *data = w->geoms;
+    scad_geometry_op *op;
+    mcsg_tree *tree;
+    mcsg_status st;
+    if (!room(sc->ev.ctx, &data, &w->geom_cap, w->geom_len, sizeof *w->geoms))
+        return mci_fail_nomem(err, "reading CSG text");
+    w->geoms = data;
+    op = &w->geoms[w->geom_len];
+    st = scad_geometry_begin(sc, stmt, op, err);
+    if (st == MCSG_OK)
+        st = mcsg_tree_create(sc->opts, &tree, err);
+    if (st != MCSG_OK)
+        return st;
+    op->outer = sc->tree;
+    sc->tree = tree;
+    w->geom_len++;
+    st = push_transform(w, &identity, err);
+    if (st == MCSG_OK)
+        st = push_frame(w, stmt, bindings, heap, w->transform_len - 1, true, ROLE_GROUP, err);
+    if (st == MCSG_OK)
+        w->frames[w->frame_len - 1].geom = w->geom_len - 1;
+    return st;
+}
+
 /* Evaluate one call: a leaf goes onto the result stack, anything else opens a frame. */
 static mcsg_status visit_call(walker *w, uint32_t stmt, uint32_t parent_transform,
                               mcsg_error *err)
@@ -146,6 +190,7 @@ static mcsg_status visit_call(walker *w, uint32_t stmt, uint32_t parent_transfor
     uint32_t bindings = sc->ev.binding_len, heap = sc->ev.heap_len;
     scad_transform child;
     scad_role role;
+    scad_dim dim;
     mcsg_node_id node;
     mcsg_status st;
     if (s->modifiers & (MODIFIER_DISABLE | MODIFIER_BACKGROUND)) {
@@ -154,15 +199,17 @@ static mcsg_status visit_call(walker *w, uint32_t stmt, uint32_t parent_transfor
                 : "background (%)", scad_module_name((scad_module)s->module));
         return MCSG_OK;
     }
+    if (scad_is_geometry_module((scad_module)s->module))
+        return enter_geometry(w, stmt, bindings, heap, err);
     st = scad_instantiate(sc, stmt, &w->transforms[parent_transform], &child, &role, &node,
-                          err);
+                          &dim, err);
     if (st == MCSG_OK && node != MCSG_NO_NODE) {
         if (s->first_child != SCAD_NONE)
             scad_warn_at(sc->ev.ctx, sc->name, s->line, s->col, "%s() takes no children: "
                          "ignoring them", scad_module_name((scad_module)s->module));
         scad_unbind_to(&sc->ev, bindings);
         sc->ev.heap_len = heap;
-        return push_result(w, node, err);
+        return push_result(w, node, dim, err);
     }
     if (st == MCSG_OK && is_transform((scad_module)s->module)) {
         st = push_transform(w, &child, err);
@@ -242,6 +289,50 @@ static mcsg_status close_frame(walker *w, const scad_transform *t,
     return MCSG_OK;
 }
 
+/* OpenSCAD's rule for a scope's results: the first of some dimension sets it, those of
+ * the other are left out with a warning. Returns the dimension; *count is updated. */
+static scad_dim keep_one_dimension(walker *w, const walk_frame *f, uint32_t *count)
+{
+    const scad_stmt *s = &w->sc->prog->stmts[f->stmt];
+    scad_dim dim = DIM_NONE;
+    uint32_t kept = 0;
+    bool warned = false;
+    for (uint32_t i = 0; i < *count; i++) {
+        scad_dim d = (scad_dim)w->dims[f->results + i];
+        if (dim == DIM_NONE)
+            dim = d;
+        if (d != DIM_NONE && d != dim) {
+            if (!warned)
+                scad_warn_at(w->sc->ev.ctx, w->sc->name, s->line, s->col, "mixing 2D and 3D "
+                             "objects is not supported: leaving out the %s ones",
+                             d == DIM_2D ? "2D" : "3D");
+            warned = true;
+            continue;
+        }
+        w->results[f->results + kept] = w->results[f->results + i];
+        w->dims[f->results + kept++] = (uint8_t)d;
+    }
+    *count = kept;
+    return dim;
+}
+
+/* A geometry module's children are done (`node`, in its own tree): its result goes into
+ * the enclosing tree in place of them. */
+static mcsg_status exit_geometry(walker *w, const walk_frame *f, mcsg_node_id *node,
+                                 scad_dim *dim, mcsg_error *err)
+{
+    scad_context *sc = w->sc;
+    scad_geometry_op *op = &w->geoms[f->geom];
+    mcsg_tree *own = sc->tree;
+    mcsg_status st = scad_geometry_finish(sc, op, *node, *dim,
+                                          &w->transforms[w->frames[w->frame_len - 1].transform],
+                                          node, dim, err);
+    sc->tree = op->outer;
+    mcsg_tree_free(own);
+    w->geom_len--;
+    return st;
+}
+
 /* A scope is done: combine its results into one node for the enclosing scope. */
 static mcsg_status exit_frame(walker *w, mcsg_error *err)
 {
@@ -250,6 +341,7 @@ static mcsg_status exit_frame(walker *w, mcsg_error *err)
     walk_frame f = w->frames[--w->frame_len];
     const scad_stmt *s = &w->sc->prog->stmts[f.stmt];
     uint32_t count = w->result_len - f.results;
+    scad_dim dim = keep_one_dimension(w, &f, &count);
     mcsg_node_id node;
     mci_buf label = {0};
     mcsg_status st = MCSG_OK;
@@ -270,14 +362,17 @@ static mcsg_status exit_frame(walker *w, mcsg_error *err)
     w->result_len = f.results;
     scad_unbind_to(&w->sc->ev, f.bindings);
     w->sc->ev.heap_len = f.heap;
-    if (f.own_transform && w->transforms[f.transform].opens_frame)
+    if (f.geom != SCAD_NONE)
+        st = exit_geometry(w, &f, &node, &dim, err);
+    if (st == MCSG_OK && dim != DIM_2D && f.own_transform &&
+        w->transforms[f.transform].opens_frame)
         st = close_frame(w, &w->transforms[f.transform],
                          &w->transforms[w->frames[w->frame_len - 1].transform], node, err);
     if (st != MCSG_OK)
         return st;
     if (f.own_transform)
         w->transform_len--;
-    return push_result(w, node, err);
+    return push_result(w, node, dim, err);
 }
 
 static mcsg_status walk_steps(walker *w, mcsg_error *err)
@@ -336,11 +431,22 @@ static mcsg_status walk(scad_context *sc, mcsg_error *err)
         st = push_frame(&w, 0, sc->ev.binding_len, sc->ev.heap_len, 0, false, ROLE_GROUP, err);
     if (st == MCSG_OK)
         st = walk_steps(&w, err);
+    if (st == MCSG_OK && w.dims[0] == DIM_2D)
+        st = mci_fail(err, MCSG_ERR_UNSUPPORTED, "%s: the top level is a 2D object: meshcsg "
+                      "evaluates 3D objects (extrude it with linear_extrude or rotate_extrude)",
+                      sc->name);
     if (st == MCSG_OK)
         st = mcsg_tree_set_root(sc->tree, w.results[0], err);
+    /* On failure, the trees of geometry modules still open. */
+    while (w.geom_len > 0) {
+        mcsg_tree_free(sc->tree);
+        sc->tree = w.geoms[--w.geom_len].outer;
+    }
     mci_free(ctx, w.frames);
     mci_free(ctx, w.transforms);
     mci_free(ctx, w.results);
+    mci_free(ctx, w.dims);
+    mci_free(ctx, w.geoms);
     mci_free(ctx, w.seen_in_scope);
     mci_free(ctx, w.last_assign);
     mci_free(ctx, w.pending);

@@ -89,8 +89,15 @@ typedef struct scad_arg {
 typedef enum scad_module {
     MOD_UNION, MOD_DIFFERENCE, MOD_INTERSECTION, MOD_GROUP, MOD_RENDER, MOD_COLOR,
     MOD_TRANSLATE, MOD_ROTATE, MOD_SCALE, MOD_MIRROR, MOD_MULTMATRIX, MOD_CUBE, MOD_SPHERE,
-    MOD_CYLINDER, MOD_POLYHEDRON, MOD_IMPORT, MOD_COUNT
+    MOD_CYLINDER, MOD_POLYHEDRON, MOD_IMPORT, MOD_CIRCLE, MOD_SQUARE, MOD_POLYGON,
+    MOD_LINEAR_EXTRUDE, MOD_ROTATE_EXTRUDE, MOD_COUNT
 } scad_module;
+
+/* Modules that work on their children's evaluated geometry. */
+static inline bool scad_is_geometry_module(scad_module m)
+{
+    return m == MOD_LINEAR_EXTRUDE || m == MOD_ROTATE_EXTRUDE;
+}
 
 enum { ST_ROOT, ST_CALL, ST_ASSIGN };
 enum { MODIFIER_DISABLE = 1, MODIFIER_BACKGROUND = 2, MODIFIER_HIGHLIGHT = 4 };
@@ -240,16 +247,106 @@ mcsg_status scad_prefetch_take(scad_context *sc, const char *path, mcsg_mesh *me
                                bool *found, mcsg_error *err);
 void scad_prefetch_free(scad_context *sc);
 
+/* ---------------------------------------------------------------------------------- */
+/* Arguments of a call, bound to its module's parameters (modules.c) */
+
+#define SCAD_MAX_PARAMS 14
+
+typedef struct scad_bound_arg {
+    scad_value value; /* undef when not given */
+    uint32_t line, col;
+    bool named;
+} scad_bound_arg;
+
+typedef struct scad_call_args {
+    const scad_stmt *stmt;
+    const char *module;
+    scad_bound_arg slot[SCAD_MAX_PARAMS];
+} scad_call_args;
+
+/* Evaluate and bind every argument of the call, OpenSCAD's way (modules.c); its
+ * $-arguments are bound as special variables (the caller unbinds them). */
+mcsg_status scad_bind_arguments(scad_context *sc, const scad_stmt *stmt, scad_call_args *ca,
+                                mcsg_error *err);
+bool scad_given(const scad_call_args *ca, int slot);
+const scad_value *scad_element(const scad_context *sc, const scad_value *v, uint32_t i);
+/* "MODULE(): `PARAM` must be EXPECTED, not TYPE" at the argument (or the call). */
+mcsg_status scad_wrong_type(const scad_context *sc, const scad_call_args *ca, int slot,
+                            const char *expected, mcsg_error *err);
+/* A number or a boolean, if given (else *x or *b is left alone). */
+mcsg_status scad_arg_number(const scad_context *sc, const scad_call_args *ca, int slot,
+                            double *x, mcsg_error *err);
+mcsg_status scad_arg_bool(const scad_context *sc, const scad_call_args *ca, int slot, bool *b,
+                          mcsg_error *err);
+/* A vector of 3 numbers, or of 2 when two_ok (the third is then `z`). */
+bool scad_get_vec3(const scad_context *sc, const scad_value *v, bool two_ok, double z,
+                   double out[3]);
+/* OpenSCAD's lookup_radius: the diameter, halved, if given; else the radius. */
+mcsg_status scad_arg_radius(const scad_context *sc, const scad_call_args *ca, int d_slot,
+                            int r_slot, double *r, bool *defined, mcsg_error *err);
+/* $fn, $fa, $fs in scope, with OpenSCAD's clamping of $fa and $fs. */
+mcsg_status scad_get_resolution(scad_context *sc, const scad_call_args *ca,
+                                mcsg_resolution *res, mcsg_error *err);
+/* Append ", $fn=..." or ", $fa=..., $fs=..." (or PREFIX and a number) to a label. */
+bool scad_put_resolution(const mci_ctx *ctx, mci_buf *buf, const mcsg_resolution *res);
+bool scad_put_number(const mci_ctx *ctx, mci_buf *buf, const char *prefix, double x);
+bool scad_is_identity(const double m[12]);
+/* A failure from a library call given the call's position ("F:L:C: MODULE(): ..."). */
+mcsg_status scad_at_call(const scad_context *sc, const scad_call_args *ca, mcsg_status st,
+                         mcsg_error *err);
+/* Add the leaf for `mesh` (taking it) under transform t, labelled "<label> at F:L:C";
+ * an empty mesh or a flattening transform gives the empty set instead. */
+mcsg_status scad_add_leaf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                          mcsg_mesh *mesh, mci_buf *label, mcsg_node_id *node,
+                          mcsg_error *err);
+/* Free the mesh and fail for want of memory. */
+mcsg_status scad_nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *err);
+
+/* ---------------------------------------------------------------------------------- */
+/* 2D shapes (shapes2d.c) and the modules that use their children's geometry
+ * (geometry.c) */
+
+/* Dimension of a walk result: DIM_NONE for the empty set of no dimension (a group
+ * without children). 2D objects are prisms from z = 0 to 1 over their region in the
+ * tree being built; only modules that use geometry read them back (region.h). */
+typedef enum scad_dim { DIM_NONE = 0, DIM_2D = 2, DIM_3D = 3 } scad_dim;
+
+/* circle, square, polygon: add the prism of the shape, under the 2D part of t. */
+mcsg_status scad_make_shape2d(scad_context *sc, const scad_call_args *ca,
+                              const scad_transform *t, mcsg_node_id *node, mcsg_error *err);
+
+/* A geometry module's arguments, read when its call is entered. */
+typedef struct scad_geometry_op {
+    uint32_t stmt;
+    scad_call_args ca;     /* for messages: its values are not used once read (the
+                              children reuse the value heap) */
+    mcsg_resolution res;
+    double height, twist, scale[2], angle;
+    int slices;            /* 0: not given */
+    bool center;
+    mcsg_tree *outer;      /* the tree the result goes into */
+} scad_geometry_op;
+
+/* Read the arguments of geometry module call `stmt` (special variables bound). */
+mcsg_status scad_geometry_begin(scad_context *sc, uint32_t stmt, scad_geometry_op *op,
+                                mcsg_error *err);
+/* The children are done: `node` of dimension `dim` in sc->tree (the op's own tree).
+ * Evaluate it and make the op's result into op->outer under transform t: *out and its
+ * dimension. sc->tree is left alone (the caller restores and frees). */
+mcsg_status scad_geometry_finish(scad_context *sc, scad_geometry_op *op, mcsg_node_id node,
+                                 scad_dim dim, const scad_transform *t, mcsg_node_id *out,
+                                 scad_dim *out_dim, mcsg_error *err);
+
 /* What a call with children contributes once its children are done. */
 typedef enum scad_role { ROLE_OP, ROLE_GROUP } scad_role;
 
 /* Evaluate the arguments of call `stmt`. For a primitive, polyhedron or import, add
- * its leaf (or an empty union) under `parent` and set *node; otherwise fill *child
+ * its leaf (or an empty union) under `parent` and set *node and *dim; otherwise fill *child
  * with the transform for the children (parent's, composed with the call's own) and
  * *role. Special variables passed as arguments are bound (the caller unbinds them). */
 mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transform *parent,
                              scad_transform *child, scad_role *role, mcsg_node_id *node,
-                             mcsg_error *err);
+                             scad_dim *dim, mcsg_error *err);
 
 /* Fail with "NAME:LINE:COL: message" and the given status. */
 mcsg_status scad_fail_at(const char *name, uint32_t line, uint32_t col, mcsg_error *err,

@@ -1,0 +1,268 @@
+/*
+ * The 2D primitives of the CSG language, following OpenSCAD 2021.01's primitives.cc:
+ *  - circle(r | d): `fragments` points at 360 * i / n degrees (OpenSCAD's degree trig),
+ *    nothing unless r > 0 and finite;
+ *  - square(size, center): the rectangle [0, x] x [0, y] (centred: moved by half), nothing
+ *    unless both sides are positive and finite;
+ *  - polygon(points, paths, convexity): the points as one outline, or each path of point
+ *    indices as an outline (indices out of range are skipped with a warning), filled by
+ *    the even-odd rule as OpenSCAD's Clipper sanitising does.
+ * Transforms act on 2D shapes through the 2D part of their matrix (rows and columns x, y
+ * and the translation), as in OpenSCAD; one with a zero determinant removes the shape.
+ * Each shape becomes a prism over its region (shape/region.h) in the tree being built.
+ */
+#include "mesh/tree.h"
+#include "scad/degree_trig.h"
+#include "scad/scad.h"
+#include "shape/region.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { CIRCLE_R, CIRCLE_D };
+enum { SQUARE_SIZE, SQUARE_CENTER };
+enum { POLYGON_POINTS, POLYGON_PATHS };
+
+/* More points than this in one shape is refused rather than allocated. */
+#define MAX_SHAPE_POINTS (UINT32_C(1) << 26)
+
+static mcsg_status alloc_outlines(const mci_ctx *ctx, mci_outlines *o, size_t points,
+                                  size_t loops, mcsg_error *err)
+{
+    memset(o, 0, sizeof *o);
+    o->xy = mci_malloc_array(ctx, points + 1, 2 * sizeof *o->xy);
+    o->loop_start = mci_calloc_array(ctx, loops + 1, sizeof *o->loop_start);
+    if (!o->xy || !o->loop_start) {
+        mci_outlines_free(ctx, o);
+        return mci_fail_nomem(err, "making a 2D shape");
+    }
+    return MCSG_OK;
+}
+
+static mcsg_status circle_outline(scad_context *sc, const scad_call_args *ca, mci_outlines *o,
+                                  mci_buf *label, mcsg_error *err)
+{
+    double r = 1;
+    bool defined;
+    mcsg_resolution res;
+    int n;
+    mcsg_status st = scad_arg_radius(sc, ca, CIRCLE_D, CIRCLE_R, &r, &defined, err);
+    if (st == MCSG_OK)
+        st = scad_get_resolution(sc, ca, &res, err);
+    if (st != MCSG_OK)
+        return st;
+    n = r > 0 && isfinite(r) ? mcsg_fragments(r, res.fn, res.fa, res.fs) : 0;
+    if ((uint32_t)n > MAX_SHAPE_POINTS)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, MCSG_ERR_LIMIT,
+                            "circle(): %d fragments, more than %u", n, MAX_SHAPE_POINTS);
+    st = alloc_outlines(sc->ev.ctx, o, (size_t)n, 1, err);
+    for (int i = 0; st == MCSG_OK && i < n; i++) {
+        double phi = (360.0 * i) / n;
+        o->xy[2 * i] = r * mci_cos_degrees(phi);
+        o->xy[2 * i + 1] = r * mci_sin_degrees(phi);
+    }
+    if (st == MCSG_OK && n > 0) {
+        o->point_count = (size_t)n;
+        o->loop_count = 1;
+        o->loop_start[1] = (uint32_t)n;
+    }
+    if (st == MCSG_OK && (!scad_put_number(sc->ev.ctx, label, "circle(r=", r) ||
+                          !scad_put_resolution(sc->ev.ctx, label, &res) ||
+                          !mci_buf_printf(sc->ev.ctx, label, ")")))
+        st = mci_fail_nomem(err, "reading CSG text");
+    return st;
+}
+
+static mcsg_status square_outline(scad_context *sc, const scad_call_args *ca, mci_outlines *o,
+                                  mci_buf *label, mcsg_error *err)
+{
+    const scad_value *size = &ca->slot[SQUARE_SIZE].value;
+    double s[3] = {1, 1, 0}, x0 = 0, y0 = 0;
+    bool center = false;
+    mcsg_status st = MCSG_OK;
+    if (size->type == VAL_NUMBER)
+        s[0] = s[1] = size->number;
+    else if (scad_given(ca, SQUARE_SIZE) &&
+             (size->count != 2 || !scad_get_vec3(sc, size, true, 0, s)))
+        st = scad_wrong_type(sc, ca, SQUARE_SIZE, "a number or a vector of 2 numbers", err);
+    if (st == MCSG_OK)
+        st = scad_arg_bool(sc, ca, SQUARE_CENTER, &center, err);
+    if (st == MCSG_OK)
+        st = alloc_outlines(sc->ev.ctx, o, 4, 1, err);
+    if (st != MCSG_OK)
+        return st;
+    if (center) {
+        x0 = -s[0] / 2;
+        y0 = -s[1] / 2;
+    }
+    if (s[0] > 0 && s[1] > 0 && isfinite(s[0]) && isfinite(s[1])) {
+        double x1 = center ? x0 + s[0] : s[0], y1 = center ? y0 + s[1] : s[1];
+        memcpy(o->xy, (double[8]){x0, y0, x1, y0, x1, y1, x0, y1}, sizeof(double[8]));
+        o->point_count = 4;
+        o->loop_count = 1;
+        o->loop_start[1] = 4;
+    }
+    if (!scad_put_number(sc->ev.ctx, label, "square(size=[", s[0]) ||
+        !scad_put_number(sc->ev.ctx, label, ", ", s[1]) ||
+        !mci_buf_printf(sc->ev.ctx, label, "], center=%s)", center ? "true" : "false"))
+        return mci_fail_nomem(err, "reading CSG text");
+    return MCSG_OK;
+}
+
+/* polygon()'s points, checked: each a vector of 2 numbers. */
+static mcsg_status polygon_points(scad_context *sc, const scad_call_args *ca, double *xy,
+                                  mcsg_error *err)
+{
+    const scad_bound_arg *a = &ca->slot[POLYGON_POINTS];
+    for (uint32_t i = 0; i < a->value.count; i++) {
+        const scad_value *p = scad_element(sc, &a->value, i);
+        double v[3];
+        if (p->type != VAL_VECTOR || p->count != 2 || !scad_get_vec3(sc, p, true, 0, v) ||
+            !isfinite(v[0]) || !isfinite(v[1]))
+            return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE,
+                                "polygon(): points[%u] is not a vector of 2 finite numbers", i);
+        xy[2 * i] = v[0];
+        xy[2 * i + 1] = v[1];
+    }
+    return MCSG_OK;
+}
+
+/* One path of point indices appended to the outlines (indices out of range skipped). */
+static mcsg_status polygon_path(scad_context *sc, const scad_call_args *ca, const double *xy,
+                                uint32_t points, uint32_t p, mci_outlines *o, mcsg_error *err)
+{
+    const scad_bound_arg *a = &ca->slot[POLYGON_PATHS];
+    const scad_value *path = scad_element(sc, &a->value, p);
+    if (path->type != VAL_VECTOR)
+        return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE, "polygon(): "
+                            "paths[%u] is %s, not a vector of point indices", p,
+                            scad_type_name((scad_type)path->type));
+    for (uint32_t k = 0; k < path->count; k++) {
+        const scad_value *index = scad_element(sc, path, k);
+        double x = index->number;
+        if (index->type != VAL_NUMBER)
+            return scad_fail_at(sc->name, a->line, a->col, err, MCSG_ERR_PARSE, "polygon(): "
+                                "paths[%u][%u] is %s, not a point index", p, k,
+                                scad_type_name((scad_type)index->type));
+        if (!(x >= 0 && x < points)) {
+            scad_warn_at(sc->ev.ctx, sc->name, a->line, a->col, "polygon(): point index %.17g "
+                         "is out of bounds (from paths[%u][%u]): skipping it", x, p, k);
+            continue;
+        }
+        memcpy(o->xy + 2 * o->point_count++, xy + 2 * (uint32_t)x, 2 * sizeof *xy);
+    }
+    o->loop_start[++o->loop_count] = (uint32_t)o->point_count;
+    return MCSG_OK;
+}
+
+static mcsg_status polygon_outlines(scad_context *sc, const scad_call_args *ca,
+                                    mci_outlines *o, mci_buf *label, mcsg_error *err)
+{
+    const scad_value *points = &ca->slot[POLYGON_POINTS].value;
+    const scad_value *paths = &ca->slot[POLYGON_PATHS].value;
+    bool by_paths = paths->type == VAL_VECTOR && paths->count > 0;
+    size_t total = 0;
+    double *xy;
+    mcsg_status st;
+    if (points->type != VAL_VECTOR)
+        return scad_wrong_type(sc, ca, POLYGON_POINTS, "a vector of points", err);
+    if (scad_given(ca, POLYGON_PATHS) && paths->type != VAL_VECTOR)
+        return scad_wrong_type(sc, ca, POLYGON_PATHS, "a vector of paths", err);
+    for (uint32_t p = 0; by_paths && p < paths->count; p++)
+        total += scad_element(sc, paths, p)->count;
+    if (!by_paths)
+        total = points->count;
+    if (total > MAX_SHAPE_POINTS || points->count > MAX_SHAPE_POINTS)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, MCSG_ERR_LIMIT,
+                            "polygon(): more than %u points", MAX_SHAPE_POINTS);
+    st = alloc_outlines(sc->ev.ctx, o, total, by_paths ? paths->count : 1, err);
+    xy = st == MCSG_OK ? mci_malloc_array(sc->ev.ctx, points->count + 1, 2 * sizeof *xy) : NULL;
+    if (st == MCSG_OK && !xy)
+        st = mci_fail_nomem(err, "making a 2D shape");
+    if (st == MCSG_OK)
+        st = polygon_points(sc, ca, xy, err);
+    for (uint32_t p = 0; st == MCSG_OK && by_paths && p < paths->count; p++)
+        st = polygon_path(sc, ca, xy, points->count, p, o, err);
+    if (st == MCSG_OK && !by_paths && points->count > 2) {
+        memcpy(o->xy, xy, 2 * sizeof *xy * points->count);
+        o->point_count = points->count;
+        o->loop_count = 1;
+        o->loop_start[1] = points->count;
+    }
+    mci_free(sc->ev.ctx, xy);
+    if (st == MCSG_OK && !mci_buf_printf(sc->ev.ctx, label, "polygon(%u points, %u paths)",
+                                         points->count, by_paths ? paths->count : 1))
+        st = mci_fail_nomem(err, "reading CSG text");
+    return st;
+}
+
+/* The 2D part of a 3D transform (x, y and the translation), applied to the points;
+ * false when it flattens the plane. */
+static bool transform_outlines(const double m[12], mci_outlines *o)
+{
+    if (m[0] * m[5] - m[1] * m[4] == 0)
+        return false;
+    for (size_t i = 0; i < o->point_count; i++) {
+        double x = o->xy[2 * i], y = o->xy[2 * i + 1];
+        o->xy[2 * i] = m[0] * x + m[1] * y + m[3];
+        o->xy[2 * i + 1] = m[4] * x + m[5] * y + m[7];
+    }
+    return true;
+}
+
+/* The prism of the outlines' region, as a leaf (or the empty set). */
+static mcsg_status add_shape(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                             mci_outlines *o, mci_buf *label, mcsg_node_id *node,
+                             mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    mci_region region = {0};
+    mcsg_mesh prism = {0};
+    bool flat = !transform_outlines(t->m, o);
+    mcsg_status st = MCSG_OK;
+    if (!flat) {
+        st = mci_region_from_outlines(ctx, o, &region, err);
+        st = st == MCSG_ERR_NOMEM ? st : scad_at_call(sc, ca, st, err);
+    }
+    if (st == MCSG_OK && region.tri_count > 0)
+        st = mci_region_prism(ctx, &region, &prism, err);
+    mci_region_free(ctx, &region);
+    if (st == MCSG_OK &&
+        !mci_buf_printf(ctx, label, " at %s:%u:%u%s", sc->name, ca->stmt->line, ca->stmt->col,
+                        prism.triangle_count ? "" : flat ? " (empty: flattened by a transform)"
+                                                         : " (empty)"))
+        st = mci_fail_nomem(err, "reading CSG text");
+    if (st != MCSG_OK) {
+        mci_mesh_free(ctx, &prism);
+        return st;
+    }
+    if (prism.triangle_count)
+        return scad_at_call(sc, ca, mci_tree_add_leaf_owned(sc->tree, &prism,
+                                                            (const char *)label->data, node,
+                                                            err), err);
+    if (flat)
+        scad_warn_at(ctx, sc->name, ca->stmt->line, ca->stmt->col, "%s() is scaled to zero "
+                     "area: removing it", ca->module);
+    else
+        scad_warn_at(ctx, sc->name, ca->stmt->line, ca->stmt->col, "%s() is empty", ca->module);
+    return scad_at_call(sc, ca, mcsg_tree_add_op(sc->tree, MCSG_NODE_UNION, NULL, 0,
+                                                 (const char *)label->data, node, err), err);
+}
+
+mcsg_status scad_make_shape2d(scad_context *sc, const scad_call_args *ca,
+                              const scad_transform *t, mcsg_node_id *node, mcsg_error *err)
+{
+    mci_outlines o = {0};
+    mci_buf label = {0};
+    mcsg_status st;
+    switch ((scad_module)ca->stmt->module) {
+    case MOD_CIRCLE: st = circle_outline(sc, ca, &o, &label, err); break;
+    case MOD_SQUARE: st = square_outline(sc, ca, &o, &label, err); break;
+    default: st = polygon_outlines(sc, ca, &o, &label, err); break;
+    }
+    if (st == MCSG_OK)
+        st = add_shape(sc, ca, t, &o, &label, node, err);
+    mci_outlines_free(sc->ev.ctx, &o);
+    mci_buf_free(sc->ev.ctx, &label);
+    return st;
+}

@@ -1,0 +1,201 @@
+/*
+ * OpenSCAD's 2D shapes and the modules that use their children's geometry (src/scad/
+ * shapes2d.c, geometry.c). Known answers come from OpenSCAD 2021.01 itself: the volume,
+ * vertex and triangle counts of `openscad -o x.stl x.scad` for each text below (its STL
+ * holds floats, hence the tolerance of 1e-5 relative); where the answer is exact
+ * (prisms of rectangles) it is checked exactly.
+ */
+#include "testlib.h"
+
+#include <math.h>
+#include <string.h>
+
+typedef struct log_capture {
+    char text[4096];
+} log_capture;
+
+static void capture(void *user, mcsg_log_level level, const char *message)
+{
+    log_capture *log = user;
+    size_t len = strlen(log->text);
+    (void)level;
+    snprintf(log->text + len, sizeof log->text - len, "%s\n", message);
+}
+
+/* Evaluate, check closed and manifold once welded, return the volume (NAN on failure). */
+static double eval_volume(const char *text, size_t *vertices, size_t *triangles,
+                          log_capture *log)
+{
+    mcsg_options opts;
+    mcsg_mesh out;
+    mcsg_eval_stats stats;
+    mcsg_check_report report;
+    mcsg_error err;
+    double volume;
+    memset(&opts, 0, sizeof opts);
+    opts.log = log ? capture : NULL;
+    opts.log_user = log;
+    if (test_eval_scad(text, &opts, &out, &stats, &err) != MCSG_OK) {
+        CHECK_MSG(false, "%s: %s", text, err.message);
+        return NAN;
+    }
+    CHECK_OK(mcsg_mesh_check(&out, NULL, &report, &err), &err);
+    CHECK_MSG(mcsg_check_report_is_valid(&report) &&
+                  !mcsg_output_check_failed(&stats.output_check),
+              "%s: %zu open, %zu non-manifold edges", text, report.boundary_edges,
+              report.nonmanifold_edges);
+    volume = test_signed_volume(&out);
+    if (vertices)
+        *vertices = out.vertex_count;
+    if (triangles)
+        *triangles = out.triangle_count;
+    mcsg_mesh_free(&out, NULL);
+    return volume;
+}
+
+/* Volume within 1e-5 of OpenSCAD's, and OpenSCAD's vertex and triangle counts. */
+static void check_openscad(const char *text, double volume, size_t vertices, size_t triangles)
+{
+    size_t v = 0, t = 0;
+    double got = eval_volume(text, &v, &t, NULL);
+    CHECK_MSG(fabs(got - volume) <= 1e-5 * volume, "%s: volume %.17g, OpenSCAD's %.17g", text,
+              got, volume);
+    CHECK_MSG(v == vertices && t == triangles, "%s: %zu vertices, %zu triangles; OpenSCAD "
+              "%zu, %zu", text, v, t, vertices, triangles);
+}
+
+static void expect_error(const char *text, mcsg_status status, const char *needle)
+{
+    mcsg_tree *tree = NULL;
+    mcsg_mesh out;
+    mcsg_error err;
+    mcsg_status st = mcsg_scad_read_memory(text, strlen(text), "t.scad", NULL, NULL, &tree,
+                                           &err);
+    if (st == MCSG_OK) {
+        mcsg_tree_free(tree);
+        st = test_eval_scad(text, NULL, &out, NULL, &err);
+        if (st == MCSG_OK)
+            mcsg_mesh_free(&out, NULL);
+    }
+    CHECK_MSG(st == status, "%s: status %s, expected %s", text, mcsg_status_string(st),
+              mcsg_status_string(status));
+    if (st != MCSG_OK)
+        CHECK_CONTAINS(err.message, needle);
+}
+
+TEST(prisms_of_squares_are_exact)
+{
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(height = 10) square([20, 10], center = true);",
+                                NULL, NULL, NULL), 2000);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(3) square(2);", NULL, NULL, NULL), 12);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(height = 2, center = true) translate([5, 5]) "
+                                "square(1);", NULL, NULL, NULL), 2);
+    /* 2D CSG before extruding: a 4 x 4 square minus two 1 x 1 corners, one overlapping. */
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) difference() { square(4); square(1); "
+                                "translate([3, 3]) square(2); }", NULL, NULL, NULL), 14);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) intersection() { square(4); "
+                                "translate([1, 2]) square(4); }", NULL, NULL, NULL), 6);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) union() { square(2); translate([1, 0]) "
+                                "square(2); }", NULL, NULL, NULL), 6);
+}
+
+TEST(polygons_with_paths)
+{
+    /* Even-odd, as OpenSCAD fills polygon(): the hole's orientation does not matter. */
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) polygon([[0,0],[10,0],[10,10],[0,10],"
+                                "[3,3],[7,3],[7,7],[3,7]], [[0,1,2,3],[4,5,6,7]]);",
+                                NULL, NULL, NULL), 84);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) polygon([[0,0],[10,0],[10,10],[0,10],"
+                                "[3,3],[7,3],[7,7],[3,7]], [[0,1,2,3],[4,7,6,5]]);",
+                                NULL, NULL, NULL), 84);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(2) polygon(points = [[0,0],[4,0],[0,4]]);",
+                                NULL, NULL, NULL), 16);
+}
+
+TEST(shapes_follow_2d_transforms)
+{
+    /* 2D objects take the x, y part of a transform: a half turn about x mirrors them, a
+     * quarter turn flattens them away (with OpenSCAD's warning). */
+    log_capture log = {""};
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) rotate([180, 0, 0]) square(2);", NULL, NULL,
+                                NULL), 4);
+    CHECK_EQ_DOUBLE(eval_volume("cube(1); linear_extrude(1) rotate([90, 0, 0]) square(2);",
+                                NULL, NULL, &log), 1);
+    CHECK_CONTAINS(log.text, "test.scad:1:47: square() is scaled to zero area: removing it");
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) scale([3, 1]) mirror([1, 0]) square(2);",
+                                NULL, NULL, NULL), 12);
+    check_openscad("linear_extrude(1) rotate(30) square([4, 2]);", 7.9999944050000016, 8, 12);
+}
+
+TEST(openscad_linear_extrude)
+{
+    check_openscad("linear_extrude(height=10, twist=90, slices=5) square([20,10], center=true);",
+                   2224.8817226823326, 24, 44);
+    check_openscad("linear_extrude(height=20, twist=-180, scale=0.3) translate([2,0]) "
+                   "circle(r=5, $fn=12);", 703.10670359084543, 168, 332);
+    check_openscad("linear_extrude(height=5, scale=[2, 0.5], $fn=7) difference() { "
+                   "square(10, center=true); circle(3, $fn=16); }", 393.0601803502737, 160, 320);
+}
+
+TEST(scale_zero_makes_a_point)
+{
+    size_t v, t;
+    /* The apex is shared by the outer cone and the hole's: the result touches itself
+     * there, so the vertex is split (one more than OpenSCAD's 9). */
+    double got = eval_volume("linear_extrude(height=4, scale=0) polygon(points=[[0,0],[10,0],"
+                             "[10,10],[0,10],[3,3],[7,3],[7,7],[3,7]], paths=[[0,1,2,3],"
+                             "[4,7,6,5]]);", &v, &t, NULL);
+    CHECK_EQ_DOUBLE(got, 112);
+    CHECK_EQ_SIZE(t, 16);
+}
+
+TEST(openscad_rotate_extrude)
+{
+    check_openscad("rotate_extrude(angle=-120, $fn=30) polygon([[0,0],[6,-3],[8,4],[0,6]]);",
+                   365.92456934849832, 24, 44);
+    check_openscad("rotate_extrude($fa=5, $fs=0.5) mirror([1,0]) translate([4,0]) circle(r=2);",
+                   312.36380234562017, 1872, 3744);
+    check_openscad("rotate_extrude($fn=40) translate([10,0]) difference() { circle(r=5, $fn=30);"
+                   " circle(r=2, $fn=20); }", 4105.2149576333622, 2000, 4000);
+}
+
+TEST(errors_and_warnings)
+{
+    log_capture log = {""};
+    expect_error("square(1);", MCSG_ERR_UNSUPPORTED, "the top level is a 2D object");
+    expect_error("rotate_extrude() translate([-1, 0]) square(2);", MCSG_ERR_PARSE,
+                 "t.scad:1:1: rotate_extrude(): all points must have the same X coordinate "
+                 "sign (range is -1.00 -> 1.00)");
+    expect_error("linear_extrude(1) polygon([[0,0],[2,2],[2,0],[0,2]]);", MCSG_ERR_UNSUPPORTED,
+                 "t.scad:1:19: polygon(): the outline crosses itself");
+    expect_error("linear_extrude(1) polygon([[0,0],[1]]);", MCSG_ERR_PARSE,
+                 "polygon(): points[1] is not a vector of 2 finite numbers");
+    expect_error("linear_extrude(height = \"a\") square(1);", MCSG_ERR_PARSE,
+                 "t.scad:1:16: linear_extrude(): `height` must be a number, not a string");
+    expect_error("linear_extrude(file = \"a.dxf\");", MCSG_ERR_UNSUPPORTED, "`file` is not "
+                 "supported");
+    expect_error("linear_extrude(1) square(\"a\");", MCSG_ERR_PARSE,
+                 "square(): `size` must be a number or a vector of 2 numbers, not a string");
+    /* Mixing dimensions: the 2D square is left out of the union, with a warning. */
+    CHECK_EQ_DOUBLE(eval_volume("union() { cube(2); square(5); }", NULL, NULL, &log), 8);
+    CHECK_CONTAINS(log.text, "mixing 2D and 3D objects is not supported: leaving out the 2D");
+    log.text[0] = 0;
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) polygon([[0,0],[4,0],[0,4]], [[0,1,2,7]]);",
+                                NULL, NULL, &log), 8);
+    CHECK_CONTAINS(log.text, "point index 7 is out of bounds (from paths[0][3])");
+    log.text[0] = 0;
+    CHECK_EQ_DOUBLE(eval_volume("cube(1); linear_extrude(1) circle(0);", NULL, NULL, &log), 1);
+    CHECK_CONTAINS(log.text, "circle() is empty");
+}
+
+int main(void)
+{
+    RUN(prisms_of_squares_are_exact);
+    RUN(polygons_with_paths);
+    RUN(shapes_follow_2d_transforms);
+    RUN(openscad_linear_extrude);
+    RUN(scale_zero_makes_a_point);
+    RUN(openscad_rotate_extrude);
+    RUN(errors_and_warnings);
+    return test_summary();
+}
