@@ -2,9 +2,10 @@
 # Make sure the build dependencies are present; install them with apt-get when running
 # as root on Debian, otherwise say exactly what is missing.
 #   tools/ensure-deps.sh          gcc, make, cmake, GMP, libpng, libzip and expat headers,
-#                                 python3
-#                                 (benchmark scenes),
-#                                 pkg-config (the install test), python3-numpy and
+#                                 FreeType, HarfBuzz and fontconfig (text()) with the
+#                                 Liberation fonts (OpenSCAD's default font), python3
+#                                 (benchmark scenes), pkg-config (the build and the
+#                                 install test), python3-numpy and
 #                                 python3-pytest (the Python interface's tests),
 #                                 and the de_DE.UTF-8 locale (test_numparse_locale checks
 #                                 that numbers ignore a decimal comma)
@@ -17,7 +18,7 @@ have gcc   || missing+=(gcc)
 have make  || missing+=(make)
 have cmake || missing+=(cmake)
 have python3 || missing+=(python3) # make bench and the optional shared-scene test
-have pkg-config || missing+=(pkg-config) # the install test builds as a user would
+have pkg-config || missing+=(pkg-config) # the font libraries; the install test builds as a user would
 # The Python interface's tests, on Debian's interpreter (the one apt's packages serve).
 python=/usr/bin/python3; [ -x "$python" ] || python=python3
 "$python" -c 'import numpy' >/dev/null 2>&1 || missing+=(python3-numpy)
@@ -37,6 +38,17 @@ if ! have gcc || ! echo '#include <zip.h>' | gcc -E -x c - >/dev/null 2>&1; then
 fi
 if ! have gcc || ! echo '#include <expat.h>' | gcc -E -x c - >/dev/null 2>&1; then
   missing+=(libexpat1-dev) # 3MF's XML
+fi
+# text(): found through pkg-config; the Liberation fonts are OpenSCAD's default, and
+# test_text compares their outlines with OpenSCAD's.
+has_pc() { have pkg-config && pkg-config --exists "$1"; }
+has_pc freetype2 || missing+=(libfreetype-dev)
+has_pc harfbuzz || missing+=(libharfbuzz-dev)
+has_pc fontconfig || missing+=(libfontconfig-dev)
+if have fc-list; then
+  [ -n "$(fc-list 'Liberation Sans' file)" ] || missing+=(fonts-liberation2)
+else
+  [ -e /usr/share/fonts/truetype/liberation2/LiberationSans-Regular.ttf ] || missing+=(fonts-liberation2)
 fi
 if [ "${1:-}" = clang ]; then
   have clang || missing+=(clang)
