@@ -716,10 +716,10 @@ TEST(unsupported_constructs)
     expect_error("if (true) cube(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`if`");
     expect_error("use <lib.scad>", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`use`");
     expect_error("include <lib.scad>", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "`include`");
-    expect_error("offset(1) square(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:",
-                 "`offset` is not supported");
-    expect_error("union() { hull() { cube(1); } }", MCSG_ERR_UNSUPPORTED, "t.scad:1:11:",
-                 "`hull`");
+    expect_error("roof() square(1);", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:",
+                 "`roof` is not supported");
+    expect_error("union() { fill() { square(1); } }", MCSG_ERR_UNSUPPORTED, "t.scad:1:11:",
+                 "`fill`");
     expect_error("x = 5;", MCSG_ERR_UNSUPPORTED, "t.scad:1:1:", "assignment to `x`");
     expect_error("cube(size);", MCSG_ERR_UNSUPPORTED, "t.scad:1:6:", "variable `size`");
     expect_error("cube(f(1));", MCSG_ERR_UNSUPPORTED, "t.scad:1:6:", "function `f`");

@@ -53,15 +53,22 @@ static double eval_volume(const char *text, size_t *vertices, size_t *triangles,
     return volume;
 }
 
-/* Volume within 1e-5 of OpenSCAD's, and OpenSCAD's vertex and triangle counts. */
-static void check_openscad(const char *text, double volume, size_t vertices, size_t triangles)
+/* Volume within `tolerance` (relative) of OpenSCAD's, and OpenSCAD's vertex and
+ * triangle counts. */
+static void check_openscad_within(const char *text, double volume, size_t vertices,
+                                  size_t triangles, double tolerance)
 {
     size_t v = 0, t = 0;
     double got = eval_volume(text, &v, &t, NULL);
-    CHECK_MSG(fabs(got - volume) <= 1e-5 * volume, "%s: volume %.17g, OpenSCAD's %.17g", text,
+    CHECK_MSG(fabs(got - volume) <= tolerance * volume, "%s: volume %.17g, OpenSCAD's %.17g", text,
               got, volume);
     CHECK_MSG(v == vertices && t == triangles, "%s: %zu vertices, %zu triangles; OpenSCAD "
               "%zu, %zu", text, v, t, vertices, triangles);
+}
+
+static void check_openscad(const char *text, double volume, size_t vertices, size_t triangles)
+{
+    check_openscad_within(text, volume, vertices, triangles, 1e-5);
 }
 
 static void expect_error(const char *text, mcsg_status status, const char *needle)
@@ -159,6 +166,65 @@ TEST(openscad_rotate_extrude)
                    " circle(r=2, $fn=20); }", 4105.2149576333622, 2000, 4000);
 }
 
+TEST(openscad_hull_offset_projection_resize)
+{
+    check_openscad("hull() { cube(5); translate([10,0,0]) sphere(2, $fn=12); }",
+                   280.74002562850575, 46, 88);
+    check_openscad("linear_extrude(2) hull() { circle(3, $fn=10); translate([8,0]) square(2); }",
+                   106.95074030600001, 18, 32);
+    check_openscad("linear_extrude(1) offset(r=2, $fn=16) square(10);", 192.24601298863999,
+                   40, 76);
+    check_openscad("linear_extrude(1) offset(r=-1, $fn=20) difference() { square(10); "
+                   "translate([3,3]) square(4); }", 28.90998848000034, 56, 112);
+    CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) offset(delta=1) difference() { square(10); "
+                                "translate([3,3]) square(4); }", NULL, NULL, NULL), 140);
+    CHECK(fabs(eval_volume("linear_extrude(1) offset(delta=1.5, chamfer=true) "
+                           "polygon([[0,0],[10,0],[5,8]]);", NULL, NULL, NULL) -
+               91.097885539999922) <= 1e-5 * 91.1);
+    check_openscad("linear_extrude(1) projection() rotate([30,20,0]) cube(5, center=true);",
+                   40.641936088000044, 12, 20);
+    check_openscad("linear_extrude(1) projection(cut=true) rotate([30,20,0]) "
+                   "cube(5, center=true);", 30.720166170229202, 16, 28);
+    check_openscad("resize([10,0,0], auto=true) sphere(2, $fn=16);", 520.3372601706792, 128,
+                   252);
+}
+
+TEST(openscad_minkowski)
+{
+    /* A sphere's mesh is convex but for rounding: it is summed as its hull, as OpenSCAD
+     * does; the cube with a corner cut away is not convex and is summed face by face. */
+    CHECK(fabs(eval_volume("minkowski() { cube([10,10,2]); cylinder(r=1, h=1, $fn=12); }",
+                           NULL, NULL, NULL) - 429) <= 1e-12 * 429);
+    /* OpenSCAD sums CGAL's convex parts of the L-shaped block and writes floats: 1.1e-5
+     * apart, within the 1e-4 that the examples are held to. */
+    check_openscad_within("minkowski() { difference() { cube(10); translate([2,2,2]) "
+                          "cube(20); } sphere(1, $fn=8); }", 1121.9608611186877, 71, 138, 1e-4);
+    check_openscad("linear_extrude(1) minkowski() { difference() { square(10); "
+                   "translate([2,2]) square(20); } circle(1, $fn=8); }", 78.535500000000255,
+                   32, 60);
+    expect_error("minkowski() { difference() { cube(10); translate([2,2,2]) cube(20); } "
+                 "difference() { cube(10); translate([2,2,2]) cube(20); } }",
+                 MCSG_ERR_UNSUPPORTED, "minkowski(): neither operand is convex or star-shaped");
+}
+
+TEST(openscad_text_dxf_surface)
+{
+    /* Liberation Sans (Debian fonts-liberation2), as OpenSCAD 2021.01 draws it; "Åç" has
+     * glyphs made of crossing pieces, filled by the non-zero rule. */
+    check_openscad("linear_extrude(1) text(\"OpenSCAD\");", 219.53413366841087, 1090, 2168);
+    check_openscad("linear_extrude(1) text(\"\u00c5\u00e7\");", 53.357887386343116, 360, 720);
+    {
+        char text[512];
+        snprintf(text, sizeof text, "linear_extrude(2) import(\"%s\");",
+                 test_data("dxf/example013.dxf"));
+        check_openscad(text, 4000, 40, 76);
+        /* OpenSCAD's STL holds floats: its volume is 21785.62, the exact mesh's 21785.556. */
+        snprintf(text, sizeof text, "surface(\"%s\", center=true);",
+                 test_data("surface/example010.dat"));
+        CHECK(fabs(eval_volume(text, NULL, NULL, NULL) - 21785.556322571869) <= 1e-9 * 21785.6);
+    }
+}
+
 TEST(errors_and_warnings)
 {
     log_capture log = {""};
@@ -196,6 +262,9 @@ int main(void)
     RUN(openscad_linear_extrude);
     RUN(scale_zero_makes_a_point);
     RUN(openscad_rotate_extrude);
+    RUN(openscad_hull_offset_projection_resize);
+    RUN(openscad_minkowski);
+    RUN(openscad_text_dxf_surface);
     RUN(errors_and_warnings);
     return test_summary();
 }

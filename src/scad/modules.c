@@ -22,6 +22,7 @@
  * from import or polyhedron, a leaf under a flattening transform).
  */
 #include "base/numparse.h"
+#include "io/surface.h"
 #include "mesh/tree.h"
 #include "scad/degree_trig.h"
 #include "scad/scad.h"
@@ -51,12 +52,20 @@ static const char *const module_params[MOD_COUNT][SCAD_MAX_PARAMS] = {
     [MOD_POLYHEDRON] = {"points", "faces", "convexity", "triangles", NULL},
     [MOD_IMPORT] = {"file", "layer", "convexity", "origin", "scale", "width", "height",
                     "filename", "layername", "center", "dpi", "id", "timestamp", NULL},
+    [MOD_SURFACE] = {"file", "center", "convexity", "invert", NULL},
     [MOD_CIRCLE] = {"r", "d", NULL},
     [MOD_SQUARE] = {"size", "center", NULL},
     [MOD_POLYGON] = {"points", "paths", "convexity", NULL},
+    [MOD_TEXT] = {"text", "size", "font", "direction", "language", "script", "halign", "valign",
+                  "spacing", NULL},
     [MOD_LINEAR_EXTRUDE] = {"file", "layer", "height", "origin", "scale", "center", "twist",
                             "slices", "convexity", NULL},
     [MOD_ROTATE_EXTRUDE] = {"file", "layer", "origin", "scale", "convexity", "angle", NULL},
+    [MOD_HULL] = {NULL},
+    [MOD_MINKOWSKI] = {"convexity", NULL},
+    [MOD_OFFSET] = {"r", "delta", "chamfer", NULL},
+    [MOD_PROJECTION] = {"cut", "convexity", NULL},
+    [MOD_RESIZE] = {"newsize", "auto", "convexity", NULL},
 };
 
 enum { CUBE_SIZE, CUBE_CENTER };
@@ -703,6 +712,49 @@ static mcsg_status import_3mf(scad_context *sc, const scad_call_args *ca, const 
     return st;
 }
 
+static bool import_is_dxf(const scad_context *sc, const scad_call_args *ca)
+{
+    int slot = !scad_given(ca, IMPORT_FILE) && scad_given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
+                                                                              : IMPORT_FILE;
+    const scad_value *v = &ca->slot[slot].value;
+    return v->type == VAL_STRING && scad_is_dxf_name(scad_string(sc->prog, v), v->count);
+}
+
+/* surface(file, center, convexity | invert): a height map as a closed mesh. */
+static mcsg_status make_surface(scad_context *sc, const scad_call_args *ca,
+                                const scad_transform *t, mci_buf *label, mcsg_node_id *node,
+                                mcsg_error *err)
+{
+    mci_buf path = {0};
+    const char *file = "";
+    uint32_t file_len = 0;
+    bool center = false, invert = false;
+    mcsg_error read_err = {MCSG_OK, ""};
+    mcsg_mesh mesh = {0};
+    mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
+    if (st == MCSG_OK)
+        st = scad_arg_bool(sc, ca, 1, &center, err);
+    if (st == MCSG_OK)
+        st = scad_arg_bool(sc, ca, 3, &invert, err);
+    if (st == MCSG_OK) {
+        st = mci_surface_read(sc->ev.ctx, (const char *)path.data, center, invert, &mesh,
+                              &read_err);
+        if (st != MCSG_OK && st != MCSG_ERR_NOMEM)
+            st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                              "surface(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+        else if (st != MCSG_OK)
+            *err = read_err;
+    }
+    mci_buf_free(sc->ev.ctx, &path);
+    if (st != MCSG_OK)
+        return st;
+    if (!mci_buf_printf(sc->ev.ctx, label, "surface(\"%.*s\", center=%s, invert=%s)",
+                        (int)file_len, file, center ? "true" : "false",
+                        invert ? "true" : "false"))
+        return scad_nomem_label(&mesh, sc->ev.ctx, err);
+    return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
+}
+
 static mcsg_status make_import(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                                mci_buf *label, mcsg_node_id *node, mcsg_error *err)
 {
@@ -713,6 +765,11 @@ static mcsg_status make_import(scad_context *sc, const scad_call_args *ca, const
     mcsg_mesh mesh;
     bool prefetched = false;
     mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
+    if (st == MCSG_OK && scad_is_dxf_name(file, file_len)) {
+        st = scad_import_dxf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
+        mci_buf_free(sc->ev.ctx, &path);
+        return st;
+    }
     if (st == MCSG_OK && scad_is_3mf_name(file, file_len)) {
         st = import_3mf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
         mci_buf_free(sc->ev.ctx, &path);
@@ -966,7 +1023,7 @@ mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transfo
     mci_buf label = {0};
     mcsg_status st = scad_bind_arguments(sc, s, &ca, err);
     *node = MCSG_NO_NODE;
-    *dim = s->module >= MOD_CIRCLE && s->module <= MOD_POLYGON ? DIM_2D : DIM_3D;
+    *dim = (s->module >= MOD_CIRCLE && s->module <= MOD_TEXT) ? DIM_2D : DIM_3D;
     *role = (s->module <= MOD_INTERSECTION) ? ROLE_OP : ROLE_GROUP;
     if (st != MCSG_OK)
         return st;
@@ -975,10 +1032,15 @@ mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transfo
     case MOD_SPHERE: st = make_sphere(sc, &ca, parent, &label, node, err); break;
     case MOD_CYLINDER: st = make_cylinder(sc, &ca, parent, &label, node, err); break;
     case MOD_POLYHEDRON: st = make_polyhedron(sc, &ca, parent, &label, node, err); break;
-    case MOD_IMPORT: st = make_import(sc, &ca, parent, &label, node, err); break;
+    case MOD_IMPORT:
+        st = make_import(sc, &ca, parent, &label, node, err);
+        *dim = import_is_dxf(sc, &ca) ? DIM_2D : DIM_3D;
+        break;
+    case MOD_SURFACE: st = make_surface(sc, &ca, parent, &label, node, err); break;
     case MOD_CIRCLE:
     case MOD_SQUARE:
-    case MOD_POLYGON: st = scad_make_shape2d(sc, &ca, parent, node, err); break;
+    case MOD_POLYGON:
+    case MOD_TEXT: st = scad_make_shape2d(sc, &ca, parent, node, err); break;
     default: st = child_transform(sc, &ca, parent, child, err); break;
     }
     mci_buf_free(sc->ev.ctx, &label);

@@ -50,19 +50,20 @@ typedef struct parser {
 static const char *const module_names[MOD_COUNT] = {
     "union", "difference", "intersection", "group", "render", "color", "translate",
     "rotate", "scale", "mirror", "multmatrix", "cube", "sphere", "cylinder", "polyhedron",
-    "import", "circle", "square", "polygon", "linear_extrude", "rotate_extrude",
+    "import", "surface", "circle", "square", "polygon", "text", "linear_extrude", "rotate_extrude", "hull",
+    "minkowski", "offset", "projection", "resize",
 };
 
 const char scad_supported_modules[] =
     "union, difference, intersection, group, render, color, translate, rotate, scale, "
-    "mirror, multmatrix, cube, sphere, cylinder, polyhedron, import, circle, square, "
-    "polygon, linear_extrude, rotate_extrude, and assignments to $fn, $fa, $fs";
+    "mirror, multmatrix, cube, sphere, cylinder, polyhedron, import, surface, circle, square, "
+    "polygon, text, linear_extrude, rotate_extrude, hull, minkowski, offset, projection, resize, "
+    "and assignments to $fn, $fa, $fs";
 
 /* OpenSCAD keywords and built-in modules that meshcsg recognises but does not support. */
 static const char *const unsupported_names[] = {
     "module", "function", "use", "include", "if", "else", "for", "intersection_for", "let",
-    "each", "assert", "echo", "children", "text", "hull", "minkowski", "offset", "projection",
-    "surface", "resize", "roof", "fill", "parent_module", "debug", NULL,
+    "each", "assert", "echo", "children", "roof", "fill", "parent_module", "debug", NULL,
 };
 
 static const char *const function_names[FN_COUNT] = {

@@ -316,15 +316,15 @@ static scad_dim keep_one_dimension(walker *w, const walk_frame *f, uint32_t *cou
     return dim;
 }
 
-/* A geometry module's children are done (`node`, in its own tree): its result goes into
- * the enclosing tree in place of them. */
-static mcsg_status exit_geometry(walker *w, const walk_frame *f, mcsg_node_id *node,
-                                 scad_dim *dim, mcsg_error *err)
+/* A geometry module's children are done (in its own tree): its result goes into the
+ * enclosing tree in place of them. */
+static mcsg_status exit_geometry(walker *w, const walk_frame *f, uint32_t count,
+                                 mcsg_node_id *node, scad_dim *dim, mcsg_error *err)
 {
     scad_context *sc = w->sc;
     scad_geometry_op *op = &w->geoms[f->geom];
     mcsg_tree *own = sc->tree;
-    mcsg_status st = scad_geometry_finish(sc, op, *node, *dim,
+    mcsg_status st = scad_geometry_finish(sc, op, w->results + f->results, count, *dim,
                                           &w->transforms[w->frames[w->frame_len - 1].transform],
                                           node, dim, err);
     sc->tree = op->outer;
@@ -345,7 +345,9 @@ static mcsg_status exit_frame(walker *w, mcsg_error *err)
     mcsg_node_id node;
     mci_buf label = {0};
     mcsg_status st = MCSG_OK;
-    if (f.role == ROLE_GROUP && count == 1) {
+    if (f.geom != SCAD_NONE) {
+        st = exit_geometry(w, &f, count, &node, &dim, err);
+    } else if (f.role == ROLE_GROUP && count == 1) {
         node = w->results[f.results];
     } else if (frame_label(w, &f, &label) != MCSG_OK) {
         st = mci_fail_nomem(err, "reading CSG text");
@@ -362,8 +364,6 @@ static mcsg_status exit_frame(walker *w, mcsg_error *err)
     w->result_len = f.results;
     scad_unbind_to(&w->sc->ev, f.bindings);
     w->sc->ev.heap_len = f.heap;
-    if (f.geom != SCAD_NONE)
-        st = exit_geometry(w, &f, &node, &dim, err);
     if (st == MCSG_OK && dim != DIM_2D && f.own_transform &&
         w->transforms[f.transform].opens_frame)
         st = close_frame(w, &w->transforms[f.transform],

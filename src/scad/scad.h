@@ -89,14 +89,15 @@ typedef struct scad_arg {
 typedef enum scad_module {
     MOD_UNION, MOD_DIFFERENCE, MOD_INTERSECTION, MOD_GROUP, MOD_RENDER, MOD_COLOR,
     MOD_TRANSLATE, MOD_ROTATE, MOD_SCALE, MOD_MIRROR, MOD_MULTMATRIX, MOD_CUBE, MOD_SPHERE,
-    MOD_CYLINDER, MOD_POLYHEDRON, MOD_IMPORT, MOD_CIRCLE, MOD_SQUARE, MOD_POLYGON,
-    MOD_LINEAR_EXTRUDE, MOD_ROTATE_EXTRUDE, MOD_COUNT
+    MOD_CYLINDER, MOD_POLYHEDRON, MOD_IMPORT, MOD_SURFACE, MOD_CIRCLE, MOD_SQUARE, MOD_POLYGON, MOD_TEXT,
+    MOD_LINEAR_EXTRUDE, MOD_ROTATE_EXTRUDE, MOD_HULL, MOD_MINKOWSKI, MOD_OFFSET,
+    MOD_PROJECTION, MOD_RESIZE, MOD_COUNT
 } scad_module;
 
 /* Modules that work on their children's evaluated geometry. */
 static inline bool scad_is_geometry_module(scad_module m)
 {
-    return m == MOD_LINEAR_EXTRUDE || m == MOD_ROTATE_EXTRUDE;
+    return m >= MOD_LINEAR_EXTRUDE && m <= MOD_RESIZE;
 }
 
 enum { ST_ROOT, ST_CALL, ST_ASSIGN };
@@ -237,6 +238,8 @@ typedef struct scad_context {
 /* Whether an import() file name ends in .3mf (case-insensitive): such a file gives a
  * leaf per build item, read by import() itself, not prefetched as one mesh. */
 bool scad_is_3mf_name(const char *file, uint32_t len);
+/* Whether an import() file name ends in .dxf: a 2D drawing, read by import() itself. */
+bool scad_is_dxf_name(const char *file, uint32_t len);
 
 /* Read the files of every import() call with a literal file name, on the options'
  * threads, into sc->prefetch (failed reads are kept as failures, not reported). */
@@ -311,9 +314,26 @@ mcsg_status scad_nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *er
  * tree being built; only modules that use geometry read them back (region.h). */
 typedef enum scad_dim { DIM_NONE = 0, DIM_2D = 2, DIM_3D = 3 } scad_dim;
 
+/* import() of a DXF drawing: its outlines as a 2D leaf (shapes2d.c). */
+mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                            const char *file, uint32_t file_len, const char *path,
+                            mcsg_node_id *node, mcsg_error *err);
 /* circle, square, polygon: add the prism of the shape, under the 2D part of t. */
 mcsg_status scad_make_shape2d(scad_context *sc, const scad_call_args *ca,
                               const scad_transform *t, mcsg_node_id *node, mcsg_error *err);
+/* The non-zero fill of outlines that may cross (text(): composite glyphs, glyphs set
+ * closer than their width), as outlines that do not: one piece per loop turning the way
+ * the largest one does, with the loops inside it, united by the engine (geometry.c). */
+struct mci_outlines;
+mcsg_status scad_fill_nonzero(scad_context *sc, struct mci_outlines *o,
+                              struct mci_outlines *filled, mcsg_error *err);
+/* Add the region the outlines fill (even-odd) under the 2D part of t, as a prism leaf
+ * labelled "<label> at F:L:C", or the empty set; the outlines' points are transformed in
+ * place. */
+struct mci_outlines;
+mcsg_status scad_add_shape(scad_context *sc, const scad_call_args *ca,
+                           const scad_transform *t, struct mci_outlines *o, mci_buf *label,
+                           mcsg_node_id *node, mcsg_error *err);
 
 /* A geometry module's arguments, read when its call is entered. */
 typedef struct scad_geometry_op {
@@ -321,20 +341,28 @@ typedef struct scad_geometry_op {
     scad_call_args ca;     /* for messages: its values are not used once read (the
                               children reuse the value heap) */
     mcsg_resolution res;
-    double height, twist, scale[2], angle;
+    double height, twist, scale[2], angle; /* linear_extrude, rotate_extrude */
     int slices;            /* 0: not given */
     bool center;
+    double delta;          /* offset */
+    int join;              /* offset: SCAD_JOIN_* */
+    bool cut;              /* projection */
+    double newsize[3];     /* resize */
+    bool autosize[3];
     mcsg_tree *outer;      /* the tree the result goes into */
 } scad_geometry_op;
+
+enum { SCAD_JOIN_ROUND, SCAD_JOIN_MITER, SCAD_JOIN_SQUARE };
 
 /* Read the arguments of geometry module call `stmt` (special variables bound). */
 mcsg_status scad_geometry_begin(scad_context *sc, uint32_t stmt, scad_geometry_op *op,
                                 mcsg_error *err);
-/* The children are done: `node` of dimension `dim` in sc->tree (the op's own tree).
- * Evaluate it and make the op's result into op->outer under transform t: *out and its
- * dimension. sc->tree is left alone (the caller restores and frees). */
-mcsg_status scad_geometry_finish(scad_context *sc, scad_geometry_op *op, mcsg_node_id node,
-                                 scad_dim dim, const scad_transform *t, mcsg_node_id *out,
+/* The children are done: `count` nodes of dimension `dim` in sc->tree (the op's own
+ * tree). Evaluate them and make the op's result into op->outer under transform t: *out
+ * and its dimension. sc->tree is left alone (the caller restores and frees). */
+mcsg_status scad_geometry_finish(scad_context *sc, scad_geometry_op *op,
+                                 const mcsg_node_id *children, size_t count, scad_dim dim,
+                                 const scad_transform *t, mcsg_node_id *out,
                                  scad_dim *out_dim, mcsg_error *err);
 
 /* What a call with children contributes once its children are done. */

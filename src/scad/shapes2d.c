@@ -15,6 +15,8 @@
 #include "scad/degree_trig.h"
 #include "scad/scad.h"
 #include "shape/region.h"
+#include "io/dxf.h"
+#include "text/text.h"
 
 #include <math.h>
 #include <string.h>
@@ -22,6 +24,9 @@
 enum { CIRCLE_R, CIRCLE_D };
 enum { SQUARE_SIZE, SQUARE_CENTER };
 enum { POLYGON_POINTS, POLYGON_PATHS };
+enum { IMPORT_LAYER = 1, IMPORT_ORIGIN = 3, IMPORT_SCALE = 4, IMPORT_LAYERNAME = 8 };
+enum { TEXT_TEXT, TEXT_SIZE, TEXT_FONT, TEXT_DIRECTION, TEXT_LANGUAGE, TEXT_SCRIPT,
+       TEXT_HALIGN, TEXT_VALIGN, TEXT_SPACING, TEXT_STRINGS = TEXT_SPACING };
 
 /* More points than this in one shape is refused rather than allocated. */
 #define MAX_SHAPE_POINTS (UINT32_C(1) << 26)
@@ -196,6 +201,86 @@ static mcsg_status polygon_outlines(scad_context *sc, const scad_call_args *ca,
     return st;
 }
 
+/* text()'s string arguments as C strings (NULL when not given): the text itself may be
+ * any value, printed as OpenSCAD prints it. */
+static mcsg_status text_strings(scad_context *sc, const scad_call_args *ca,
+                                char *strings[TEXT_STRINGS], mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    for (int i = 0; i < TEXT_STRINGS; i++) {
+        const scad_value *v = &ca->slot[i].value;
+        mci_buf buf = {0};
+        bool ok;
+        strings[i] = NULL;
+        if (i == TEXT_SIZE || !scad_given(ca, i))
+            continue;
+        if (v->type != VAL_STRING && i != TEXT_TEXT)
+            return scad_wrong_type(sc, ca, i, "a string", err);
+        ok = v->type == VAL_STRING ? mci_buf_append(ctx, &buf, scad_string(sc->prog, v), v->count)
+                                   : scad_format_value(&sc->ev, v, &buf);
+        if (!ok || !mci_buf_append(ctx, &buf, "", 1)) {
+            mci_buf_free(ctx, &buf);
+            return mci_fail_nomem(err, "making text");
+        }
+        strings[i] = (char *)buf.data;
+    }
+    return MCSG_OK;
+}
+
+static mcsg_status text_outlines(scad_context *sc, const scad_call_args *ca, mci_outlines *o,
+                                 mci_buf *label, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    char *strings[TEXT_STRINGS] = {NULL};
+    mci_text_params p;
+    mcsg_resolution res;
+    mci_region check = {0};
+    mci_outlines filled = {0};
+    mcsg_status st;
+    memset(&p, 0, sizeof p);
+    p.size = 10;
+    p.spacing = 1;
+    st = scad_arg_number(sc, ca, TEXT_SIZE, &p.size, err);
+    if (st == MCSG_OK)
+        st = scad_arg_number(sc, ca, TEXT_SPACING, &p.spacing, err);
+    if (st == MCSG_OK)
+        st = scad_get_resolution(sc, ca, &res, err);
+    if (st == MCSG_OK)
+        st = text_strings(sc, ca, strings, err);
+    if (st == MCSG_OK) {
+        p.text = strings[TEXT_TEXT];
+        p.font = strings[TEXT_FONT];
+        p.halign = strings[TEXT_HALIGN];
+        p.valign = strings[TEXT_VALIGN];
+        p.direction = strings[TEXT_DIRECTION];
+        p.language = strings[TEXT_LANGUAGE];
+        p.script = strings[TEXT_SCRIPT];
+        p.fn = res.fn;
+        p.fa = res.fa;
+        p.fs = res.fs;
+        st = mci_text_outlines(ctx, &p, o, err);
+        st = st == MCSG_OK || st == MCSG_ERR_NOMEM ? st : scad_at_call(sc, ca, st, err);
+    }
+    /* Loops that cross (composite glyphs, glyphs set close) are filled non-zero first. */
+    if (st == MCSG_OK && mci_region_from_outlines(ctx, o, &check, err) == MCSG_ERR_UNSUPPORTED) {
+        st = scad_fill_nonzero(sc, o, &filled, err);
+        if (st == MCSG_OK) {
+            mci_outlines_free(ctx, o);
+            *o = filled;
+        }
+    }
+    mci_region_free(ctx, &check);
+    if (st == MCSG_OK &&
+        (!mci_buf_printf(ctx, label, "text(\"%s\"", p.text ? p.text : "") ||
+         !scad_put_number(ctx, label, ", size=", p.size) ||
+         !mci_buf_printf(ctx, label, "%s%s%s)", p.font ? ", font=\"" : "",
+                         p.font ? p.font : "", p.font ? "\"" : "")))
+        st = mci_fail_nomem(err, "reading CSG text");
+    for (int i = 0; i < TEXT_STRINGS; i++)
+        mci_free(ctx, strings[i]);
+    return st;
+}
+
 /* The 2D part of a 3D transform (x, y and the translation), applied to the points;
  * false when it flattens the plane. */
 static bool transform_outlines(const double m[12], mci_outlines *o)
@@ -210,10 +295,9 @@ static bool transform_outlines(const double m[12], mci_outlines *o)
     return true;
 }
 
-/* The prism of the outlines' region, as a leaf (or the empty set). */
-static mcsg_status add_shape(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
-                             mci_outlines *o, mci_buf *label, mcsg_node_id *node,
-                             mcsg_error *err)
+mcsg_status scad_add_shape(scad_context *sc, const scad_call_args *ca,
+                           const scad_transform *t, struct mci_outlines *o, mci_buf *label,
+                           mcsg_node_id *node, mcsg_error *err)
 {
     const mci_ctx *ctx = sc->ev.ctx;
     mci_region region = {0};
@@ -249,6 +333,70 @@ static mcsg_status add_shape(scad_context *sc, const scad_call_args *ca, const s
                                                  (const char *)label->data, node, err), err);
 }
 
+/* import()'s layer (or the legacy layername), origin and scale for a DXF drawing. */
+static mcsg_status dxf_args(scad_context *sc, const scad_call_args *ca, char **layer,
+                            double origin[2], double *scale, mcsg_error *err)
+{
+    int slot = !scad_given(ca, IMPORT_LAYER) && scad_given(ca, IMPORT_LAYERNAME) ? IMPORT_LAYERNAME
+                                                                                : IMPORT_LAYER;
+    const scad_value *l = &ca->slot[slot].value, *o = &ca->slot[IMPORT_ORIGIN].value;
+    double v[3];
+    mcsg_status st = scad_arg_number(sc, ca, IMPORT_SCALE, scale, err);
+    *layer = NULL;
+    if (st == MCSG_OK && scad_given(ca, IMPORT_ORIGIN)) {
+        if (o->type != VAL_VECTOR || o->count != 2 || !scad_get_vec3(sc, o, true, 0, v) ||
+            !isfinite(v[0]) || !isfinite(v[1]))
+            return scad_wrong_type(sc, ca, IMPORT_ORIGIN, "a vector of 2 finite numbers", err);
+        origin[0] = v[0];
+        origin[1] = v[1];
+    }
+    if (st == MCSG_OK && !(*scale > 0 && isfinite(*scale)))
+        *scale = 1; /* OpenSCAD: a scale of 0 or less is 1 */
+    if (st == MCSG_OK && scad_given(ca, slot)) {
+        if (l->type != VAL_STRING)
+            return scad_wrong_type(sc, ca, slot, "a layer name (a string)", err);
+        if (!(*layer = mci_malloc(sc->ev.ctx, l->count + 1)))
+            return mci_fail_nomem(err, "reading a DXF file");
+        memcpy(*layer, scad_string(sc->prog, l), l->count);
+        (*layer)[l->count] = 0;
+    }
+    return st;
+}
+
+mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                            const char *file, uint32_t file_len, const char *path,
+                            mcsg_node_id *node, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    double origin[2] = {0, 0}, scale = 1;
+    char *layer = NULL;
+    mcsg_resolution res;
+    mci_outlines o = {0};
+    mci_buf label = {0};
+    mcsg_error read_err = {MCSG_OK, ""};
+    mcsg_status st = dxf_args(sc, ca, &layer, origin, &scale, err);
+    if (st == MCSG_OK)
+        st = scad_get_resolution(sc, ca, &res, err);
+    if (st == MCSG_OK) {
+        st = mci_dxf_read(ctx, path, layer, origin, scale, res.fn, res.fa, res.fs, &o, &read_err);
+        if (st != MCSG_OK && st != MCSG_ERR_NOMEM)
+            st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                              "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+        else if (st != MCSG_OK)
+            *err = read_err;
+    }
+    if (st == MCSG_OK &&
+        !mci_buf_printf(ctx, &label, "import(\"%.*s\"%s%s%s)", (int)file_len, file,
+                        layer ? ", layer=\"" : "", layer ? layer : "", layer ? "\"" : ""))
+        st = mci_fail_nomem(err, "reading CSG text");
+    if (st == MCSG_OK)
+        st = scad_add_shape(sc, ca, t, &o, &label, node, err);
+    mci_outlines_free(ctx, &o);
+    mci_buf_free(ctx, &label);
+    mci_free(ctx, layer);
+    return st;
+}
+
 mcsg_status scad_make_shape2d(scad_context *sc, const scad_call_args *ca,
                               const scad_transform *t, mcsg_node_id *node, mcsg_error *err)
 {
@@ -258,10 +406,11 @@ mcsg_status scad_make_shape2d(scad_context *sc, const scad_call_args *ca,
     switch ((scad_module)ca->stmt->module) {
     case MOD_CIRCLE: st = circle_outline(sc, ca, &o, &label, err); break;
     case MOD_SQUARE: st = square_outline(sc, ca, &o, &label, err); break;
+    case MOD_TEXT: st = text_outlines(sc, ca, &o, &label, err); break;
     default: st = polygon_outlines(sc, ca, &o, &label, err); break;
     }
     if (st == MCSG_OK)
-        st = add_shape(sc, ca, t, &o, &label, node, err);
+        st = scad_add_shape(sc, ca, t, &o, &label, node, err);
     mci_outlines_free(sc->ev.ctx, &o);
     mci_buf_free(sc->ev.ctx, &label);
     return st;

@@ -51,8 +51,8 @@ eval_fails 'union() { cube(1); import("missing.stl"); }' 'import("missing.stl")'
 printf 'solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0\n' > "$WORK/broken.stl"
 eval_fails 'union() { cube(1); import("broken.stl"); }' 'broken.stl:5:'
 
-eval_fails 'union() { cube(1); offset(2) square(1); }' \
-  'case.scad:1:20: `offset` is not supported by meshcsg'
+eval_fails 'union() { cube(1); roof() square(1); }' \
+  'case.scad:1:20: `roof` is not supported by meshcsg'
 eval_fails 'union() { cube(1) }' 'case.scad:1:19: expected a statement'
 
 # An empty mesh is the empty set (a warning, not an error).
