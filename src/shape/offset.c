@@ -31,6 +31,8 @@ typedef struct piece_set {
     const mci_ctx *ctx;
     mci_outlines *o;
     size_t point_cap, loop_cap;
+    double *join;     /* the current corner's points (x, y pairs) */
+    size_t join_count, join_cap;
 } piece_set;
 
 static bool add_point(piece_set *s, double x, double y)
@@ -54,12 +56,14 @@ static bool close_piece(piece_set *s)
     return true;
 }
 
-static bool edge_piece(piece_set *s, const double *a, const double *b, const double *n,
-                       double delta)
+static bool join_point(piece_set *s, const double *v, double dx, double dy)
 {
-    return add_point(s, a[0], a[1]) && add_point(s, b[0], b[1]) &&
-           add_point(s, b[0] + n[0] * delta, b[1] + n[1] * delta) &&
-           add_point(s, a[0] + n[0] * delta, a[1] + n[1] * delta) && close_piece(s);
+    if (!mci_grow_array(s->ctx, (void **)&s->join, &s->join_cap, 2 * (s->join_count + 1),
+                        sizeof *s->join, 64))
+        return false;
+    s->join[2 * s->join_count] = v[0] + dx;
+    s->join[2 * s->join_count++ + 1] = v[1] + dy;
+    return true;
 }
 
 static bool round_join(piece_set *s, const double *v, const double *nk, const double *nj,
@@ -69,25 +73,24 @@ static bool round_join(piece_set *s, const double *v, const double *nk, const do
     double sr = sin(TWO_PI / steps) * (delta < 0 ? -1 : 1), cr = cos(TWO_PI / steps);
     double x = nk[0], y = nk[1];
     long count = lround(steps / TWO_PI * fabs(a));
-    bool ok = add_point(s, v[0], v[1]);
+    bool ok = true;
     for (long i = 0; ok && i < (count > 1 ? count : 1); i++) {
         double x2 = x;
-        ok = add_point(s, v[0] + x * delta, v[1] + y * delta);
+        ok = join_point(s, v, x * delta, y * delta);
         x = x * cr - sr * y;
         y = x2 * sr + y * cr;
     }
-    return ok && add_point(s, v[0] + nj[0] * delta, v[1] + nj[1] * delta) && close_piece(s);
+    return ok && join_point(s, v, nj[0] * delta, nj[1] * delta);
 }
 
 static bool square_join(piece_set *s, const double *v, const double *nk, const double *nj,
                         double sin_a, double delta)
 {
     double t = tan(atan2(sin_a, nk[0] * nj[0] + nk[1] * nj[1]) / 4);
-    return add_point(s, v[0], v[1]) &&
-           add_point(s, v[0] + nk[0] * delta, v[1] + nk[1] * delta) &&
-           add_point(s, v[0] + delta * (nk[0] - nk[1] * t), v[1] + delta * (nk[1] + nk[0] * t)) &&
-           add_point(s, v[0] + delta * (nj[0] + nj[1] * t), v[1] + delta * (nj[1] - nj[0] * t)) &&
-           add_point(s, v[0] + nj[0] * delta, v[1] + nj[1] * delta) && close_piece(s);
+    return join_point(s, v, nk[0] * delta, nk[1] * delta) &&
+           join_point(s, v, delta * (nk[0] - nk[1] * t), delta * (nk[1] + nk[0] * t)) &&
+           join_point(s, v, delta * (nj[0] + nj[1] * t), delta * (nj[1] - nj[0] * t)) &&
+           join_point(s, v, nj[0] * delta, nj[1] * delta);
 }
 
 static bool miter_join(piece_set *s, const double *v, const double *nk, const double *nj,
@@ -97,16 +100,18 @@ static bool miter_join(piece_set *s, const double *v, const double *nk, const do
     if (r < 2 / (MITER_LIMIT * MITER_LIMIT))
         return square_join(s, v, nk, nj, sin_a, delta);
     q = delta / r;
-    return add_point(s, v[0], v[1]) &&
-           add_point(s, v[0] + nk[0] * delta, v[1] + nk[1] * delta) &&
-           add_point(s, v[0] + (nk[0] + nj[0]) * q, v[1] + (nk[1] + nj[1]) * q) &&
-           add_point(s, v[0] + nj[0] * delta, v[1] + nj[1] * delta) && close_piece(s);
+    return join_point(s, v, nk[0] * delta, nk[1] * delta) &&
+           join_point(s, v, (nk[0] + nj[0]) * q, (nk[1] + nj[1]) * q) &&
+           join_point(s, v, nj[0] * delta, nj[1] * delta);
 }
 
-static bool corner_piece(piece_set *s, const double *v, const double *nk, const double *nj,
-                         double delta, mci_join join, double steps)
+/* The join's points at v, from v + delta nk to v + delta nj (none where nothing is
+ * filled). */
+static bool corner_points(piece_set *s, const double *v, const double *nk, const double *nj,
+                          double delta, mci_join join, double steps)
 {
     double sin_a = nk[0] * nj[1] - nj[0] * nk[1];
+    s->join_count = 0;
     if (fabs(sin_a * delta * CLIPPER_SCALE) < 1.0 && nk[0] * nj[0] + nk[1] * nj[1] > 0)
         return true;
     sin_a = fmax(-1.0, fmin(1.0, sin_a));
@@ -126,6 +131,9 @@ static void unit_normal(const double *a, const double *b, double *n)
     n[1] = -dx * f;
 }
 
+/* One piece per edge prev -> v: the edge swept by delta along its normal nk, with the
+ * join at v attached (its points from v + delta nj back to v + delta nk): a rectangle
+ * with a fan at one end, simple, and half as many pieces to unite as apart. */
 static bool loop_pieces(piece_set *s, const mci_outlines *o, size_t loop, double delta,
                         mci_join join, double steps)
 {
@@ -134,10 +142,15 @@ static bool loop_pieces(piece_set *s, const mci_outlines *o, size_t loop, double
     for (size_t j = 0; j < n; j++) {
         const double *prev = p + 2 * ((j + n - 1) % n), *v = p + 2 * j, *next = p + 2 * ((j + 1) % n);
         double nk[2], nj[2];
+        bool ok;
         unit_normal(prev, v, nk);
         unit_normal(v, next, nj);
-        if (!edge_piece(s, v, next, nj, delta) ||
-            !corner_piece(s, v, nk, nj, delta, join, steps))
+        ok = corner_points(s, v, nk, nj, delta, join, steps) && add_point(s, prev[0], prev[1]) &&
+             add_point(s, v[0], v[1]);
+        for (size_t i = s->join_count; ok && i-- > 0;)
+            ok = add_point(s, s->join[2 * i], s->join[2 * i + 1]);
+        if (!ok || (s->join_count == 0 && !add_point(s, v[0] + nk[0] * delta, v[1] + nk[1] * delta)) ||
+            !add_point(s, prev[0] + nk[0] * delta, prev[1] + nk[1] * delta) || !close_piece(s))
             return false;
     }
     return true;
@@ -147,21 +160,22 @@ mcsg_status mci_offset_pieces(const mci_ctx *ctx, const mci_outlines *o, double 
                               mci_join join, double steps, mci_outlines *pieces,
                               mcsg_error *err)
 {
-    piece_set s = {ctx, pieces, 0, 0};
+    piece_set s = {ctx, pieces, 0, 0, NULL, 0, 0};
+    mcsg_status st = MCSG_OK;
     memset(pieces, 0, sizeof *pieces);
     pieces->loop_start = mci_calloc_array(ctx, 2, sizeof *pieces->loop_start);
     s.loop_cap = pieces->loop_start ? 2 : 0;
-    for (size_t k = 0; pieces->loop_start && k < o->loop_count; k++) {
+    if (!pieces->loop_start)
+        st = mci_fail_nomem(err, "offsetting a 2D shape");
+    for (size_t k = 0; st == MCSG_OK && k < o->loop_count; k++) {
         if (o->loop_start[k + 1] - o->loop_start[k] >= 3 &&
             !loop_pieces(&s, o, k, delta, join, steps))
-            break;
-        if (k + 1 == o->loop_count)
-            return MCSG_OK;
+            st = mci_fail_nomem(err, "offsetting a 2D shape");
     }
-    if (pieces->loop_start && o->loop_count == 0)
-        return MCSG_OK;
-    mci_outlines_free(ctx, pieces);
-    return mci_fail_nomem(err, "offsetting a 2D shape");
+    mci_free(ctx, s.join);
+    if (st != MCSG_OK)
+        mci_outlines_free(ctx, pieces);
+    return st;
 }
 
 double mci_offset_round_steps(int fragments)
