@@ -1,19 +1,12 @@
 /*
  * Modules that use their children's evaluated geometry, following OpenSCAD 2021.01
- * (linearextrude.cc, rotateextrude.cc, GeometryEvaluator.cc):
- *  - the children are built into a tree of their own, in their own coordinates, and
- *    evaluated exactly by the engine (2D children as prisms, read back as a region);
- *  - linear_extrude(height, center, twist, slices, scale) extrudes the region: caps
- *    from its triangles, walls slice by slice, each slice's outline turned by -twist * k /
- *    slices degrees and scaled by 1 - (1 - scale) * k / slices; each wall quad split along
- *    its shorter diagonal by OpenSCAD's rule (add_slice), so that twisted walls are the
- *    same surface; slices default as OpenSCAD computes them from $fn, $fa, $fs;
- *  - rotate_extrude(angle) sweeps the region about the z axis (x becomes the radius, y
- *    the height) in fragments from the widest x, starting on the -x axis for a full turn
- *    and on the +x axis otherwise, with caps when the angle is not 360;
- * Every point of a level (a slice, a ring) is computed once and shared by the caps and
- * walls, then points with equal coordinates are welded, so that the result is closed
- * even where a ring meets the axis or a scale of zero pinches the top.
+ * (linear_extrude, rotate_extrude, hull, minkowski, offset, projection, resize): the
+ * walk builds their children into a tree of their own, in their own coordinates; when
+ * the children are done, geometry.c evaluates that tree exactly with the engine (2D
+ * children are prisms, read back as a region from the faces at z = 0), makes the
+ * module's result, and adds it as one leaf (or a 2D prism) to the enclosing tree. The
+ * sweeps are in extrude.c, the hulls and offset pieces in src/shape. See
+ * docs/csg-language.md for each module's rules.
  */
 #include "base/sort.h"
 #include "exact/kernel.h"
@@ -35,7 +28,6 @@ enum { RESIZE_NEWSIZE, RESIZE_AUTO };
 #define MAX_SUM_POINTS 67108864.0
 /* More convex sums than this to unite is refused: they overlap heavily. */
 #define MAX_SUM_PIECES 4096
-
 
 static mcsg_status finite_number(const scad_context *sc, const scad_call_args *ca, int slot,
                                  double *x, mcsg_error *err)

@@ -7,7 +7,9 @@
  *   expr.c      expression evaluation: a stack machine over postfix expressions,
  *               values (numbers, booleans, strings, vectors) and built-in functions
  *   modules.c   the built-in modules: argument binding, primitives, transforms,
- *               polyhedron and import, producing tree nodes
+ *               polyhedron, import and surface, producing tree nodes
+ *   shapes2d.c  the 2D shapes (circle, square, polygon, text, DXF import) as prisms
+ *   geometry.c  modules using their children's geometry (extrusions in extrude.c)
  *   prefetch.c  the files of import() calls, read ahead in parallel
  *   scad.c      the public entry points and the non-recursive walk over statements
  * Offsets and counts are 32-bit: texts of 4 GiB or more are refused up front.
