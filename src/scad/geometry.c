@@ -12,6 +12,7 @@
 #include "exact/kernel.h"
 #include "exact/predicates.h"
 #include "mesh/tree.h"
+#include "scad/degree_trig.h"
 #include "scad/geometry.h"
 #include "shape/hull.h"
 #include "shape/offset.h"
@@ -568,6 +569,15 @@ static mcsg_status finish_hull(scad_context *sc, scad_geometry_op *op, const sca
     return st;
 }
 
+/* Clipper's arc steps per full turn for OpenSCAD's offset(r): `fragments` is
+ * get_fragments_from_r(|r|, $fn, $fs, $fa); OpenSCAD sets the arc tolerance to
+ * |r| (1 - cos(180 / fragments)) and Clipper clamps it to a quarter of |r|. */
+static double round_steps(int fragments)
+{
+    double ratio = fmin(1 - mci_cos_degrees(180.0 / fragments), 0.25);
+    return 3.14159265358979323846 / acos(1 - ratio);
+}
+
 static mcsg_status finish_offset(scad_context *sc, scad_geometry_op *op, const scad_transform *t,
                                  const mcsg_node_id *children, size_t count, mci_buf *label,
                                  mcsg_node_id *out, mcsg_error *err)
@@ -582,7 +592,7 @@ static mcsg_status finish_offset(scad_context *sc, scad_geometry_op *op, const s
         st = read_shape(ctx, &prisms, &s, err);
     if (st == MCSG_OK && op->delta != 0 && s.r.tri_count > 0) {
         st = mci_offset_pieces(ctx, &s.o, op->delta, (mci_join)op->join,
-                               mci_offset_round_steps(fragments), &pieces, err);
+                               round_steps(fragments), &pieces, err);
         if (st == MCSG_OK)
             st = combine_pieces(sc, &prisms, &pieces, op->delta > 0 ? MCSG_NODE_UNION
                                 : MCSG_NODE_DIFFERENCE, &grown, err);

@@ -18,8 +18,6 @@
  */
 #include "shape/offset.h"
 
-#include "scad/degree_trig.h"
-
 #include <math.h>
 #include <string.h>
 
@@ -176,10 +174,4 @@ mcsg_status mci_offset_pieces(const mci_ctx *ctx, const mci_outlines *o, double 
     if (st != MCSG_OK)
         mci_outlines_free(ctx, pieces);
     return st;
-}
-
-double mci_offset_round_steps(int fragments)
-{
-    double ratio = fmin(1 - mci_cos_degrees(180.0 / fragments), 0.25);
-    return 3.14159265358979323846 / acos(1 - ratio);
 }

@@ -18,15 +18,9 @@ typedef enum mci_join { MCI_JOIN_ROUND, MCI_JOIN_MITER, MCI_JOIN_SQUARE } mci_jo
 
 /* The pieces for outlines `o` (the region on their left, as mci_region_outlines gives
  * them), each piece one loop of *pieces. `steps` is the number of arc steps of a full
- * turn for round joins (Clipper's, from OpenSCAD's arc tolerance; see
- * mci_offset_round_steps). */
+ * turn for round joins (Clipper's, from OpenSCAD's arc tolerance: the caller's). */
 mcsg_status mci_offset_pieces(const mci_ctx *ctx, const mci_outlines *o, double delta,
                               mci_join join, double steps, mci_outlines *pieces,
                               mcsg_error *err);
-
-/* Clipper's arc steps per full turn for OpenSCAD's offset(r): `fragments` is
- * get_fragments_from_r(|r|, $fn, $fs, $fa); OpenSCAD sets the arc tolerance to
- * |r| (1 - cos(180 / fragments)) and Clipper clamps it to a quarter of |r|. */
-double mci_offset_round_steps(int fragments);
 
 #endif
