@@ -7,10 +7,9 @@
  * check reports and mcsg_mesh_check confirms.
  *
  * The Menger sponge (example024, faces meant to be coplanar 1e-5 apart) is evaluated in
- * the frame of its turned group (docs/robustness.md, "Frames"). It, GEB (an offset of
- * curved letters: over a thousand pieces) and the projection of an STL (a prism per
- * triangle) take seconds here and minutes under the sanitizers, where they are left
- * out.
+ * the frame of its turned group (docs/robustness.md, "Frames"). It and GEB (offsets
+ * of curved letters, intersected and projected three times) take seconds here and
+ * minutes under the sanitizers, where they are left out.
  */
 #include "testlib.h"
 
@@ -87,8 +86,7 @@ TEST(openscad_examples)
         }
         count++;
         if (sanitized && (strcmp(name, "Old_example024") == 0 ||
-                          strcmp(name, "Advanced_GEB") == 0 ||
-                          strcmp(name, "Basics_projection") == 0))
+                          strcmp(name, "Advanced_GEB") == 0))
             continue;
         check_example(name, volume);
     }

@@ -223,6 +223,77 @@ TEST(star_polygons)
     }
 }
 
+/* The positive fill of counter-clockwise triangles is their union: shared edges cancel,
+ * nested and overlapping ones count once, and clockwise ones take away. */
+static void check_positive(const double *xy, const uint32_t *sizes, size_t loops, double area,
+                           size_t edges)
+{
+    mci_outlines o = outlines(xy, sizes, loops);
+    mci_region r;
+    mcsg_error err;
+    CHECK_OK(mci_region_fill(&ctx, &o, MCI_FILL_POSITIVE, &r, &err), &err);
+    CHECK_EQ_DOUBLE(region_area(&r), area);
+    CHECK_EQ_DOUBLE(boundary_area(&r), area);
+    CHECK_EQ_SIZE(r.edge_count, edges);
+    mci_region_free(&ctx, &r);
+    mci_outlines_free(&ctx, &o);
+}
+
+TEST(positive_fill_is_a_union)
+{
+    /* Two triangles of a square (the diagonal cancels), and the square again inside a
+     * bigger one: wound twice there, still inside once. */
+    static const double halves[] = {0, 0, 2, 0, 2, 2, 0, 0, 2, 2, 0, 2};
+    static const double nested[] = {0, 0, 2, 0, 2, 2, 0, 2, -1, -1, 3, -1, 3, 3, -1, 3};
+    /* A square wound twice along a shared stretch: the edge counts twice and stays. */
+    static const double twice[] = {0, 0, 2, 0, 2, 2, 0, 2, 0, 0, 1, 0, 1, 1, 0, 1};
+    /* A clockwise square inside a counter-clockwise one is a hole; given twice, the
+     * winding there is -1: still outside. */
+    static const double hole[] = {0, 0, 4, 0, 4, 4, 0, 4, 1, 1, 1, 3, 3, 3, 3, 1,
+                                  1, 1, 1, 3, 3, 3, 3, 1};
+    check_positive(halves, (uint32_t[]){3, 3}, 2, 4, 4);
+    check_positive(nested, (uint32_t[]){4, 4}, 2, 16, 4);
+    check_positive(twice, (uint32_t[]){4, 4}, 2, 4, 6);
+    check_positive(hole, (uint32_t[]){4, 4}, 2, 12, 8);
+    check_positive(hole, (uint32_t[]){4, 4, 4}, 3, 12, 8);
+}
+
+TEST(positive_fill_refuses_crossings)
+{
+    static const double crossing[] = {0, 0, 4, 0, 4, 4, 0, 4, 2, 2, 6, 2, 6, 6, 2, 6};
+    mci_outlines o = outlines(crossing, (uint32_t[]){4, 4}, 2);
+    mci_region r;
+    mcsg_error err;
+    CHECK(mci_region_fill(&ctx, &o, MCI_FILL_POSITIVE, &r, &err) == MCSG_ERR_UNSUPPORTED);
+    CHECK_CONTAINS(err.message, "crosses itself");
+    mci_outlines_free(&ctx, &o);
+}
+
+TEST(straight_points_and_appending)
+{
+    /* Points on the square's sides (a run of two on the bottom) go; the triangle keeps
+     * its three; a spike (going back along the same line) stays. */
+    static const double xy[] = {0, 0, 1, 0, 2, 0, 4, 0, 4, 4, 0, 4, 0, 2,
+                                5, 5, 6, 5, 5, 6, 7, 0, 9, 0, 8, 0, 8, 3};
+    mci_outlines o = outlines(xy, (uint32_t[]){7, 3, 4}, 3), sum = {0};
+    mci_outlines_drop_straight(&o);
+    CHECK_EQ_SIZE(o.point_count, 11);
+    CHECK_EQ_SIZE(o.loop_start[1], 4);
+    CHECK_EQ_SIZE(o.loop_start[2], 7);
+    CHECK_EQ_DOUBLE(mci_outline_area2(&o, 0), 32);
+    CHECK_EQ_DOUBLE(o.xy[2 * 7], 7);
+    CHECK_EQ_DOUBLE(o.xy[2 * 9], 8);
+    CHECK(mci_outlines_append(&ctx, &sum, &o));
+    CHECK(mci_outlines_append(&ctx, &sum, &o));
+    CHECK_EQ_SIZE(sum.point_count, 22);
+    CHECK_EQ_SIZE(sum.loop_count, 6);
+    CHECK_EQ_SIZE(sum.loop_start[3], 11);
+    CHECK_EQ_SIZE(sum.loop_start[6], 22);
+    CHECK_EQ_DOUBLE(mci_outline_area2(&sum, 3), 32);
+    mci_outlines_free(&ctx, &sum);
+    mci_outlines_free(&ctx, &o);
+}
+
 int main(void)
 {
     mci_ctx_init(&ctx, NULL);
@@ -235,5 +306,8 @@ int main(void)
     RUN(empty_outlines);
     RUN(prisms_and_back);
     RUN(star_polygons);
+    RUN(positive_fill_is_a_union);
+    RUN(positive_fill_refuses_crossings);
+    RUN(straight_points_and_appending);
     return test_summary();
 }

@@ -625,34 +625,249 @@ static void mesh_bounds(const mcsg_mesh *m, double lo[3], double hi[3])
     }
 }
 
-/* The triangles facing up, each a piece: their union is the shadow of a closed mesh. */
-static mcsg_status shadow_pieces(const mci_ctx *ctx, const mcsg_mesh *m, mci_outlines *pieces,
+/* The shadow of a closed mesh is the union of its triangles facing up, projected. */
+typedef struct shadow {
+    scad_context *sc;
+    const mcsg_mesh *mesh;
+    uint32_t *up;        /* the triangles facing up */
+    mci_outlines loops;  /* one loop per triangle of `up`, in that order */
+    mcsg_tree *tree;     /* one prism per piece */
+    mcsg_node_id *ids;
+    size_t count;
+} shadow;
+
+/* Reorder up[0 .. n) breadth first over shared edges, so that a range of it is mostly
+ * a connected patch: patches of a surface facing up seldom overlap themselves in
+ * projection, and their triangles then make one piece. */
+static mcsg_status order_patches(const mci_ctx *ctx, const mcsg_mesh *m, uint32_t *up, size_t n,
                                  mcsg_error *err)
 {
-    size_t count = 0;
-    memset(pieces, 0, sizeof *pieces);
-    pieces->xy = mci_malloc_array(ctx, 3 * m->triangle_count + 1, 2 * sizeof *pieces->xy);
-    pieces->loop_start = mci_malloc_array(ctx, m->triangle_count + 2,
-                                          sizeof *pieces->loop_start);
-    if (!pieces->xy || !pieces->loop_start) {
-        mci_outlines_free(ctx, pieces);
+    mci_keyed *sides = mci_malloc_array(ctx, 3 * n + 1, sizeof *sides);
+    uint32_t *order = mci_malloc_array(ctx, n + 1, sizeof *order);
+    uint8_t *seen = mci_calloc_array(ctx, n + 1, 1);
+    size_t len = 0;
+    if (!sides || !order || !seen) {
+        mci_free(ctx, sides);
+        mci_free(ctx, order);
+        mci_free(ctx, seen);
         return mci_fail_nomem(err, "projecting a 3D object");
     }
-    pieces->loop_start[0] = 0;
-    for (size_t t = 0; t < m->triangle_count; t++) {
-        const double *a = m->vertices + 3 * (size_t)m->triangles[3 * t];
-        const double *b = m->vertices + 3 * (size_t)m->triangles[3 * t + 1];
-        const double *c = m->vertices + 3 * (size_t)m->triangles[3 * t + 2];
-        if (mci_orient2d(a[0], a[1], b[0], b[1], c[0], c[1]) <= 0)
-            continue;
-        memcpy(pieces->xy + 6 * count, (double[6]){a[0], a[1], b[0], b[1], c[0], c[1]},
-               sizeof(double[6]));
-        count++;
-        pieces->loop_start[count] = (uint32_t)(3 * count);
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t *c = m->triangles + 3 * (size_t)up[i];
+        for (int k = 0; k < 3; k++)
+            sides[3 * i + k] = (mci_keyed){mci_edge_key(c[k], c[(k + 1) % 3]), (uint32_t)i};
     }
-    pieces->point_count = 3 * count;
-    pieces->loop_count = count;
+    mci_sort_keyed(sides, 3 * n);
+    for (size_t start = 0; start < n; start++) {
+        if (seen[start])
+            continue;
+        seen[start] = 1;
+        order[len++] = (uint32_t)start;
+        for (size_t head = len - 1; head < len; head++) {
+            const uint32_t *c = m->triangles + 3 * (size_t)up[order[head]];
+            for (int k = 0; k < 3; k++) {
+                uint64_t key = mci_edge_key(c[k], c[(k + 1) % 3]);
+                for (size_t j = mci_find_key(sides, 3 * n, key);
+                     j < 3 * n && sides[j].key == key; j++) {
+                    if (!seen[sides[j].ref]) {
+                        seen[sides[j].ref] = 1;
+                        order[len++] = sides[j].ref;
+                    }
+                }
+            }
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        order[i] = up[order[i]];
+    memcpy(up, order, n * sizeof *up);
+    mci_free(ctx, sides);
+    mci_free(ctx, order);
+    mci_free(ctx, seen);
     return MCSG_OK;
+}
+
+static mcsg_status shadow_loops(const mci_ctx *ctx, shadow *sh, mcsg_error *err)
+{
+    const mcsg_mesh *m = sh->mesh;
+    mci_outlines *o = &sh->loops;
+    size_t count = 0;
+    mcsg_status st;
+    sh->up = mci_malloc_array(ctx, m->triangle_count + 1, sizeof *sh->up);
+    o->xy = mci_malloc_array(ctx, 3 * m->triangle_count + 1, 2 * sizeof *o->xy);
+    o->loop_start = mci_malloc_array(ctx, m->triangle_count + 2, sizeof *o->loop_start);
+    if (!sh->up || !o->xy || !o->loop_start)
+        return mci_fail_nomem(err, "projecting a 3D object");
+    for (size_t t = 0; t < m->triangle_count; t++) {
+        const uint32_t *c = m->triangles + 3 * t;
+        const double *a = m->vertices + 3 * (size_t)c[0], *b = m->vertices + 3 * (size_t)c[1];
+        const double *d = m->vertices + 3 * (size_t)c[2];
+        if (mci_orient2d(a[0], a[1], b[0], b[1], d[0], d[1]) > 0)
+            sh->up[count++] = (uint32_t)t;
+    }
+    st = order_patches(ctx, m, sh->up, count, err);
+    o->loop_start[0] = 0;
+    for (size_t i = 0; st == MCSG_OK && i < count; i++) {
+        for (int k = 0; k < 3; k++)
+            memcpy(o->xy + 6 * i + 2 * k, m->vertices + 3 * (size_t)m->triangles[3 * (size_t)sh->up[i] + k],
+                   2 * sizeof *o->xy);
+        o->loop_start[i + 1] = (uint32_t)(3 * (i + 1));
+    }
+    o->point_count = 3 * count;
+    o->loop_count = count;
+    return st;
+}
+
+/* The positive fill of triangles [first, end) of `up`: MCSG_ERR_UNSUPPORTED when their
+ * outline crosses itself. */
+static mcsg_status shadow_fill(shadow *sh, size_t first, size_t end, mci_region *r,
+                               mcsg_error *err)
+{
+    mci_outlines part = {sh->loops.xy, NULL, sh->loops.point_count,
+                         sh->loops.loop_start + first, end - first};
+    mcsg_status st = mci_region_fill(sh->sc->ev.ctx, &part, MCI_FILL_POSITIVE, r, err);
+    if (st == MCSG_ERR_UNSUPPORTED && err)
+        memset(err, 0, sizeof *err); /* a shorter run will do */
+    return st;
+}
+
+/* How many triangles from `first` on make one piece: the longest run whose outline does
+ * not cross itself, found by doubling then halving (a lone triangle always does). */
+static mcsg_status shadow_run(shadow *sh, size_t first, size_t *run, mcsg_error *err)
+{
+    size_t left = sh->loops.loop_count - first, good = 1, bad = left + 1;
+    mcsg_status st = MCSG_OK;
+    while (st == MCSG_OK && good < bad - 1) {
+        size_t len = bad > left ? (2 * good < left ? 2 * good : left) : good + (bad - good) / 2;
+        mci_region r;
+        st = shadow_fill(sh, first, first + len, &r, err);
+        mci_region_free(sh->sc->ev.ctx, &r);
+        if (st == MCSG_OK)
+            good = len;
+        else if (st == MCSG_ERR_UNSUPPORTED)
+            bad = len;
+        st = st == MCSG_ERR_UNSUPPORTED ? MCSG_OK : st;
+    }
+    *run = good;
+    return st;
+}
+
+/* The outline of run [first, first + run) of `up`, without ids. */
+static mcsg_status run_outline(shadow *sh, size_t first, size_t run, mci_outlines *o,
+                               mcsg_error *err)
+{
+    const mci_ctx *ctx = sh->sc->ev.ctx;
+    mci_region r;
+    mcsg_status st = shadow_fill(sh, first, first + run, &r, err);
+    memset(o, 0, sizeof *o);
+    if (st == MCSG_OK)
+        st = mci_region_outlines(ctx, &r, o, err);
+    mci_region_free(ctx, &r);
+    if (st == MCSG_OK) {
+        mci_free(ctx, o->ids);
+        o->ids = NULL;
+        mci_outlines_drop_straight(o);
+    }
+    return st;
+}
+
+/* Add outline o to the first group whose outline it does not cross, or start a group. */
+static mcsg_status add_to_group(shadow *sh, mci_outlines *groups, size_t *count,
+                                const mci_outlines *o, mcsg_error *err)
+{
+    const mci_ctx *ctx = sh->sc->ev.ctx;
+    for (size_t g = 0; g <= *count; g++) {
+        mci_outlines both = {0};
+        mci_region r;
+        mcsg_status st = MCSG_OK;
+        if (!mci_outlines_append(ctx, &both, &groups[g]) || !mci_outlines_append(ctx, &both, o))
+            st = mci_fail_nomem(err, "projecting a 3D object");
+        if (st == MCSG_OK && g < *count) {
+            st = mci_region_fill(ctx, &both, MCI_FILL_POSITIVE, &r, err);
+            mci_region_free(ctx, &r);
+        }
+        if (st == MCSG_OK) {
+            mci_outlines_free(ctx, &groups[g]);
+            groups[g] = both;
+            *count += g == *count;
+            return MCSG_OK;
+        }
+        mci_outlines_free(ctx, &both);
+        if (st != MCSG_ERR_UNSUPPORTED)
+            return st;
+        if (err)
+            memset(err, 0, sizeof *err); /* another group may take it */
+    }
+    return MCSG_OK; /* not reached: a new group always takes it */
+}
+
+/* The shadow's pieces: runs of triangles of `up` whose outline does not cross itself,
+ * gathered into groups whose outlines do not cross each other, a prism over each group
+ * (the fewer, the faster the union). */
+static mcsg_status shadow_pieces(shadow *sh, mcsg_error *err)
+{
+    const mci_ctx *ctx = sh->sc->ev.ctx;
+    size_t groups = 0, n = sh->loops.loop_count;
+    mci_outlines *group = mci_calloc_array(ctx, n + 1, sizeof *group);
+    mcsg_status st = group ? MCSG_OK : mci_fail_nomem(err, "projecting a 3D object");
+    for (size_t first = 0, run = 0; st == MCSG_OK && first < n; first += run) {
+        mci_outlines o;
+        st = shadow_run(sh, first, &run, err);
+        if (st == MCSG_OK)
+            st = run_outline(sh, first, run, &o, err);
+        if (st == MCSG_OK)
+            st = add_to_group(sh, group, &groups, &o, err);
+        mci_outlines_free(ctx, &o);
+    }
+    for (size_t g = 0; st == MCSG_OK && g < groups; g++) {
+        mci_region r;
+        mcsg_mesh prism = {0};
+        st = mci_region_fill(ctx, &group[g], MCI_FILL_POSITIVE, &r, err);
+        if (st == MCSG_OK && r.tri_count)
+            st = mci_region_prism(ctx, &r, &prism, err);
+        if (st == MCSG_OK && prism.triangle_count)
+            st = mcsg_tree_add_leaf_take(sh->tree, &prism, NULL, "a piece",
+                                         &sh->ids[sh->count++], err);
+        mci_mesh_free(ctx, &prism);
+        mci_region_free(ctx, &r);
+    }
+    for (size_t g = 0; group && g < groups; g++)
+        mci_outlines_free(ctx, &group[g]);
+    mci_free(ctx, group);
+    return st;
+}
+
+/* The shadow of closed mesh m on z = 0. */
+static mcsg_status shadow_shape(scad_context *sc, const mcsg_mesh *m, shape2d *out,
+                                mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    shadow sh = {sc, m, NULL, {0}, NULL, NULL, 0};
+    mcsg_mesh result = {0};
+    mcsg_node_id root;
+    mcsg_status st = shadow_loops(ctx, &sh, err);
+    memset(out, 0, sizeof *out);
+    if (st == MCSG_OK && !(sh.ids = mci_malloc_array(ctx, sh.loops.loop_count + 1,
+                                                     sizeof *sh.ids)))
+        st = mci_fail_nomem(err, "projecting a 3D object");
+    if (st == MCSG_OK)
+        st = mcsg_tree_create(sc->opts, &sh.tree, err);
+    if (st == MCSG_OK && sh.loops.loop_count)
+        st = shadow_pieces(&sh, err);
+    if (st == MCSG_OK && sh.count)
+        st = mcsg_tree_add_op(sh.tree, MCSG_NODE_UNION, sh.ids, sh.count, "pieces", &root,
+                              err);
+    if (st == MCSG_OK && sh.count)
+        st = evaluate_node(sc, sh.tree, root, &result, err);
+    if (st == MCSG_OK)
+        st = read_shape(ctx, &result, out, err);
+    if (st == MCSG_OK)
+        mci_outlines_drop_straight(&out->o);
+    mci_mesh_free(ctx, &result);
+    mcsg_tree_free(sh.tree);
+    mci_free(ctx, sh.ids);
+    mci_free(ctx, sh.up);
+    mci_outlines_free(ctx, &sh.loops);
+    return st;
 }
 
 /* The section at z = 0: the mesh cut by a box from z = 0 up, read at z = 0. */
@@ -696,21 +911,14 @@ static mcsg_status finish_projection(scad_context *sc, scad_geometry_op *op,
                                      mcsg_error *err)
 {
     const mci_ctx *ctx = sc->ev.ctx;
-    mcsg_mesh m, none = {0};
-    mci_outlines pieces = {0};
+    mcsg_mesh m;
     shape2d s = {0};
     mcsg_status st = evaluate_union(sc, op, children, count, &m, err);
-    if (st == MCSG_OK && op->cut) {
-        st = section(sc, &m, &s, err);
-    } else if (st == MCSG_OK) {
-        st = shadow_pieces(ctx, &m, &pieces, err);
-        if (st == MCSG_OK)
-            st = combine_pieces(sc, &none, &pieces, MCSG_NODE_UNION, &s, err);
-    }
+    if (st == MCSG_OK)
+        st = op->cut ? section(sc, &m, &s, err) : shadow_shape(sc, &m, &s, err);
     if (st == MCSG_OK)
         st = put_2d(sc, op, t, &s.o, label, out, err);
     mci_mesh_free(ctx, &m);
-    mci_outlines_free(ctx, &pieces);
     shape2d_free(ctx, &s);
     return st;
 }

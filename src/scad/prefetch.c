@@ -69,7 +69,8 @@ static char *resolve(const mci_ctx *ctx, const char *dir, const char *file, uint
     char *path = mci_malloc(ctx, dir_len + slash + len + 1);
     if (!path)
         return NULL;
-    memcpy(path, dir, dir_len);
+    if (dir_len) /* dir may be NULL, and memcpy's pointers may not */
+        memcpy(path, dir, dir_len);
     if (slash)
         path[dir_len] = '/';
     memcpy(path + dir_len + slash, file, len);

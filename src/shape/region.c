@@ -81,7 +81,11 @@ typedef struct builder {
     double *xyz;      /* 3 per unique point, after the 3 corners of the big triangle */
     size_t points;    /* unique points, corners excluded */
     xy_point *sorted; /* unique points by x, then y */
-    edge_set raw, kept;
+    edge_set raw, kept; /* kept: in increasing mci_edge_key order */
+    mci_fill_rule rule;
+    uint32_t *weight;   /* MCI_FILL_POSITIVE: how many more times each kept edge is given
+                           in its direction than against it */
+    size_t weight_cap;
 } builder;
 
 #define PT(b, i) ((b)->xyz + 3 * ((size_t)(i) + 3))
@@ -196,14 +200,37 @@ static bool split_edge(builder *b, uint32_t u, uint32_t v, edge_set *out, xy_poi
     return add_edge(b->ctx, out, prev, v);
 }
 
-/* Split every edge at the points inside it, then keep the undirected edges that occur
- * an odd number of times. */
+/* Keep the undirected edge of the sorted items [first, end) (one per time it is given,
+ * ref 1 when given from its larger id): by the even-odd rule when it is given an odd
+ * number of times; by the positive rule when it is given more often one way than the
+ * other, in that direction, weighted by the difference. */
+static bool keep_edge(builder *b, const mci_keyed *items, size_t first, size_t end)
+{
+    uint32_t lo = (uint32_t)(items[first].key >> 32), hi = (uint32_t)items[first].key;
+    int64_t net = 0;
+    if (b->rule == MCI_FILL_EVEN_ODD)
+        return (end - first) % 2 == 0 || add_edge(b->ctx, &b->kept, lo, hi);
+    for (size_t i = first; i < end; i++)
+        net += items[i].ref ? -1 : 1;
+    if (net == 0)
+        return true;
+    if (!add_edge(b->ctx, &b->kept, net > 0 ? lo : hi, net > 0 ? hi : lo))
+        return false;
+    if (!mci_grow_array(b->ctx, (void **)&b->weight, &b->weight_cap, b->kept.count,
+                        sizeof *b->weight, 64))
+        return false;
+    b->weight[b->kept.count - 1] = (uint32_t)(net > 0 ? net : -net);
+    return true;
+}
+
+/* Split every edge at the points inside it, then keep the undirected edges that the fill
+ * rule keeps. */
 static mcsg_status split_and_cancel(builder *b, mcsg_error *err)
 {
     edge_set split = {0};
     xy_point *on = NULL;
     size_t on_cap = 0;
-    uint64_t *keys = NULL;
+    mci_keyed *items = NULL;
     mcsg_status st = MCSG_OK;
     for (size_t i = 0; i < b->raw.count; i++) {
         if (!split_edge(b, b->raw.e[2 * i], b->raw.e[2 * i + 1], &split, &on, &on_cap)) {
@@ -211,24 +238,25 @@ static mcsg_status split_and_cancel(builder *b, mcsg_error *err)
             break;
         }
     }
-    if (st == MCSG_OK && !(keys = mci_malloc_array(b->ctx, split.count + 1, sizeof *keys)))
+    if (st == MCSG_OK && !(items = mci_malloc_array(b->ctx, split.count + 1, sizeof *items)))
         st = mci_fail_nomem(err, "making a 2D shape");
-    for (size_t i = 0; st == MCSG_OK && i < split.count; i++)
-        keys[i] = mci_edge_key(split.e[2 * i], split.e[2 * i + 1]);
+    for (size_t i = 0; st == MCSG_OK && i < split.count; i++) {
+        uint32_t u = split.e[2 * i], v = split.e[2 * i + 1];
+        items[i] = (mci_keyed){mci_edge_key(u, v), u > v};
+    }
     if (st == MCSG_OK)
-        mci_sort_u64(keys, split.count);
+        mci_sort_keyed(items, split.count);
     for (size_t i = 0; st == MCSG_OK && i < split.count;) {
         size_t j = i;
-        while (j < split.count && keys[j] == keys[i])
+        while (j < split.count && items[j].key == items[i].key)
             j++;
-        if ((j - i) % 2 == 1 &&
-            !add_edge(b->ctx, &b->kept, (uint32_t)(keys[i] >> 32), (uint32_t)keys[i]))
+        if (!keep_edge(b, items, i, j))
             st = mci_fail_nomem(err, "making a 2D shape");
         i = j;
     }
     mci_free(b->ctx, split.e);
     mci_free(b->ctx, on);
-    mci_free(b->ctx, keys);
+    mci_free(b->ctx, items);
     return st;
 }
 
@@ -347,23 +375,45 @@ static mcsg_status triangulate(builder *b, mci_cdt_output *out, mcsg_error *err)
     return st;
 }
 
-/* inside[t]: parity of the constraints crossed from outside the big triangle. */
-static mcsg_status mark_inside(const mci_ctx *ctx, const mci_cdt_output *cdt, uint8_t *inside,
+/* How much the winding number drops crossing the kept edge p-q (CDT ids) from its
+ * left: its weight when it runs from p to q, minus that when it runs the other way. */
+static int64_t edge_weight(const builder *b, uint32_t p, uint32_t q)
+{
+    uint64_t key = mci_edge_key(p - 3, q - 3);
+    size_t lo = 0, hi = b->kept.count;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (mci_edge_key(b->kept.e[2 * mid], b->kept.e[2 * mid + 1]) < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == b->kept.count || mci_edge_key(b->kept.e[2 * lo], b->kept.e[2 * lo + 1]) != key)
+        return 0; /* not reached: every constraint is a kept edge */
+    return b->kept.e[2 * lo] == p - 3 ? (int64_t)b->weight[lo] : -(int64_t)b->weight[lo];
+}
+
+/* inside[t] from a walk out of the big triangle: by the even-odd rule the parity of the
+ * constraints crossed; by the positive rule whether the winding number, changed by each
+ * crossed edge's weight, is above zero. */
+static mcsg_status mark_inside(const builder *b, const mci_cdt_output *cdt, uint8_t *inside,
                                mcsg_error *err)
 {
+    const mci_ctx *ctx = b->ctx;
     size_t n = cdt->tri_count, len = 0;
     uint32_t *queue = mci_malloc_array(ctx, n + 1, sizeof *queue);
     uint8_t *seen = mci_calloc_array(ctx, n + 1, 1);
-    if (!queue || !seen) {
+    int64_t *winding = mci_calloc_array(ctx, n + 1, sizeof *winding);
+    if (!queue || !seen || !winding) {
         mci_free(ctx, queue);
         mci_free(ctx, seen);
+        mci_free(ctx, winding);
         return mci_fail_nomem(err, "making a 2D shape");
     }
     for (size_t t = 0; t < n; t++) {
         for (int i = 0; i < 3; i++) {
             if (cdt->adj[3 * t + i] == UINT32_MAX && !seen[t]) {
                 seen[t] = 1;
-                inside[t] = 0;
                 queue[len++] = (uint32_t)t;
             }
         }
@@ -372,19 +422,39 @@ static mcsg_status mark_inside(const mci_ctx *ctx, const mci_cdt_output *cdt, ui
         uint32_t t = queue[head];
         for (int i = 0; i < 3; i++) {
             uint32_t a = cdt->adj[3 * (size_t)t + i], u;
+            const uint32_t *c = cdt->tris + 3 * (size_t)t;
             if (a == UINT32_MAX)
                 continue;
             u = (a & ~MCI_CDT_CONSTRAINT) / 3;
             if (seen[u])
                 continue;
             seen[u] = 1;
-            inside[u] = inside[t] ^ ((a & MCI_CDT_CONSTRAINT) != 0);
+            if (!(a & MCI_CDT_CONSTRAINT))
+                winding[u] = winding[t];
+            else if (b->rule == MCI_FILL_EVEN_ODD)
+                winding[u] = !winding[t];
+            else
+                winding[u] = winding[t] - edge_weight(b, c[i], c[(i + 1) % 3]);
             queue[len++] = u;
         }
     }
+    for (size_t t = 0; t < n; t++)
+        inside[t] = winding[t] > 0;
     mci_free(ctx, queue);
     mci_free(ctx, seen);
+    mci_free(ctx, winding);
     return MCSG_OK;
+}
+
+/* Whether edge i of inside triangle t bounds the region: a constraint with no inside
+ * triangle across it (by the positive rule a constraint may separate two windings above
+ * zero). */
+static bool on_boundary(const mci_cdt_output *cdt, const uint8_t *inside, size_t t, int i)
+{
+    uint32_t a = cdt->adj[3 * t + i];
+    if (!(a & MCI_CDT_CONSTRAINT))
+        return false;
+    return a == UINT32_MAX || !inside[(a & ~MCI_CDT_CONSTRAINT) / 3];
 }
 
 /* The inside triangles and their boundary, over the points they use. */
@@ -402,7 +472,7 @@ static mcsg_status inside_region(builder *b, const mci_cdt_output *cdt, const ui
         tris += inside[t];
         for (int i = 0; inside[t] && i < 3; i++) {
             uint32_t p = cdt->tris[3 * t + i];
-            edges += (cdt->adj[3 * t + i] & MCI_CDT_CONSTRAINT) != 0;
+            edges += on_boundary(cdt, inside, t, i);
             if (map[p] == UINT32_MAX)
                 map[p] = (uint32_t)out->vertex_count++;
         }
@@ -425,7 +495,7 @@ static mcsg_status inside_region(builder *b, const mci_cdt_output *cdt, const ui
             continue;
         for (int i = 0; i < 3; i++) {
             out->tris[3 * out->tri_count + i] = map[c[i]];
-            if (cdt->adj[3 * t + i] & MCI_CDT_CONSTRAINT) {
+            if (on_boundary(cdt, inside, t, i)) {
                 out->edges[2 * out->edge_count] = map[c[i]];
                 out->edges[2 * out->edge_count++ + 1] = map[c[(i + 1) % 3]];
             }
@@ -439,6 +509,12 @@ static mcsg_status inside_region(builder *b, const mci_cdt_output *cdt, const ui
 mcsg_status mci_region_from_outlines(const mci_ctx *ctx, const mci_outlines *o,
                                      mci_region *out, mcsg_error *err)
 {
+    return mci_region_fill(ctx, o, MCI_FILL_EVEN_ODD, out, err);
+}
+
+mcsg_status mci_region_fill(const mci_ctx *ctx, const mci_outlines *o, mci_fill_rule rule,
+                            mci_region *out, mcsg_error *err)
+{
     builder b;
     mci_cdt_output cdt = {0};
     uint8_t *inside = NULL;
@@ -446,6 +522,7 @@ mcsg_status mci_region_from_outlines(const mci_ctx *ctx, const mci_outlines *o,
     memset(&b, 0, sizeof b);
     memset(out, 0, sizeof *out);
     b.ctx = ctx;
+    b.rule = rule;
     st = collect(&b, o, err);
     if (st == MCSG_OK)
         st = sort_points(&b, err);
@@ -460,7 +537,7 @@ mcsg_status mci_region_from_outlines(const mci_ctx *ctx, const mci_outlines *o,
         if (st == MCSG_OK && !(inside = mci_malloc_array(ctx, cdt.tri_count + 1, 1)))
             st = mci_fail_nomem(err, "making a 2D shape");
         if (st == MCSG_OK)
-            st = mark_inside(ctx, &cdt, inside, err);
+            st = mark_inside(&b, &cdt, inside, err);
         if (st == MCSG_OK)
             st = inside_region(&b, &cdt, inside, out, err);
     }
@@ -471,6 +548,7 @@ mcsg_status mci_region_from_outlines(const mci_ctx *ctx, const mci_outlines *o,
     mci_free(ctx, b.sorted);
     mci_free(ctx, b.raw.e);
     mci_free(ctx, b.kept.e);
+    mci_free(ctx, b.weight);
     return st;
 }
 
@@ -637,4 +715,67 @@ mcsg_status mci_region_outlines(const mci_ctx *ctx, const mci_region *r, mci_out
     mci_free(ctx, from);
     mci_free(ctx, used);
     return MCSG_OK;
+}
+
+/* Whether b lies strictly inside segment a-c (a straight point between its neighbours). */
+static bool straight_between(const double *a, const double *b, const double *c)
+{
+    if (mci_orient2d(a[0], a[1], b[0], b[1], c[0], c[1]) != 0)
+        return false;
+    return (a[0] != c[0] ? (a[0] < b[0]) == (b[0] < c[0]) && b[0] != a[0] && b[0] != c[0]
+                         : (a[1] < b[1]) == (b[1] < c[1]) && b[1] != a[1] && b[1] != c[1]);
+}
+
+/* Dropping every straight point at once is safe: a run of them is monotone along its
+ * line, so the edge that replaces the run covers the same segment. */
+void mci_outlines_drop_straight(mci_outlines *o)
+{
+    size_t out = 0;
+    uint32_t start = 0;
+    for (size_t k = 0; k < o->loop_count; k++) {
+        uint32_t first = o->loop_start[k], end = o->loop_start[k + 1], n = end - first;
+        /* Points are moved down over the ones dropped; the loop's first point is read
+         * again at its end. */
+        double head[2] = {o->xy[2 * (size_t)first], o->xy[2 * (size_t)first + 1]};
+        for (uint32_t i = 0; i < n; i++) {
+            const double *a = o->xy + 2 * (size_t)(first + (i + n - 1) % n);
+            const double *b = o->xy + 2 * (size_t)(first + i);
+            const double *c = i + 1 < n ? b + 2 : head;
+            if (n > 3 && straight_between(a, b, c))
+                continue;
+            memmove(o->xy + 2 * out, b, 2 * sizeof *o->xy);
+            if (o->ids)
+                o->ids[out] = o->ids[first + i];
+            out++;
+        }
+        o->loop_start[k] = start;
+        start = (uint32_t)out;
+    }
+    o->loop_start[o->loop_count] = start;
+    o->point_count = out;
+}
+
+bool mci_outlines_append(const mci_ctx *ctx, mci_outlines *dst, const mci_outlines *src)
+{
+    size_t points = dst->point_count + src->point_count, loops = dst->loop_count + src->loop_count;
+    double *xy;
+    uint32_t *start;
+    if (src->loop_count == 0)
+        return true;
+    if (dst->ids || src->ids || points > UINT32_MAX)
+        return false;
+    xy = mci_realloc_array(ctx, dst->xy, points + 1, 2 * sizeof *xy);
+    if (!xy)
+        return false;
+    dst->xy = xy;
+    start = mci_realloc_array(ctx, dst->loop_start, loops + 2, sizeof *start);
+    if (!start)
+        return false;
+    dst->loop_start = start;
+    memcpy(xy + 2 * dst->point_count, src->xy, 2 * src->point_count * sizeof *xy);
+    for (size_t k = 0; k <= src->loop_count; k++)
+        start[dst->loop_count + k] = (uint32_t)dst->point_count + src->loop_start[k];
+    dst->point_count = points;
+    dst->loop_count = loops;
+    return true;
 }

@@ -42,9 +42,22 @@ void mci_region_free(const mci_ctx *ctx, mci_region *r);
 mcsg_status mci_region_from_outlines(const mci_ctx *ctx, const mci_outlines *o,
                                      mci_region *out, mcsg_error *err);
 
+typedef enum mci_fill_rule {
+    MCI_FILL_EVEN_ODD, /* inside where a ray crosses the outlines an odd number of times */
+    MCI_FILL_POSITIVE  /* inside where the outlines wind counter-clockwise around the point
+                          more often than clockwise: the union of counter-clockwise loops */
+} mci_fill_rule;
+
+/* The same by either rule. By the positive rule, edges given both ways cancel in pairs
+ * and the rest keep their direction and multiplicity, so the loops of counter-clockwise
+ * triangles give their union. */
+mcsg_status mci_region_fill(const mci_ctx *ctx, const mci_outlines *o, mci_fill_rule rule,
+                            mci_region *out, mcsg_error *err);
+
 /* The prism over the region from z = 0 to z = 1: closed and outward. */
 mcsg_status mci_region_prism(const mci_ctx *ctx, const mci_region *r, mcsg_mesh *out,
                              mcsg_error *err);
+
 
 /* The region read back from a mesh of prisms evaluated by the engine: its triangles
  * with every corner at z = 0 (facing down there), turned to face up. */
@@ -55,6 +68,14 @@ mcsg_status mci_region_from_prisms(const mci_ctx *ctx, const mcsg_mesh *mesh, mc
  * on its left: outer outlines counter-clockwise, holes clockwise). */
 mcsg_status mci_region_outlines(const mci_ctx *ctx, const mci_region *r, mci_outlines *out,
                                 mcsg_error *err);
+
+/* Drop the points of loops of more than three points that lie straight between their
+ * neighbours (inside the segment joining them): the same region with fewer points. */
+void mci_outlines_drop_straight(mci_outlines *o);
+
+/* Add src's loops after dst's (outlines without ids; dst may be all zero). False when
+ * memory runs out (dst unchanged but still valid) or either has ids. */
+bool mci_outlines_append(const mci_ctx *ctx, mci_outlines *dst, const mci_outlines *src);
 
 /* Twice the signed area of loop k. */
 double mci_outline_area2(const mci_outlines *o, size_t k);

@@ -77,4 +77,13 @@ run 1 check --self-intersections "$WORK/pushed.off"
 contains 'pairs of triangles intersect each other'
 run 0 check --self-intersections "$MODELS/spot.obj"
 contains 'spot.obj: ok: no self-intersections'
+
+# Named relative to the working folder, the model has no folder to resolve imports
+# against: they are opened from the working folder (a missing one named as given).
+cube_off > "$WORK/closed.off"
+printf 'union() { import("closed.off"); import("missing.off"); }\n' > "$WORK/relative.scad"
+cli=$(cd "$(dirname "$CLI")" && pwd)/$(basename "$CLI")
+OUT=$(cd "$WORK" && "$cli" eval relative.scad -o out.off 2>&1); code=$?
+if [ "$code" -eq 1 ]; then passed=$((passed + 1)); else echo "FAIL: exit $code: $OUT"; failed=$((failed + 1)); fi
+contains 'missing.off'
 finish
