@@ -278,6 +278,14 @@ TEST(every_allocation_failure_is_clean)
                                    "minkowski() { cube(1); cube(1); }\n", true) > 10);
 }
 
+/* The shadow's runs, groups and union fail as cleanly. */
+TEST(projection_allocation_failures_are_clean)
+{
+    CHECK(test_allocation_failures("projection", read_and_eval,
+                                   "linear_extrude(1) projection() "
+                                   "rotate([0, 0, 30]) cube(1);\n", true) > 10);
+}
+
 int main(void)
 {
     RUN(prisms_of_squares_are_exact);
@@ -291,5 +299,6 @@ int main(void)
     RUN(openscad_text_dxf_surface);
     RUN(errors_and_warnings);
     RUN(every_allocation_failure_is_clean);
+    RUN(projection_allocation_failures_are_clean);
     return test_summary();
 }

@@ -810,7 +810,7 @@ static mcsg_status shadow_pieces(shadow *sh, mcsg_error *err)
     mci_outlines *group = mci_calloc_array(ctx, n + 1, sizeof *group);
     mcsg_status st = group ? MCSG_OK : mci_fail_nomem(err, "projecting a 3D object");
     for (size_t first = 0, run = 0; st == MCSG_OK && first < n; first += run) {
-        mci_outlines o;
+        mci_outlines o = {0};
         st = shadow_run(sh, first, &run, err);
         if (st == MCSG_OK)
             st = run_outline(sh, first, run, &o, err);
