@@ -671,7 +671,8 @@ static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const
 
 /* Leaves for the parts of an imported file, "import("f") WORD K (NAME)" with K numbers[k]
  * (k + 1 without numbers) and NAME names[k] (left out when ""), under a union when there
- * are several. Each mesh is the tree's afterwards, or freed, and zeroed. */
+ * are several. Each mesh given to the tree (or freed by it on failure) is zeroed; the
+ * caller frees the rest. */
 static mcsg_status import_parts(scad_context *sc, const scad_call_args *ca,
                                 const scad_transform *t, const char *file, uint32_t file_len,
                                 const char *word, mcsg_mesh *meshes, char *const *names,
@@ -687,10 +688,11 @@ static mcsg_status import_parts(scad_context *sc, const scad_call_args *ca,
         if (!mci_buf_printf(ctx, &label, "import(\"%.*s\") %s %zu%s%s%s", (int)file_len, file,
                             word, numbers ? numbers[k] : k + 1, names[k][0] ? " (" : "",
                             names[k], names[k][0] ? ")" : ""))
-            st = mci_fail_nomem(err, "reading CSG text");
-        else
+            st = mci_fail_nomem(err, "reading CSG text"); /* meshes[k] left to the caller */
+        else {
             st = scad_add_leaf(sc, ca, t, &meshes[k], &label, &leaves[k], err);
-        memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
+            memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
+        }
     }
     if (st == MCSG_OK && count == 1)
         *node = leaves[0];
