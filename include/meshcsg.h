@@ -72,8 +72,8 @@ typedef struct mcsg_error {
 
 /* Custom allocator. Either all three functions are set, or none (then the C library's
  * malloc/realloc/free are used). realloc_fn(user, NULL, n) must behave like malloc_fn.
- * The library never calls free_fn with NULL. The libraries behind 3MF (libzip, expat)
- * take no allocator: their own working memory comes from malloc. */
+ * The library never calls free_fn with NULL. The libraries behind 3MF and AMF (libzip,
+ * expat) take no allocator: their own working memory comes from malloc. */
 typedef struct mcsg_allocator {
     void *(*malloc_fn)(void *user, size_t size);
     void *(*realloc_fn)(void *user, void *ptr, size_t size);
@@ -217,7 +217,11 @@ const char *mcsg_format_name(mcsg_format format);
 mcsg_format mcsg_format_from_path(const char *path);
 
 /* Read a mesh file. With MCSG_FORMAT_AUTO the format is detected from the content (PLY
- * and OFF headers, STL ASCII vs binary by size and keywords) and the extension. Polygons
+ * and OFF headers, STL ASCII vs binary by size and keywords) and the extension. AMF is
+ * read only so (it has no format code: it is never written): a file named .amf or XML
+ * whose root element is <amf>, plain or zipped, read as OpenSCAD 2021.01's import()
+ * reads it, every object's triangles side by side in one mesh; units are ignored, as
+ * OpenSCAD ignores them. Polygons
  * are fan-triangulated. For STL, vertices with bit-identical coordinates (with -0 == +0)
  * are welded into one. Numbers are parsed exactly (correctly rounded, independent of the
  * C locale). Errors name `path` and the line (text formats) or byte offset (binary).

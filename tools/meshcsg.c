@@ -1069,8 +1069,8 @@ static const cli_option demo_options[] = {
     END_OF_OPTIONS};
 
 static const cli_command commands[] = {
-    {"check", "FILE...", "validate meshes (.off .obj .stl .ply .3mf) or every leaf of a CSG file "
-     "(.scad .csg)",
+    {"check", "FILE...", "validate meshes (.off .obj .stl .ply .3mf .amf) or every leaf of a "
+     "CSG file (.scad .csg)",
      "Prints one line per file when the mesh is a closed, consistently oriented,\n"
      "edge-manifold mesh, and one line per kind of problem otherwise.",
      check_options, 1, -1, cmd_check},
@@ -1097,7 +1097,7 @@ static const cli_command commands[] = {
      "resolves; zero-area triangles are removed with a warning. The exit status is 3\n"
      "when rounding to doubles broke a guarantee, as for eval.",
      repair_options, 1, 1, cmd_repair},
-    {"picture", "MESH OUT", "draw a mesh (.off .obj .stl .ply .3mf) into a PNG picture",
+    {"picture", "MESH OUT", "draw a mesh (.off .obj .stl .ply .3mf .amf) into a PNG picture",
      "A software rasterizer: shaded faces, hidden ones removed; no display needed.",
      picture_options_table, 2, 2, cmd_picture},
     {"demo", "", "evaluate the built-in scene (the paper's ring with spheres), print the "

@@ -296,8 +296,9 @@ def transform(mesh, matrix):
 
 
 def read(path):
-    """Read a mesh file (.off .obj .stl .ply .3mf, detected from the content and the
-    name); a 3MF file's build items come as one mesh, their shells side by side."""
+    """Read a mesh file (.off .obj .stl .ply .3mf .amf, detected from the content and the
+    name); a 3MF file's build items, or an AMF file's objects, come as one mesh, their
+    shells side by side."""
     owned, err = _Owned(), _capi.ErrorInfo()
     _capi.check(_capi.lib.mcsg_mesh_read(os.fsencode(path), 0, None, ctypes.byref(owned.mesh),
                                          ctypes.byref(err)), err)

@@ -1,17 +1,21 @@
 /*
  * Mesh files: the public read/write entry points, format names and detection, and the
  * helpers every format shares (error messages, the growable mesh, text scanning and
- * text output). The formats themselves live in off.c, obj.c, stl.c and ply.c.
+ * text output). The formats themselves live in off.c, obj.c, stl.c, ply.c, threemf.c and
+ * amf.c.
  *
- * Detection for MCSG_FORMAT_AUTO, in order: a "ply" magic line; an OFF keyword as the
- * first token (Geomview's [ST][C][N][4][n]OFF); the file name's extension; an STL
+ * Detection for MCSG_FORMAT_AUTO, in order: a "ply" magic line; AMF by the .amf extension
+ * or XML whose first element is <amf> (AMF has no format code: it is only read, and only
+ * so); 3MF by the .3mf extension or a zip archive; an OFF keyword as the first token
+ * (Geomview's [ST][C][N][4][n]OFF); the file name's extension; an STL
  * "solid" keyword or a size matching a binary STL header; an OBJ keyword as the first
  * token. Messages are "NAME:LINE: ..." for text and "NAME: byte OFFSET: ..." for binary.
  */
 #include "io/mesh_io.h"
-#include "io/threemf.h"
-#include "base/parallel.h"
 
+#include "base/parallel.h"
+#include "io/amf.h"
+#include "io/threemf.h"
 
 #include <float.h>
 #include <math.h>
@@ -549,6 +553,10 @@ static mcsg_status read_detected(const mci_io_source *src, mcsg_mesh *out)
     mcsg_format by_name = mcsg_format_from_path(src->name);
     if (is_ply_magic(src))
         return mci_ply_read(src, out);
+    if (mci_amf_is_name(src->name) ||
+        (mci_amf_looks_like(src->text, src->size) &&
+         !mci_stl_binary_size_matches(src->bytes, src->size)))
+        return mci_amf_read_merged(src, out); /* plain or zipped XML */
     if (by_name == MCSG_FORMAT_3MF || (src->size >= 4 && memcmp(src->text, "PK\3\4", 4) == 0))
         return mci_3mf_read_merged(src, out); /* a zip archive */
     if (has_token && mci_off_is_keyword(begin, stop))
@@ -566,7 +574,8 @@ static mcsg_status read_detected(const mci_io_source *src, mcsg_mesh *out)
     if (has_token && looks_like_obj(begin, stop))
         return mci_obj_read(src, out);
     return mci_fail(src->err, MCSG_ERR_FORMAT,
-                    "%s: unknown mesh format (not OFF, OBJ, STL, PLY or 3MF by content or name)",
+                    "%s: unknown mesh format (not OFF, OBJ, STL, PLY, 3MF or AMF by content or "
+                    "name)",
                     src->name);
 }
 

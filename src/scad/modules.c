@@ -17,11 +17,13 @@
  *    transform that flattens space (zero scale, singular matrix) makes its leaves empty;
  *  - polyhedron faces are clockwise seen from outside, so each is reversed, then split
  *    by a fan from its first (reversed) corner; import reads OFF/OBJ/STL/PLY relative to
- *    the file's directory.
+ *    the file's directory, 3MF as a leaf per build item and AMF as a leaf per object
+ *    (OpenSCAD unions an AMF file's objects), DXF as 2D outlines.
  * The empty set is always a union node without children (e.g. cube(0), an empty mesh
  * from import or polyhedron, a leaf under a flattening transform).
  */
 #include "base/numparse.h"
+#include "io/amf.h"
 #include "io/surface.h"
 #include "mesh/tree.h"
 #include "scad/degree_trig.h"
@@ -667,33 +669,30 @@ static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const
     return MCSG_OK;
 }
 
-/* A 3MF file's build items, one leaf each ("import("f.3mf") item 2 (Cylinder)"), under
- * a union when there are several. */
-static mcsg_status import_3mf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
-                              const char *file, uint32_t file_len, const char *path,
-                              mcsg_node_id *node, mcsg_error *err)
+/* Leaves for the parts of an imported file, "import("f") WORD K (NAME)" with K numbers[k]
+ * (k + 1 without numbers) and NAME names[k] (left out when ""), under a union when there
+ * are several. Each mesh given to the tree (or freed by it on failure) is zeroed; the
+ * caller frees the rest. */
+static mcsg_status import_parts(scad_context *sc, const scad_call_args *ca,
+                                const scad_transform *t, const char *file, uint32_t file_len,
+                                const char *word, mcsg_mesh *meshes, char *const *names,
+                                const size_t *numbers, size_t count, mcsg_node_id *node,
+                                mcsg_error *err)
 {
     const mci_ctx *ctx = sc->ev.ctx;
-    mcsg_error read_err = {MCSG_OK, ""};
-    mcsg_mesh *meshes;
-    char **names;
-    size_t count;
-    mcsg_node_id *leaves = NULL;
+    mcsg_node_id *leaves = mci_malloc_array(ctx, count, sizeof *leaves);
     mci_buf label = {0};
-    mcsg_status st = mcsg_3mf_read(path, sc->opts, &meshes, &names, &count, &read_err);
-    if (st != MCSG_OK)
-        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
-                            "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
-    if (!(leaves = mci_malloc_array(ctx, count, sizeof *leaves)))
-        st = mci_fail_nomem(err, "reading CSG text");
+    mcsg_status st = leaves ? MCSG_OK : mci_fail_nomem(err, "reading CSG text");
     for (size_t k = 0; st == MCSG_OK && k < count; k++) {
         label.len = 0;
-        if (!mci_buf_printf(ctx, &label, "import(\"%.*s\") item %zu%s%s%s", (int)file_len, file,
-                            k + 1, names[k][0] ? " (" : "", names[k], names[k][0] ? ")" : ""))
-            st = mci_fail_nomem(err, "reading CSG text");
-        else
+        if (!mci_buf_printf(ctx, &label, "import(\"%.*s\") %s %zu%s%s%s", (int)file_len, file,
+                            word, numbers ? numbers[k] : k + 1, names[k][0] ? " (" : "",
+                            names[k], names[k][0] ? ")" : ""))
+            st = mci_fail_nomem(err, "reading CSG text"); /* meshes[k] left to the caller */
+        else {
             st = scad_add_leaf(sc, ca, t, &meshes[k], &label, &leaves[k], err);
-        memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
+            memset(&meshes[k], 0, sizeof meshes[k]); /* the tree's now, or freed */
+        }
     }
     if (st == MCSG_OK && count == 1)
         *node = leaves[0];
@@ -708,7 +707,72 @@ static mcsg_status import_3mf(scad_context *sc, const scad_call_args *ca, const 
     }
     mci_buf_free(ctx, &label);
     mci_free(ctx, leaves);
+    return st;
+}
+
+/* A 3MF file's build items, one leaf each ("import("f.3mf") item 2 (Cylinder)"), under
+ * a union when there are several. */
+static mcsg_status import_3mf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                              const char *file, uint32_t file_len, const char *path,
+                              mcsg_node_id *node, mcsg_error *err)
+{
+    mcsg_error read_err = {MCSG_OK, ""};
+    mcsg_mesh *meshes;
+    char **names;
+    size_t count;
+    mcsg_status st = mcsg_3mf_read(path, sc->opts, &meshes, &names, &count, &read_err);
+    if (st != MCSG_OK)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                            "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+    st = import_parts(sc, ca, t, file, file_len, "item", meshes, names, NULL, count, node, err);
     mcsg_3mf_free(meshes, names, count, sc->opts);
+    return st;
+}
+
+/* An AMF file's objects with triangles, one leaf each ("import("f.amf") object 2
+ * (Pyramid)", numbered in the file), under a union when there are several: OpenSCAD
+ * unions its objects, each the triangles of all its volumes. Without any, the import is
+ * empty, as OpenSCAD's is. */
+static mcsg_status import_amf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                              const char *file, uint32_t file_len, const char *path,
+                              mcsg_node_id *node, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    mcsg_error read_err = {MCSG_OK, ""};
+    mci_amf_objects objects;
+    size_t *numbers, kept = 0;
+    mcsg_status st = mci_amf_read_file(ctx, path, &objects, &read_err);
+    if (st == MCSG_ERR_NOMEM)
+        return mci_fail_nomem(err, "reading CSG text");
+    if (st != MCSG_OK)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                            "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+    if (!(numbers = mci_malloc_array(ctx, objects.count + 1, sizeof *numbers))) {
+        mci_amf_objects_free(ctx, &objects);
+        return mci_fail_nomem(err, "reading CSG text");
+    }
+    for (size_t k = 0; k < objects.count; k++) { /* empty objects to the back */
+        if (objects.meshes[k].triangle_count == 0)
+            continue;
+        mcsg_mesh m = objects.meshes[kept];
+        char *name = objects.names[kept];
+        objects.meshes[kept] = objects.meshes[k], objects.meshes[k] = m;
+        objects.names[kept] = objects.names[k], objects.names[k] = name;
+        numbers[kept++] = k + 1;
+    }
+    if (kept > 0)
+        st = import_parts(sc, ca, t, file, file_len, "object", objects.meshes, objects.names,
+                          numbers, kept, node, err);
+    else {
+        mcsg_mesh empty = {0};
+        mci_buf label = {0};
+        st = mci_buf_printf(ctx, &label, "import(\"%.*s\")", (int)file_len, file)
+                 ? scad_add_leaf(sc, ca, t, &empty, &label, node, err)
+                 : mci_fail_nomem(err, "reading CSG text");
+        mci_buf_free(ctx, &label);
+    }
+    mci_free(ctx, numbers);
+    mci_amf_objects_free(ctx, &objects);
     return st;
 }
 
@@ -772,6 +836,11 @@ static mcsg_status make_import(scad_context *sc, const scad_call_args *ca, const
     }
     if (st == MCSG_OK && scad_is_3mf_name(file, file_len)) {
         st = import_3mf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
+        mci_buf_free(sc->ev.ctx, &path);
+        return st;
+    }
+    if (st == MCSG_OK && scad_is_amf_name(file, file_len)) {
+        st = import_amf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
         mci_buf_free(sc->ev.ctx, &path);
         return st;
     }

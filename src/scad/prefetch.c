@@ -44,7 +44,7 @@ static bool literal_file(const scad_program *prog, const scad_stmt *stmt, const 
         *file = (const char *)prog->strings.data + e->a;
         *len = e->b;
         return memchr(*file, 0, *len) == NULL && !scad_is_3mf_name(*file, *len) &&
-               !scad_is_dxf_name(*file, *len);
+               !scad_is_amf_name(*file, *len) && !scad_is_dxf_name(*file, *len);
     }
     return false;
 }
@@ -52,6 +52,12 @@ static bool literal_file(const scad_program *prog, const scad_stmt *stmt, const 
 bool scad_is_3mf_name(const char *file, uint32_t len)
 {
     return len >= 4 && file[len - 4] == '.' && file[len - 3] == '3' &&
+           (file[len - 2] | 32) == 'm' && (file[len - 1] | 32) == 'f';
+}
+
+bool scad_is_amf_name(const char *file, uint32_t len)
+{
+    return len >= 4 && file[len - 4] == '.' && (file[len - 3] | 32) == 'a' &&
            (file[len - 2] | 32) == 'm' && (file[len - 1] | 32) == 'f';
 }
 

@@ -240,6 +240,8 @@ typedef struct scad_context {
 /* Whether an import() file name ends in .3mf (case-insensitive): such a file gives a
  * leaf per build item, read by import() itself, not prefetched as one mesh. */
 bool scad_is_3mf_name(const char *file, uint32_t len);
+/* Whether an import() file name ends in .amf: a leaf per object, read by import() itself. */
+bool scad_is_amf_name(const char *file, uint32_t len);
 /* Whether an import() file name ends in .dxf: a 2D drawing, read by import() itself. */
 bool scad_is_dxf_name(const char *file, uint32_t len);
 
