@@ -15,9 +15,10 @@
  *    rotate(a, v) about an axis, scale(v or s), mirror(v) (reflection through the plane
  *    normal to v), multmatrix(m) padded with the identity and divided by m[3][3]; a
  *    transform that flattens space (zero scale, singular matrix) makes its leaves empty;
- *  - polyhedron faces are clockwise seen from outside, so each is reversed, then split
- *    by a fan from its first (reversed) corner; import reads OFF/OBJ/STL/PLY relative to
- *    the file's directory.
+ *  - polyhedron faces are clockwise seen from outside, so each is reversed, then
+ *    triangulated as OpenSCAD's export does (shape/tess.h: libtess2's triangles, which
+ *    decide a non-planar face's volume); import reads OFF/OBJ/STL/PLY relative to the
+ *    file's directory.
  * The empty set is always a union node without children (e.g. cube(0), an empty mesh
  * from import or polyhedron, a leaf under a flattening transform).
  */
