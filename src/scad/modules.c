@@ -15,9 +15,10 @@
  *    rotate(a, v) about an axis, scale(v or s), mirror(v) (reflection through the plane
  *    normal to v), multmatrix(m) padded with the identity and divided by m[3][3]; a
  *    transform that flattens space (zero scale, singular matrix) makes its leaves empty;
- *  - polyhedron faces are clockwise seen from outside, so each is reversed, then split
- *    by a fan from its first (reversed) corner; import reads OFF/OBJ/STL/PLY relative to
- *    the file's directory, 3MF as a leaf per build item and AMF as a leaf per object
+ *  - polyhedron faces are clockwise seen from outside, so each is reversed, then
+ *    triangulated as OpenSCAD's export does (shape/tess.h: libtess2's triangles, which
+ *    decide a non-planar face's volume); import reads OFF/OBJ/STL/PLY relative to the
+ *    file's directory, 3MF as a leaf per build item and AMF as a leaf per object
  *    (OpenSCAD unions an AMF file's objects), DXF as 2D outlines.
  * The empty set is always a union node without children (e.g. cube(0), an empty mesh
  * from import or polyhedron, a leaf under a flattening transform).
@@ -28,6 +29,7 @@
 #include "mesh/tree.h"
 #include "scad/degree_trig.h"
 #include "scad/scad.h"
+#include "shape/tess.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -576,20 +578,77 @@ static mcsg_status polyhedron_face(scad_context *sc, const scad_bound_arg *a, ui
     return MCSG_OK;
 }
 
-/* Fan-triangulate the reversed faces (OpenSCAD's faces are clockwise from outside). */
-static void polyhedron_triangles(scad_context *sc, const scad_bound_arg *a, mcsg_mesh *mesh)
+/* Each point's vertex: the first point with the same float coordinates (OpenSCAD
+ * merges vertices by their float values before triangulating faces). */
+static mcsg_status polyhedron_vertex_ids(const mci_ctx *ctx, const mcsg_mesh *mesh,
+                                         uint32_t **ids, mcsg_error *err)
 {
-    uint32_t *t = mesh->triangles;
-    for (uint32_t f = 0; f < a->value.count; f++) {
-        const scad_value *face = scad_element(sc, &a->value, f);
-        uint32_t n = face->count;
-        for (uint32_t k = 1; n >= 3 && k + 1 < n; k++) {
-            t[0] = (uint32_t)scad_element(sc, face, n - 1)->number;
-            t[1] = (uint32_t)scad_element(sc, face, n - 1 - k)->number;
-            t[2] = (uint32_t)scad_element(sc, face, n - 2 - k)->number;
-            t += 3;
-        }
+    size_t n = mesh->vertex_count;
+    double *rounded = mci_malloc_array(ctx, 3 * (n ? n : 1), sizeof *rounded);
+    *ids = mci_malloc_array(ctx, n ? n : 1, sizeof **ids);
+    bool ok = rounded && *ids;
+    for (size_t i = 0; ok && i < 3 * n; i++)
+        rounded[i] = (double)(float)mesh->vertices[i];
+    ok = ok && mci_first_equal_coordinates(ctx, rounded, n, *ids);
+    mci_free(ctx, rounded);
+    if (ok)
+        return MCSG_OK;
+    mci_free(ctx, *ids);
+    *ids = NULL;
+    return mci_fail_nomem(err, "triangulating polyhedron faces");
+}
+
+/* One face reversed (OpenSCAD's faces are clockwise from outside) and triangulated as
+ * OpenSCAD does (shape/tess.h); its triangles appended at *t. */
+static mcsg_status polyhedron_face_triangles(scad_context *sc, const scad_value *face,
+                                             const mcsg_mesh *mesh, const uint32_t *canon,
+                                             mci_tess **tess, mci_buf *scratch, uint32_t **t,
+                                             mci_tess_how *how, mcsg_error *err)
+{
+    uint32_t n = face->count, count = 0;
+    size_t need = (size_t)n * (3 * sizeof(double) + 2 * sizeof(uint32_t));
+    if (!mci_buf_reserve(sc->ev.ctx, scratch, need))
+        return mci_fail_nomem(err, "triangulating polyhedron faces");
+    double *xyz = (double *)scratch->data;
+    uint32_t *point = (uint32_t *)(xyz + 3 * (size_t)n), *ids = point + n;
+    for (uint32_t k = 0; k < n; k++) {
+        point[k] = canon[(uint32_t)scad_element(sc, face, n - 1 - k)->number];
+        ids[k] = point[k];
+        memcpy(xyz + 3 * (size_t)k, mesh->vertices + 3 * (size_t)point[k], 3 * sizeof *xyz);
     }
+    mcsg_status st = mci_tess_face(sc->ev.ctx, tess, xyz, ids, n, *t, &count, how, err);
+    for (uint32_t k = 0; st == MCSG_OK && k < 3 * count; k++)
+        (*t)[k] = point[(*t)[k]];
+    *t += 3 * (size_t)count;
+    return st;
+}
+
+/* All faces' triangles; mesh->triangle_count becomes their number (at most the
+ * n - 2 per face allocated). Faces that OpenSCAD's triangulation is not reproduced for
+ * are fanned, with one warning. */
+static mcsg_status polyhedron_triangles(scad_context *sc, const scad_bound_arg *a,
+                                        mcsg_mesh *mesh, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    uint32_t *canon = NULL, *t = mesh->triangles, fans = 0;
+    mci_tess *tess = NULL;
+    mci_buf scratch = {0};
+    mcsg_status st = polyhedron_vertex_ids(ctx, mesh, &canon, err);
+    for (uint32_t f = 0; st == MCSG_OK && f < a->value.count; f++) {
+        mci_tess_how how;
+        st = polyhedron_face_triangles(sc, scad_element(sc, &a->value, f), mesh, canon, &tess,
+                                       &scratch, &t, &how, err);
+        fans += how == MCI_TESS_FAN;
+    }
+    mci_tess_free(ctx, &tess);
+    mci_buf_free(ctx, &scratch);
+    mci_free(ctx, canon);
+    mesh->triangle_count = (size_t)(t - mesh->triangles) / 3;
+    if (st == MCSG_OK && fans > 0)
+        scad_warn_at(ctx, sc->name, a->line, a->col, "polyhedron(): %u faces cross or touch "
+                     "themselves seen along their normal; triangulated as fans, which may "
+                     "differ from OpenSCAD's triangles", fans);
+    return st;
 }
 
 static const scad_bound_arg *polyhedron_faces_arg(scad_context *sc, const scad_call_args *ca)
@@ -636,7 +695,11 @@ static mcsg_status make_polyhedron(scad_context *sc, const scad_call_args *ca,
         mci_mesh_free(sc->ev.ctx, &mesh);
         return st;
     }
-    polyhedron_triangles(sc, faces, &mesh);
+    st = polyhedron_triangles(sc, faces, &mesh, err);
+    if (st != MCSG_OK) {
+        mci_mesh_free(sc->ev.ctx, &mesh);
+        return scad_at_call(sc, ca, st, err);
+    }
     if (!mci_buf_printf(sc->ev.ctx, label, "polyhedron(%zu points, %u faces)",
                         mesh.vertex_count, faces->value.count))
         return scad_nomem_label(&mesh, sc->ev.ctx, err);
