@@ -1339,14 +1339,78 @@ static void XMLCALL element_end(void *user, const XML_Char *name)
 /* Placement on Clipper's grid, and the entry points */
 
 typedef struct placed {
-    double *xy;     /* the loop's points on the grid, repeats dropped */
-    size_t n;
+    size_t n;       /* the loop's points on the grid, repeats dropped */
     bool out_of_range;
 } placed;
 
-/* Loop k of the drawing placed on the page and truncated to 2^-16 (into p->xy, room
- * for the loop's points). */
-static void place_loop(const svg_reader *r, size_t k, double cx, double cy, placed *p)
+/* Clipper's DistanceFromLineSqrd: the squared distance of p from the line a b. */
+static double line_distance2(const int64_t *p, const int64_t *a, const int64_t *b)
+{
+    double A = (double)(a[1] - b[1]), B = (double)(b[0] - a[0]);
+    double C = A * (double)a[0] + B * (double)a[1];
+    C = A * (double)p[0] + B * (double)p[1] - C;
+    return (C * C) / (A * A + B * B);
+}
+
+/* Clipper's SlopesNearCollinear, measured from the point that lies between the others. */
+static bool near_collinear(const int64_t *p1, const int64_t *p2, const int64_t *p3, double d2)
+{
+    int k = llabs(p1[0] - p2[0]) > llabs(p1[1] - p2[1]) ? 0 : 1;
+    if ((p1[k] > p2[k]) == (p1[k] < p3[k]))
+        return line_distance2(p1, p2, p3) < d2;
+    if ((p2[k] > p1[k]) == (p2[k] < p3[k]))
+        return line_distance2(p2, p1, p3) < d2;
+    return line_distance2(p3, p1, p2) < d2;
+}
+
+static bool points_close(const int64_t *a, const int64_t *b, double d2)
+{
+    double dx = (double)a[0] - (double)b[0], dy = (double)a[1] - (double)b[1];
+    return dx * dx + dy * dy <= d2;
+}
+
+/* Clipper's CleanPolygon (distance 1.415, as OpenSCAD's toPolygon2d calls it) on the n
+ * grid points g: points closer than that to their neighbour or to the line through
+ * their neighbours go; the rest, from where the cleaning stopped, into out (in
+ * millimetres). `link` has room for 3 n entries. Returns the count left (0 when fewer
+ * than 3). */
+static size_t clean_polygon(const int64_t *g, size_t n, size_t *link, double *out)
+{
+    size_t *next = link, *prev = link + n, *done = link + 2 * n, op = 0, size = n;
+    const double d2 = 1.415 * 1.415;
+    for (size_t i = 0; i < n; i++) {
+        next[i] = (i + 1) % n;
+        prev[(i + 1) % n] = i;
+        done[i] = 0;
+    }
+    while (!done[op] && next[op] != prev[op]) {
+        size_t pr = prev[op], nx = next[op];
+        if (points_close(g + 2 * op, g + 2 * pr, d2)) {
+            next[pr] = nx, prev[nx] = pr, done[pr] = 0, op = pr, size--;
+        } else if (points_close(g + 2 * pr, g + 2 * nx, d2)) {
+            size_t nn = next[nx];
+            next[op] = nn, prev[nn] = op, done[op] = 0;
+            next[pr] = nn, prev[nn] = pr, done[pr] = 0, op = pr, size -= 2;
+        } else if (near_collinear(g + 2 * pr, g + 2 * op, g + 2 * nx, d2)) {
+            next[pr] = nx, prev[nx] = pr, done[pr] = 0, op = pr, size--;
+        } else {
+            done[op] = 1;
+            op = nx;
+        }
+    }
+    if (size < 3)
+        return 0;
+    for (size_t i = 0; i < size; i++, op = next[op]) {
+        out[2 * i] = (double)g[2 * op] / CLIPPER_SCALE;
+        out[2 * i + 1] = (double)g[2 * op + 1] / CLIPPER_SCALE;
+    }
+    return size;
+}
+
+/* Loop k of the drawing placed on the page, truncated to 2^-16 (Clipper's grid units
+ * into g, room for the loop's points), repeats dropped. */
+static void place_loop(const svg_reader *r, size_t k, double cx, double cy, int64_t *g,
+                       placed *p)
 {
     const paths *a = &r->all;
     size_t first = a->start[k], end = a->start[k + 1];
@@ -1361,14 +1425,12 @@ static void place_loop(const svg_reader *r, size_t k, double cx, double cy, plac
             p->n = 0;
             return;
         }
-        gx = (double)(int64_t)gx / CLIPPER_SCALE;
-        gy = (double)(int64_t)gy / CLIPPER_SCALE;
-        if (p->n > 0 && p->xy[2 * p->n - 2] == gx && p->xy[2 * p->n - 1] == gy)
+        if (p->n > 0 && g[2 * p->n - 2] == (int64_t)gx && g[2 * p->n - 1] == (int64_t)gy)
             continue;
-        p->xy[2 * p->n] = gx;
-        p->xy[2 * p->n++ + 1] = gy;
+        g[2 * p->n] = (int64_t)gx;
+        g[2 * p->n++ + 1] = (int64_t)gy;
     }
-    while (p->n > 1 && p->xy[2 * p->n - 2] == p->xy[0] && p->xy[2 * p->n - 1] == p->xy[1])
+    while (p->n > 1 && g[2 * p->n - 2] == g[0] && g[2 * p->n - 1] == g[1])
         p->n--;
 }
 
@@ -1379,27 +1441,34 @@ static mcsg_status place(const svg_reader *r, mci_svg *out, mcsg_error *err)
     double cy = r->center ? (r->box_min[1] + r->box_max[1]) / 2 : r->height_mm - r->align[1];
     mci_outlines *o = &out->outlines;
     placed p = {0};
+    size_t longest = 0, *link;
+    int64_t *g;
+    for (size_t k = 0; k < a->count; k++)
+        longest = a->start[k + 1] - a->start[k] > longest ? a->start[k + 1] - a->start[k] : longest;
+    g = mci_malloc_array(r->ctx, 2 * longest + 2, sizeof *g);
+    link = mci_malloc_array(r->ctx, 3 * longest + 3, sizeof *link);
     if (r->center && r->box_empty)
         cx = cy = 0;
     o->xy = mci_malloc_array(r->ctx, a->n + 1, 2 * sizeof *o->xy);
     o->loop_start = mci_calloc_array(r->ctx, a->count + 1, sizeof *o->loop_start);
     out->shape_start = mci_calloc_array(r->ctx, r->shape_count + 1, sizeof *out->shape_start);
     out->shape_line = mci_calloc_array(r->ctx, r->shape_count + 1, sizeof *out->shape_line);
-    if (!o->xy || !o->loop_start || !out->shape_start || !out->shape_line) {
+    if (!o->xy || !o->loop_start || !out->shape_start || !out->shape_line || !g || !link) {
         mci_svg_free(r->ctx, out);
+        mci_free(r->ctx, g);
+        mci_free(r->ctx, link);
         return mci_fail_nomem(err, "reading an SVG file");
     }
     for (size_t s = 0; s < r->shape_count; s++) {
         size_t before = o->loop_count;
         for (size_t k = r->shape_start[s]; k < r->shape_start[s + 1]; k++) {
-            p.xy = o->xy + 2 * o->point_count;
-            place_loop(r, k, cx, cy, &p);
+            place_loop(r, k, cx, cy, g, &p);
             if (p.out_of_range) {
                 mci_log(r->ctx, MCSG_LOG_WARNING, "%s:%u: Range check failed for polygon. "
                         "skipping", r->name, (unsigned)r->shape_line[s]);
                 break;
             }
-            if (p.n < 3)
+            if (p.n < 3 || (p.n = clean_polygon(g, p.n, link, o->xy + 2 * o->point_count)) < 3)
                 continue;
             o->point_count += p.n;
             o->loop_start[++o->loop_count] = (uint32_t)o->point_count;
@@ -1409,6 +1478,8 @@ static mcsg_status place(const svg_reader *r, mci_svg *out, mcsg_error *err)
             out->shape_start[++out->shape_count] = (uint32_t)o->loop_count;
         }
     }
+    mci_free(r->ctx, g);
+    mci_free(r->ctx, link);
     return MCSG_OK;
 }
 
