@@ -24,8 +24,8 @@
  *    polyline: stroked, never filled (even when closed).
  *  - path: OpenSCAD's tokens (separators space and comma; the command letters
  *    zmlcqahvst, either case, and '-' are tokens of their own; a token with two dots or
- *    more split after each dot that follows digits; a token ending in 'e' held as the
- *    start of an exponent). Commands as OpenSCAD implements them: Béziers in 20 steps
+ *    more cut into numbers each ending before a dot ("1.2.3" -> "1.2", ".3"); a token
+ *    ending in 'e' held as the start of an exponent). Commands as OpenSCAD implements them: Béziers in 20 steps
  *    (t = i / 20, Bernstein form), arcs in |sweep| * 10 / 180 + 4 steps by the SVG
  *    implementation notes, S and T reflecting the previous control point only after a C
  *    or S (resp. Q or T). M starts a new subpath; the previous one, when its ends are
