@@ -72,8 +72,8 @@ typedef struct mcsg_error {
 
 /* Custom allocator. Either all three functions are set, or none (then the C library's
  * malloc/realloc/free are used). realloc_fn(user, NULL, n) must behave like malloc_fn.
- * The library never calls free_fn with NULL. The libraries behind 3MF and AMF (libzip,
- * expat) take no allocator: their own working memory comes from malloc. */
+ * The library never calls free_fn with NULL. The libraries behind 3MF, AMF and SVG
+ * import (libzip, expat) take no allocator: their own working memory comes from malloc. */
 typedef struct mcsg_allocator {
     void *(*malloc_fn)(void *user, size_t size);
     void *(*realloc_fn)(void *user, void *ptr, size_t size);

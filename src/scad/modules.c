@@ -839,12 +839,13 @@ static mcsg_status import_amf(scad_context *sc, const scad_call_args *ca, const 
     return st;
 }
 
-static bool import_is_dxf(const scad_context *sc, const scad_call_args *ca)
+static bool import_is_2d(const scad_context *sc, const scad_call_args *ca)
 {
     int slot = !scad_given(ca, IMPORT_FILE) && scad_given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
                                                                               : IMPORT_FILE;
     const scad_value *v = &ca->slot[slot].value;
-    return v->type == VAL_STRING && scad_is_dxf_name(scad_string(sc->prog, v), v->count);
+    return v->type == VAL_STRING && (scad_is_dxf_name(scad_string(sc->prog, v), v->count) ||
+                                     scad_is_svg_name(scad_string(sc->prog, v), v->count));
 }
 
 /* surface(file, center, convexity | invert): a height map as a closed mesh. */
@@ -894,6 +895,11 @@ static mcsg_status make_import(scad_context *sc, const scad_call_args *ca, const
     mcsg_status st = import_path(sc, ca, &file, &file_len, &path, err);
     if (st == MCSG_OK && scad_is_dxf_name(file, file_len)) {
         st = scad_import_dxf(sc, ca, t, file, file_len, (const char *)path.data, node, err);
+        mci_buf_free(sc->ev.ctx, &path);
+        return st;
+    }
+    if (st == MCSG_OK && scad_is_svg_name(file, file_len)) {
+        st = scad_import_svg(sc, ca, t, file, file_len, (const char *)path.data, node, err);
         mci_buf_free(sc->ev.ctx, &path);
         return st;
     }
@@ -1166,7 +1172,7 @@ mcsg_status scad_instantiate(scad_context *sc, uint32_t stmt, const scad_transfo
     case MOD_POLYHEDRON: st = make_polyhedron(sc, &ca, parent, &label, node, err); break;
     case MOD_IMPORT:
         st = make_import(sc, &ca, parent, &label, node, err);
-        *dim = import_is_dxf(sc, &ca) ? DIM_2D : DIM_3D;
+        *dim = import_is_2d(sc, &ca) ? DIM_2D : DIM_3D;
         break;
     case MOD_SURFACE: st = make_surface(sc, &ca, parent, &label, node, err); break;
     case MOD_CIRCLE:

@@ -44,7 +44,8 @@ static bool literal_file(const scad_program *prog, const scad_stmt *stmt, const 
         *file = (const char *)prog->strings.data + e->a;
         *len = e->b;
         return memchr(*file, 0, *len) == NULL && !scad_is_3mf_name(*file, *len) &&
-               !scad_is_amf_name(*file, *len) && !scad_is_dxf_name(*file, *len);
+               !scad_is_amf_name(*file, *len) && !scad_is_dxf_name(*file, *len) &&
+               !scad_is_svg_name(*file, *len);
     }
     return false;
 }
@@ -65,6 +66,12 @@ bool scad_is_dxf_name(const char *file, uint32_t len)
 {
     return len >= 4 && file[len - 4] == '.' && (file[len - 3] | 32) == 'd' &&
            (file[len - 2] | 32) == 'x' && (file[len - 1] | 32) == 'f';
+}
+
+bool scad_is_svg_name(const char *file, uint32_t len)
+{
+    return len >= 4 && file[len - 4] == '.' && (file[len - 3] | 32) == 's' &&
+           (file[len - 2] | 32) == 'v' && (file[len - 1] | 32) == 'g';
 }
 
 /* The path import() opens for `file`: relative names under the base directory. */

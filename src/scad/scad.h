@@ -244,6 +244,9 @@ bool scad_is_3mf_name(const char *file, uint32_t len);
 bool scad_is_amf_name(const char *file, uint32_t len);
 /* Whether an import() file name ends in .dxf: a 2D drawing, read by import() itself. */
 bool scad_is_dxf_name(const char *file, uint32_t len);
+/* Whether an import() file name ends in .svg (case-insensitive): a 2D drawing, read by
+ * import() itself. */
+bool scad_is_svg_name(const char *file, uint32_t len);
 
 /* Read the files of every import() call with a literal file name, on the options'
  * threads, into sc->prefetch (failed reads are kept as failures, not reported). */
@@ -320,6 +323,11 @@ typedef enum scad_dim { DIM_NONE = 0, DIM_2D = 2, DIM_3D = 3 } scad_dim;
 
 /* import() of a DXF drawing: its outlines as a 2D leaf (shapes2d.c). */
 mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                            const char *file, uint32_t file_len, const char *path,
+                            mcsg_node_id *node, mcsg_error *err);
+/* import() of an SVG drawing: each shape's even-odd fill, united, as a 2D leaf
+ * (shapes2d.c). */
+mcsg_status scad_import_svg(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                             const char *file, uint32_t file_len, const char *path,
                             mcsg_node_id *node, mcsg_error *err);
 /* circle, square, polygon: add the prism of the shape, under the 2D part of t. */

@@ -16,6 +16,7 @@
 #include "scad/scad.h"
 #include "shape/region.h"
 #include "io/dxf.h"
+#include "io/svg.h"
 #include "text/text.h"
 
 #include <math.h>
@@ -24,7 +25,8 @@
 enum { CIRCLE_R, CIRCLE_D };
 enum { SQUARE_SIZE, SQUARE_CENTER };
 enum { POLYGON_POINTS, POLYGON_PATHS };
-enum { IMPORT_LAYER = 1, IMPORT_ORIGIN = 3, IMPORT_SCALE = 4, IMPORT_LAYERNAME = 8 };
+enum { IMPORT_LAYER = 1, IMPORT_ORIGIN = 3, IMPORT_SCALE = 4, IMPORT_LAYERNAME = 8,
+       IMPORT_CENTER = 9, IMPORT_DPI = 10 };
 enum { TEXT_TEXT, TEXT_SIZE, TEXT_FONT, TEXT_DIRECTION, TEXT_LANGUAGE, TEXT_SCRIPT,
        TEXT_HALIGN, TEXT_VALIGN, TEXT_SPACING, TEXT_STRINGS = TEXT_SPACING };
 
@@ -394,6 +396,127 @@ mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const sc
     mci_outlines_free(ctx, &o);
     mci_buf_free(ctx, &label);
     mci_free(ctx, layer);
+    return st;
+}
+
+/* import()'s center and dpi for an SVG drawing, as OpenSCAD reads them: center only
+ * when a boolean, dpi only when a number of at least 0.001 (else 72, with a warning). */
+static void svg_args(scad_context *sc, const scad_call_args *ca, bool *center, double *dpi)
+{
+    const scad_value *c = &ca->slot[IMPORT_CENTER].value, *d = &ca->slot[IMPORT_DPI].value;
+    *center = c->type == VAL_BOOL && c->number != 0;
+    *dpi = 72;
+    if (d->type != VAL_NUMBER)
+        return;
+    if (d->number >= 0.001)
+        *dpi = d->number;
+    else
+        scad_warn_at(sc->ev.ctx, sc->name, ca->slot[IMPORT_DPI].line, ca->slot[IMPORT_DPI].col,
+                     "Invalid dpi value giving, using default of 72 dpi. Value must be "
+                     "positive and >= 0.001");
+}
+
+/* Shape k of the drawing as outlines of its own, filled by the even-odd rule as
+ * OpenSCAD fills it; when its loops cross (which that fill cannot take here), by the
+ * non-zero rule instead, with a warning. *empty when it encloses nothing. */
+static mcsg_status svg_shape(scad_context *sc, const scad_call_args *ca, const mci_svg *svg,
+                             size_t k, const char *file, uint32_t file_len, mci_outlines *o,
+                             bool *empty, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    uint32_t first = svg->shape_start[k], end = svg->shape_start[k + 1];
+    uint32_t p0 = svg->outlines.loop_start[first], points = svg->outlines.loop_start[end] - p0;
+    mci_region r = {0};
+    mcsg_status st = alloc_outlines(ctx, o, points, end - first, err);
+    if (st != MCSG_OK)
+        return st;
+    memcpy(o->xy, svg->outlines.xy + 2 * (size_t)p0, 2 * sizeof *o->xy * points);
+    for (uint32_t i = first; i <= end; i++)
+        o->loop_start[i - first] = svg->outlines.loop_start[i] - p0;
+    o->point_count = points;
+    o->loop_count = end - first;
+    st = mci_region_from_outlines(ctx, o, &r, err);
+    *empty = st == MCSG_OK && r.tri_count == 0;
+    mci_region_free(ctx, &r);
+    if (st == MCSG_ERR_UNSUPPORTED) {
+        mci_outlines filled = {0};
+        scad_warn_at(ctx, sc->name, ca->stmt->line, ca->stmt->col,
+                     "import(\"%.*s\"): the outlines of the shape at line %u cross: filled by "
+                     "the non-zero rule, not OpenSCAD's even-odd rule", (int)file_len, file,
+                     (unsigned)svg->shape_line[k]);
+        st = scad_fill_nonzero(sc, o, &filled, err);
+        if (st == MCSG_OK) {
+            mci_outlines_free(ctx, o);
+            *o = filled;
+            *empty = o->loop_count == 0;
+        }
+    }
+    return st;
+}
+
+/* The drawing's non-empty shapes as leaves, united under *node. */
+static mcsg_status svg_leaves(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                              const mci_svg *svg, const char *file, uint32_t file_len,
+                              mcsg_node_id *node, mcsg_error *err)
+{
+    const mci_ctx *ctx = sc->ev.ctx;
+    mcsg_node_id *ids = mci_malloc_array(ctx, svg->shape_count + 1, sizeof *ids);
+    size_t count = 0;
+    mci_buf label = {0};
+    mcsg_status st = ids ? MCSG_OK : mci_fail_nomem(err, "reading an SVG file");
+    for (size_t k = 0; st == MCSG_OK && k < svg->shape_count; k++) {
+        mci_outlines o = {0};
+        bool empty = false;
+        st = svg_shape(sc, ca, svg, k, file, file_len, &o, &empty, err);
+        label.len = 0;
+        if (st == MCSG_OK && !empty &&
+            !mci_buf_printf(ctx, &label, "import(\"%.*s\") shape at line %u", (int)file_len,
+                            file, (unsigned)svg->shape_line[k]))
+            st = mci_fail_nomem(err, "reading CSG text");
+        if (st == MCSG_OK && !empty)
+            st = scad_add_shape(sc, ca, t, &o, &label, &ids[count++], err);
+        mci_outlines_free(ctx, &o);
+    }
+    label.len = 0;
+    if (st == MCSG_OK && count != 1 &&
+        !mci_buf_printf(ctx, &label, "import(\"%.*s\")", (int)file_len, file))
+        st = mci_fail_nomem(err, "reading CSG text");
+    if (st == MCSG_OK && count == 0) {
+        mci_outlines none = {0};
+        st = scad_add_shape(sc, ca, t, &none, &label, node, err);
+    } else if (st == MCSG_OK && count == 1) {
+        *node = ids[0];
+    } else if (st == MCSG_OK) {
+        st = mci_buf_printf(ctx, &label, " at %s:%u:%u", sc->name, ca->stmt->line, ca->stmt->col)
+                 ? mcsg_tree_add_op(sc->tree, MCSG_NODE_UNION, ids, count,
+                                    (const char *)label.data, node, err)
+                 : mci_fail_nomem(err, "reading CSG text");
+    }
+    mci_buf_free(ctx, &label);
+    mci_free(ctx, ids);
+    return st;
+}
+
+mcsg_status scad_import_svg(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                            const char *file, uint32_t file_len, const char *path,
+                            mcsg_node_id *node, mcsg_error *err)
+{
+    mci_svg svg = {0};
+    mcsg_error read_err = {MCSG_OK, ""};
+    bool center;
+    double dpi;
+    mcsg_status st;
+    svg_args(sc, ca, &center, &dpi);
+    st = mci_svg_read(sc->ev.ctx, path, dpi, center, &svg, &read_err);
+    if (st != MCSG_OK && st != MCSG_ERR_NOMEM)
+        return scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                            "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
+    if (st != MCSG_OK) {
+        *err = read_err;
+        return st;
+    }
+    st = svg_leaves(sc, ca, t, &svg, file, file_len, node, err);
+    mci_svg_free(sc->ev.ctx, &svg);
     return st;
 }
 
