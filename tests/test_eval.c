@@ -1106,7 +1106,10 @@ TEST(repair_joins_overlapping_shells)
     CHECK(mcsg_check_report_is_valid(&r) && fabs(r.volume - (1875 - (216 - 27))) < 1e-9);
     mcsg_mesh_free(&out, NULL);
     CHECK(mcsg_mesh_repair(NULL, NULL, &out, &st, &err) == MCSG_ERR_INVALID_ARG);
-    CHECK(test_allocation_failures("mcsg_mesh_repair", repair_under, &two, false) > 50);
+    /* A failure may be absorbed: classification can need the optional per-thread table
+     * of exact points (src/exact/exact_cache.c), whose failed allocation only costs
+     * speed. */
+    CHECK(test_allocation_failures("mcsg_mesh_repair", repair_under, &two, true) > 50);
     mcsg_mesh_free(&two, NULL);
     mcsg_mesh_free(&hollow, NULL);
 }

@@ -218,6 +218,23 @@ TEST(openscad_text_dxf_surface)
         snprintf(text, sizeof text, "linear_extrude(2) import(\"%s\");",
                  test_data("dxf/example013.dxf"));
         check_openscad(text, 4000, 40, 76);
+        /* The deprecated `file` reads the drawing in place of the children (warning),
+         * with rotate_extrude's origin and scale. */
+        snprintf(text, sizeof text, "linear_extrude(height = 2, file = \"%s\");",
+                 test_data("dxf/example013.dxf"));
+        check_openscad(text, 4000, 40, 76);
+        {
+            log_capture log = {{0}};
+            char child[512];
+            snprintf(text, sizeof text, "rotate_extrude(file = \"%s\", origin = [-30, 0], "
+                     "scale = 0.5, $fn = 16);", test_data("dxf/example013.dxf"));
+            snprintf(child, sizeof child, "rotate_extrude($fn = 16) scale(0.5) "
+                     "translate([30, 0]) import(\"%s\", $fn = 16);",
+                     test_data("dxf/example013.dxf"));
+            CHECK_EQ_DOUBLE(eval_volume(text, NULL, NULL, &log), eval_volume(child, NULL, NULL,
+                                                                             NULL));
+            CHECK_CONTAINS(log.text, "rotate_extrude(): `file` is deprecated");
+        }
         /* OpenSCAD's STL holds floats: its volume is 21785.62, the exact mesh's 21785.556. */
         snprintf(text, sizeof text, "surface(\"%s\", center=true);",
                  test_data("surface/example010.dat"));
@@ -238,8 +255,8 @@ TEST(errors_and_warnings)
                  "polygon(): points[1] is not a vector of 2 finite numbers");
     expect_error("linear_extrude(height = \"a\") square(1);", MCSG_ERR_PARSE,
                  "t.scad:1:16: linear_extrude(): `height` must be a number, not a string");
-    expect_error("linear_extrude(file = \"a.dxf\");", MCSG_ERR_UNSUPPORTED, "`file` is not "
-                 "supported");
+    expect_error("linear_extrude(file = \"a.dxf\");", MCSG_ERR_IO,
+                 "t.scad:1:1: linear_extrude(\"a.dxf\"): a.dxf: cannot open");
     expect_error("linear_extrude(1) square(\"a\");", MCSG_ERR_PARSE,
                  "square(): `size` must be a number or a vector of 2 numbers, not a string");
     /* Mixing dimensions: the 2D square is left out of the union, with a warning. */

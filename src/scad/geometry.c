@@ -39,16 +39,13 @@ static mcsg_status finite_number(const scad_context *sc, const scad_call_args *c
     return st;
 }
 
-/* The deprecated `file` parameter (a DXF file to extrude) is not read. */
-static mcsg_status no_file(const scad_context *sc, const scad_call_args *ca, int slot,
-                           mcsg_error *err)
+/* The deprecated `file` parameter: a DXF drawing to extrude, in place of the children. */
+static void warn_file(const scad_context *sc, const scad_call_args *ca, int slot)
 {
-    if (ca->slot[slot].value.type != VAL_STRING)
-        return MCSG_OK;
-    return scad_fail_at(sc->name, ca->slot[slot].line, ca->slot[slot].col, err,
-                        MCSG_ERR_UNSUPPORTED, "%s(): `file` is not supported by meshcsg "
-                        "(OpenSCAD deprecates it: extrude a child import() instead)",
-                        ca->module);
+    if (ca->slot[slot].value.type == VAL_STRING)
+        scad_warn_at(sc->ev.ctx, sc->name, ca->slot[slot].line, ca->slot[slot].col,
+                     "%s(): `file` is deprecated (OpenSCAD will remove it): extrude a child "
+                     "import() instead", ca->module);
 }
 
 static mcsg_status linear_extrude_args(scad_context *sc, scad_geometry_op *op, mcsg_error *err)
@@ -56,7 +53,8 @@ static mcsg_status linear_extrude_args(scad_context *sc, scad_geometry_op *op, m
     const scad_call_args *ca = &op->ca;
     const scad_value *scale = &ca->slot[LE_SCALE].value;
     double slices = 0;
-    mcsg_status st = no_file(sc, ca, LE_FILE, err);
+    mcsg_status st = MCSG_OK;
+    warn_file(sc, ca, LE_FILE);
     op->height = 100;
     op->scale[0] = op->scale[1] = 1;
     /* OpenSCAD: without `height`, a first positional number is the height. */
@@ -96,12 +94,75 @@ static mcsg_status linear_extrude_args(scad_context *sc, scad_geometry_op *op, m
 
 static mcsg_status rotate_extrude_args(scad_context *sc, scad_geometry_op *op, mcsg_error *err)
 {
-    mcsg_status st = no_file(sc, &op->ca, RE_FILE, err);
+    mcsg_status st;
+    warn_file(sc, &op->ca, RE_FILE);
     op->angle = 360;
-    if (st == MCSG_OK)
-        st = finite_number(sc, &op->ca, RE_ANGLE, &op->angle, err);
+    st = finite_number(sc, &op->ca, RE_ANGLE, &op->angle, err);
     if (op->angle <= -360 || op->angle > 360)
         op->angle = 360;
+    return st;
+}
+
+/* The drawing a deprecated `file` names, read as OpenSCAD's extrusions read it: layer,
+ * origin, and as scale the extrusion's x scale (linear_extrude) or its own `scale`
+ * (rotate_extrude, 1 unless above 0). */
+static mcsg_status file_view(scad_context *sc, const scad_geometry_op *op, int layer_slot,
+                             int origin_slot, scad_dxf_view *view, mcsg_error *err)
+{
+    const scad_call_args *ca = &op->ca;
+    const scad_value *l = &ca->slot[layer_slot].value, *o = &ca->slot[origin_slot].value;
+    double v[3];
+    view->res = op->res;
+    if (scad_given(ca, origin_slot)) {
+        if (o->type != VAL_VECTOR || o->count != 2 || !scad_get_vec3(sc, o, true, 0, v) ||
+            !isfinite(v[0]) || !isfinite(v[1]))
+            return scad_wrong_type(sc, ca, origin_slot, "a vector of 2 finite numbers", err);
+        view->origin[0] = v[0];
+        view->origin[1] = v[1];
+    }
+    if (scad_given(ca, layer_slot) && l->type != VAL_STRING)
+        return scad_wrong_type(sc, ca, layer_slot, "a layer name (a string)", err);
+    if (scad_given(ca, layer_slot) && l->count > 0 && !memchr(scad_string(sc->prog, l), 0, l->count)) {
+        char *layer = mci_malloc(sc->ev.ctx, l->count + 1);
+        if (!layer)
+            return mci_fail_nomem(err, "reading a DXF file");
+        memcpy(layer, scad_string(sc->prog, l), l->count);
+        layer[l->count] = 0;
+        view->layer = layer;
+    }
+    return MCSG_OK;
+}
+
+mcsg_status scad_geometry_file(scad_context *sc, scad_geometry_op *op, mcsg_node_id *node,
+                               bool *given, mcsg_error *err)
+{
+    static const scad_transform identity = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                                            {0}, false, false, false};
+    const scad_call_args *ca = &op->ca;
+    bool linear = ca->stmt->module == MOD_LINEAR_EXTRUDE;
+    int file_slot = linear ? LE_FILE : RE_FILE;
+    const scad_value *scale = &ca->slot[RE_SCALE].value;
+    scad_dxf_view view = {NULL, {0, 0}, 1, {0, 0, 0}};
+    const char *file;
+    uint32_t file_len;
+    mci_buf path = {0};
+    mcsg_status st;
+    *given = (linear || ca->stmt->module == MOD_ROTATE_EXTRUDE) &&
+             ca->slot[file_slot].value.type == VAL_STRING;
+    if (!*given)
+        return MCSG_OK;
+    view.scale = linear ? op->scale[0] : scale->type == VAL_NUMBER && scale->number > 0 ?
+                 scale->number : 1;
+    st = file_view(sc, op, linear ? LE_LAYER : RE_LAYER, linear ? LE_ORIGIN : RE_ORIGIN,
+                   &view, err);
+    if (st == MCSG_OK)
+        st = scad_file_path(sc, ca, file_slot, &file, &file_len, &path, err);
+    if (st == MCSG_OK)
+        st = scad_add_dxf(sc, ca, &identity, file, file_len, (const char *)path.data, &view,
+                          node, err);
+    mci_buf_free(sc->ev.ctx, &path);
+    mci_free(sc->ev.ctx, (void *)view.layer);
     return st;
 }
 

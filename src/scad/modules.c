@@ -706,12 +706,10 @@ static mcsg_status make_polyhedron(scad_context *sc, const scad_call_args *ca,
     return scad_add_leaf(sc, ca, t, &mesh, label, node, err);
 }
 
-/* The file to import, resolved against the base directory, into `path`. */
-static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const char **file,
-                               uint32_t *file_len, mci_buf *path, mcsg_error *err)
+mcsg_status scad_file_path(scad_context *sc, const scad_call_args *ca, int slot,
+                           const char **file, uint32_t *file_len, mci_buf *path,
+                           mcsg_error *err)
 {
-    int slot = !scad_given(ca, IMPORT_FILE) && scad_given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
-                                                                      : IMPORT_FILE;
     const scad_value *v = &ca->slot[slot].value;
     const char *dir = sc->base_dir;
     size_t dir_len = dir ? strlen(dir) : 0;
@@ -721,7 +719,7 @@ static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const
     *file_len = v->count;
     if (v->count == 0 || memchr(*file, 0, v->count))
         return scad_fail_at(sc->name, ca->slot[slot].line, ca->slot[slot].col, err,
-                            MCSG_ERR_PARSE, "import(): invalid file name");
+                            MCSG_ERR_PARSE, "%s(): invalid file name", ca->module);
     if ((*file)[0] == '/' || dir_len == 0)
         dir_len = 0;
     if (!mci_buf_append(sc->ev.ctx, path, dir, dir_len) ||
@@ -730,6 +728,15 @@ static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const
         !mci_buf_append(sc->ev.ctx, path, "", 1))
         return mci_fail_nomem(err, "reading CSG text");
     return MCSG_OK;
+}
+
+/* The file to import, resolved against the base directory, into `path`. */
+static mcsg_status import_path(scad_context *sc, const scad_call_args *ca, const char **file,
+                               uint32_t *file_len, mci_buf *path, mcsg_error *err)
+{
+    int slot = !scad_given(ca, IMPORT_FILE) && scad_given(ca, IMPORT_FILENAME) ? IMPORT_FILENAME
+                                                                      : IMPORT_FILE;
+    return scad_file_path(sc, ca, slot, file, file_len, path, err);
 }
 
 /* Leaves for the parts of an imported file, "import("f") WORD K (NAME)" with K numbers[k]

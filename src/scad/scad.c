@@ -160,6 +160,8 @@ static mcsg_status enter_geometry(walker *w, uint32_t stmt, uint32_t bindings, u
     void *data = w->geoms;
     scad_geometry_op *op;
     mcsg_tree *tree;
+    mcsg_node_id file_node;
+    bool file_given = false;
     mcsg_status st;
     if (!room(sc->ev.ctx, &data, &w->geom_cap, w->geom_len, sizeof *w->geoms))
         return mci_fail_nomem(err, "reading CSG text");
@@ -178,6 +180,10 @@ static mcsg_status enter_geometry(walker *w, uint32_t stmt, uint32_t bindings, u
         st = push_frame(w, stmt, bindings, heap, w->transform_len - 1, true, ROLE_GROUP, err);
     if (st == MCSG_OK)
         w->frames[w->frame_len - 1].geom = w->geom_len - 1;
+    if (st == MCSG_OK)
+        st = scad_geometry_file(sc, op, &file_node, &file_given, err);
+    if (st == MCSG_OK && file_given)
+        st = push_result(w, file_node, DIM_2D, err);
     return st;
 }
 

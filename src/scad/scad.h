@@ -321,6 +321,28 @@ mcsg_status scad_nomem_label(mcsg_mesh *mesh, const mci_ctx *ctx, mcsg_error *er
  * tree being built; only modules that use geometry read them back (region.h). */
 typedef enum scad_dim { DIM_NONE = 0, DIM_2D = 2, DIM_3D = 3 } scad_dim;
 
+/* How a DXF drawing is read: layer (NULL: all), origin, scale, and the resolution its
+ * arcs are split by. */
+typedef struct scad_dxf_view {
+    const char *layer;
+    double origin[2];
+    double scale;
+    mcsg_resolution res;
+} scad_dxf_view;
+
+/* A DXF drawing's outlines (file_len bytes of `file` for messages, opened at `path`) as
+ * a 2D leaf under t, labelled import("file"); read errors name the call's module and
+ * place (shapes2d.c). */
+mcsg_status scad_add_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                         const char *file, uint32_t file_len, const char *path,
+                         const scad_dxf_view *view, mcsg_node_id *node, mcsg_error *err);
+/* The file named by argument `slot` (a non-empty string) resolved against the base
+ * directory into `path` (NUL-terminated); *file and *file_len the name as written
+ * (modules.c). */
+mcsg_status scad_file_path(scad_context *sc, const scad_call_args *ca, int slot,
+                           const char **file, uint32_t *file_len, struct mci_buf *path,
+                           mcsg_error *err);
+
 /* import() of a DXF drawing: its outlines as a 2D leaf (shapes2d.c). */
 mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
                             const char *file, uint32_t file_len, const char *path,
@@ -376,6 +398,12 @@ mcsg_status scad_geometry_finish(scad_context *sc, scad_geometry_op *op,
                                  const mcsg_node_id *children, size_t count, scad_dim dim,
                                  const scad_transform *t, mcsg_node_id *out,
                                  scad_dim *out_dim, mcsg_error *err);
+
+/* The deprecated `file` of linear_extrude and rotate_extrude, read before the children:
+ * the drawing as the op's first child in its own tree (*given false without one;
+ * geometry.c). */
+mcsg_status scad_geometry_file(scad_context *sc, scad_geometry_op *op, mcsg_node_id *node,
+                               bool *given, mcsg_error *err);
 
 /* What a call with children contributes once its children are done. */
 typedef enum scad_role { ROLE_OP, ROLE_GROUP } scad_role;

@@ -365,28 +365,24 @@ static mcsg_status dxf_args(scad_context *sc, const scad_call_args *ca, char **l
     return st;
 }
 
-mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
-                            const char *file, uint32_t file_len, const char *path,
-                            mcsg_node_id *node, mcsg_error *err)
+mcsg_status scad_add_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                         const char *file, uint32_t file_len, const char *path,
+                         const scad_dxf_view *view, mcsg_node_id *node, mcsg_error *err)
 {
     const mci_ctx *ctx = sc->ev.ctx;
-    double origin[2] = {0, 0}, scale = 1;
-    char *layer = NULL;
-    mcsg_resolution res;
+    const char *layer = view->layer;
+    const mcsg_resolution *res = &view->res;
     mci_outlines o = {0};
     mci_buf label = {0};
     mcsg_error read_err = {MCSG_OK, ""};
-    mcsg_status st = dxf_args(sc, ca, &layer, origin, &scale, err);
-    if (st == MCSG_OK)
-        st = scad_get_resolution(sc, ca, &res, err);
-    if (st == MCSG_OK) {
-        st = mci_dxf_read(ctx, path, layer, origin, scale, res.fn, res.fa, res.fs, &o, &read_err);
-        if (st != MCSG_OK && st != MCSG_ERR_NOMEM)
-            st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
-                              "import(\"%.*s\"): %s", (int)file_len, file, read_err.message);
-        else if (st != MCSG_OK)
-            *err = read_err;
-    }
+    mcsg_status st = mci_dxf_read(ctx, path, layer, view->origin, view->scale, res->fn,
+                                  res->fa, res->fs, &o, &read_err);
+    if (st != MCSG_OK && st != MCSG_ERR_NOMEM)
+        st = scad_fail_at(sc->name, ca->stmt->line, ca->stmt->col, err, st,
+                          "%s(\"%.*s\"): %s", ca->module, (int)file_len, file,
+                          read_err.message);
+    else if (st != MCSG_OK)
+        *err = read_err;
     if (st == MCSG_OK &&
         !mci_buf_printf(ctx, &label, "import(\"%.*s\"%s%s%s)", (int)file_len, file,
                         layer ? ", layer=\"" : "", layer ? layer : "", layer ? "\"" : ""))
@@ -395,7 +391,22 @@ mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const sc
         st = scad_add_shape(sc, ca, t, &o, &label, node, err);
     mci_outlines_free(ctx, &o);
     mci_buf_free(ctx, &label);
-    mci_free(ctx, layer);
+    return st;
+}
+
+mcsg_status scad_import_dxf(scad_context *sc, const scad_call_args *ca, const scad_transform *t,
+                            const char *file, uint32_t file_len, const char *path,
+                            mcsg_node_id *node, mcsg_error *err)
+{
+    scad_dxf_view view = {NULL, {0, 0}, 1, {0, 0, 0}};
+    char *layer = NULL;
+    mcsg_status st = dxf_args(sc, ca, &layer, view.origin, &view.scale, err);
+    if (st == MCSG_OK)
+        st = scad_get_resolution(sc, ca, &view.res, err);
+    view.layer = layer;
+    if (st == MCSG_OK)
+        st = scad_add_dxf(sc, ca, t, file, file_len, path, &view, node, err);
+    mci_free(sc->ev.ctx, layer);
     return st;
 }
 
