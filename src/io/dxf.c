@@ -48,7 +48,7 @@
 
 #include "base/numparse.h"
 #include "base/sort.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -55,7 +55,7 @@
 #include "io/svg.h"
 
 #include "base/numparse.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "shape/stroke.h"
 
 #include <expat.h>

@@ -17,7 +17,7 @@
  * hostile text cannot make evaluation allocate more than a constant factor of itself.
  */
 #include "base/numparse.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "scad/scad.h"
 
 #include <math.h>

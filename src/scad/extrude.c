@@ -14,7 +14,7 @@
  * with equal coordinates are welded, so that the result is closed even where a ring
  * meets the axis or a scale of zero pinches the top.
  */
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "scad/geometry.h"
 
 #include <math.h>

@@ -12,7 +12,7 @@
 #include "exact/kernel.h"
 #include "exact/predicates.h"
 #include "mesh/tree.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "scad/geometry.h"
 #include "shape/hull.h"
 #include "shape/offset.h"

@@ -27,7 +27,7 @@
 #include "io/amf.h"
 #include "io/surface.h"
 #include "mesh/tree.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "scad/scad.h"
 #include "shape/tess.h"
 

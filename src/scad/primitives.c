@@ -20,7 +20,7 @@
  * cone n + (n-2).
  */
 #include "base/core.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 
 #include <limits.h>
 #include <math.h>

@@ -12,7 +12,7 @@
  * Each shape becomes a prism over its region (shape/region.h) in the tree being built.
  */
 #include "mesh/tree.h"
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 #include "scad/scad.h"
 #include "shape/region.h"
 #include "io/dxf.h"

@@ -9,7 +9,7 @@
  *  - other angles use the C library's sin/cos/tan of x * (pi / 180), always on the
  *    smaller of the angle and its complement (sin of [0, 45), cos of [45, 90]).
  */
-#include "scad/degree_trig.h"
+#include "base/degree_trig.h"
 
 #include <math.h>
 

@@ -4,8 +4,8 @@
  * (correctly rounded) results, so that e.g. cos(90) is 0 and sin(30) is 0.5. Used by
  * the primitive tessellation, by rotate() and by the CSG language's sin/cos/tan.
  */
-#ifndef MESHCSG_SCAD_DEGREE_TRIG_H
-#define MESHCSG_SCAD_DEGREE_TRIG_H
+#ifndef MESHCSG_BASE_DEGREE_TRIG_H
+#define MESHCSG_BASE_DEGREE_TRIG_H
 
 double mci_sin_degrees(double x);
 double mci_cos_degrees(double x);
