@@ -261,7 +261,13 @@ TEST(errors_and_warnings)
                  "square(): `size` must be a number or a vector of 2 numbers, not a string");
     /* Mixing dimensions: the 2D square is left out of the union, with a warning. */
     CHECK_EQ_DOUBLE(eval_volume("union() { cube(2); square(5); }", NULL, NULL, &log), 8);
-    CHECK_CONTAINS(log.text, "mixing 2D and 3D objects is not supported: leaving out the 2D");
+    CHECK_CONTAINS(log.text, "mixing 2D and 3D objects is not supported: the 2D ones are empty");
+    /* ... where they stand, as OpenSCAD has it: an intersection with one is empty. */
+    log.text[0] = 0;
+    CHECK_EQ_DOUBLE(eval_volume("cube(1); intersection() { cube(5); square(2); }", NULL, NULL,
+                                &log), 1);
+    CHECK_CONTAINS(log.text, "the 2D ones are empty, and so is the intersection");
+    CHECK_EQ_DOUBLE(eval_volume("difference() { cube(5); square(2); }", NULL, NULL, NULL), 125);
     log.text[0] = 0;
     CHECK_EQ_DOUBLE(eval_volume("linear_extrude(1) polygon([[0,0],[4,0],[0,4]], [[0,1,2,7]]);",
                                 NULL, NULL, &log), 8);

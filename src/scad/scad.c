@@ -300,6 +300,7 @@ static mcsg_status close_frame(walker *w, const scad_transform *t,
 static scad_dim keep_one_dimension(walker *w, const walk_frame *f, uint32_t *count)
 {
     const scad_stmt *s = &w->sc->prog->stmts[f->stmt];
+    bool intersection = f->role == ROLE_OP && s->module == MOD_INTERSECTION;
     scad_dim dim = DIM_NONE;
     uint32_t kept = 0;
     bool warned = false;
@@ -310,15 +311,18 @@ static scad_dim keep_one_dimension(walker *w, const walk_frame *f, uint32_t *cou
         if (d != DIM_NONE && d != dim) {
             if (!warned)
                 scad_warn_at(w->sc->ev.ctx, w->sc->name, s->line, s->col, "mixing 2D and 3D "
-                             "objects is not supported: leaving out the %s ones",
-                             d == DIM_2D ? "2D" : "3D");
+                             "objects is not supported: the %s ones are empty%s",
+                             d == DIM_2D ? "2D" : "3D", intersection ? ", and so is the "
+                             "intersection" : "");
             warned = true;
             continue;
         }
         w->results[f->results + kept] = w->results[f->results + i];
         w->dims[f->results + kept++] = (uint8_t)d;
     }
-    *count = kept;
+    /* OpenSCAD replaces them by the empty set where they stand: the other operations
+     * lose nothing when they are left out, an intersection everything. */
+    *count = intersection && warned ? 0 : kept;
     return dim;
 }
 
