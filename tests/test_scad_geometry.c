@@ -156,6 +156,25 @@ TEST(scale_zero_makes_a_point)
     CHECK_EQ_SIZE(t, 16);
 }
 
+/* A top scaled to zero along one axis is a segment, which a notch on one side only
+ * splits at its corners: the walls must meet there (OpenSCAD 2021.01's own result is
+ * open, 4 boundary edges). The volume is the region's 3 times the height 3 times the
+ * mean scale 1/2. */
+TEST(scale_zero_makes_a_segment)
+{
+    static const char *const shape = "difference() { square(2, true); "
+                                     "translate([-0.5, 0]) square(1, true); }";
+    char text[256];
+    snprintf(text, sizeof text, "linear_extrude(height=3, slices=20, scale=[0, 1]) %s", shape);
+    CHECK(fabs(eval_volume(text, NULL, NULL, NULL) - 4.5) < 1e-12); /* slices' heights round */
+    snprintf(text, sizeof text, "linear_extrude(height=3, slices=7, scale=[1, 0]) "
+             "rotate(90) %s", shape);
+    CHECK(fabs(eval_volume(text, NULL, NULL, NULL) - 4.5) < 1e-12);
+    /* Twisted, the walls are ruled surfaces cut into triangles: closed, about 4.5. */
+    snprintf(text, sizeof text, "linear_extrude(height=3, twist=90, scale=[0, 1]) %s", shape);
+    CHECK(fabs(eval_volume(text, NULL, NULL, NULL) - 4.5) < 0.1);
+}
+
 TEST(openscad_rotate_extrude)
 {
     check_openscad("rotate_extrude(angle=-120, $fn=30) polygon([[0,0],[6,-3],[8,4],[0,6]]);",
@@ -320,6 +339,7 @@ int main(void)
     RUN(shapes_follow_2d_transforms);
     RUN(openscad_linear_extrude);
     RUN(scale_zero_makes_a_point);
+    RUN(scale_zero_makes_a_segment);
     RUN(openscad_rotate_extrude);
     RUN(openscad_hull_offset_projection_resize);
     RUN(openscad_minkowski);

@@ -15,6 +15,7 @@
  * meets the axis or a scale of zero pinches the top.
  */
 #include "base/degree_trig.h"
+#include "base/sort_template.h"
 #include "scad/geometry.h"
 
 #include <math.h>
@@ -229,6 +230,81 @@ static bool linear_walls(const scad_geometry_op *op, sweep *s, const mci_outline
     return true;
 }
 
+/* A top scaled to zero along one axis is a segment: every region vertex goes to the
+ * image of its other coordinate u. The last walls' top edges run along it, and the two
+ * sides of the outline have corners at different u (a notch on one side only), so each
+ * top edge is split at every image strictly between its ends, fanned from its wall's
+ * third corner: the walls then meet edge to edge once welded. */
+typedef struct top_value {
+    double u;
+    uint32_t v; /* a region vertex with that u */
+} top_value;
+
+#define TOP_LESS(a, b) ((a)->u < (b)->u)
+MCI_DEFINE_SORT(sort_top_values, top_value, TOP_LESS)
+
+static size_t first_above(const top_value *t, size_t n, double u)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (t[mid].u <= u)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Split triangle t's top edge (corners k, k + 1 on the top level, the third below). */
+static bool split_top_edge(sweep *s, const mci_region *r, const top_value *tv, size_t n,
+                           int axis, size_t t, int k)
+{
+    uint32_t c[3], top = (uint32_t)((s->levels - 1) * s->per_level);
+    memcpy(c, s->tris + 3 * t, sizeof c);
+    uint32_t a = c[k], b = c[(k + 1) % 3], apex = c[(k + 2) % 3], prev = a;
+    double ua = r->xy[2 * (size_t)(a - top) + axis], ub = r->xy[2 * (size_t)(b - top) + axis];
+    bool up = ua < ub;
+    size_t lo = first_above(tv, n, fmin(ua, ub)), hi = first_above(tv, n, fmax(ua, ub));
+    size_t inside = hi > lo && tv[hi - 1].u == fmax(ua, ub) ? hi - 1 - lo : hi - lo;
+    for (size_t j = 0; j < inside; j++) {
+        uint32_t q = top + tv[up ? lo + j : lo + inside - 1 - j].v;
+        if (j == 0)
+            memcpy(s->tris + 3 * t, (uint32_t[3]){prev, q, apex}, sizeof(uint32_t[3]));
+        else if (!add_tri(s, prev, q, apex))
+            return false;
+        prev = q;
+    }
+    return inside == 0 || add_tri(s, prev, b, apex);
+}
+
+static bool split_top(sweep *s, const mci_region *r, int axis)
+{
+    size_t n = r->vertex_count, kept = 0, count = s->tri_count;
+    uint32_t top = (uint32_t)((s->levels - 1) * s->per_level);
+    top_value *tv = mci_malloc_array(s->ctx, n + 1, sizeof *tv);
+    bool ok = tv != NULL;
+    for (size_t i = 0; ok && i < n; i++)
+        tv[i] = (top_value){r->xy[2 * i + axis], (uint32_t)i};
+    if (ok)
+        sort_top_values(tv, n);
+    for (size_t i = 0; ok && i < n; i++) { /* one vertex per value */
+        if (kept == 0 || tv[kept - 1].u != tv[i].u)
+            tv[kept++] = tv[i];
+    }
+    for (size_t t = 0; ok && t < count; t++) {
+        const uint32_t *c = s->tris + 3 * t;
+        for (int k = 0; k < 3; k++) {
+            if (c[k] >= top && c[(k + 1) % 3] >= top && c[(k + 2) % 3] < top) {
+                ok = split_top_edge(s, r, tv, kept, axis, t, k);
+                break;
+            }
+        }
+    }
+    mci_free(s->ctx, tv);
+    return ok;
+}
+
 mcsg_status scad_linear_extrude(scad_context *sc, const scad_geometry_op *op,
                                   const mci_region *r, const mci_outlines *o, mcsg_mesh *out,
                                   mcsg_error *err)
@@ -249,6 +325,8 @@ mcsg_status scad_linear_extrude(scad_context *sc, const scad_geometry_op *op,
         for (size_t loop = 0; ok && loop < o->loop_count; loop++)
             ok = linear_walls(op, &s, o, loop, k);
     }
+    if (ok && (op->scale[0] == 0) != (op->scale[1] == 0))
+        ok = split_top(&s, r, op->scale[0] == 0 ? 1 : 0);
     if (!ok) {
         mci_free(s.ctx, s.points);
         mci_free(s.ctx, s.tris);
