@@ -122,7 +122,8 @@ static mcsg_status file_view(scad_context *sc, const scad_geometry_op *op, int l
     }
     if (scad_given(ca, layer_slot) && l->type != VAL_STRING)
         return scad_wrong_type(sc, ca, layer_slot, "a layer name (a string)", err);
-    if (scad_given(ca, layer_slot) && l->count > 0 && !memchr(scad_string(sc->prog, l), 0, l->count)) {
+    if (scad_given(ca, layer_slot) && l->count > 0 &&
+        !memchr(scad_string(sc->prog, l), 0, l->count)) { /* "" and "\0..." name no layer */
         char *layer = mci_malloc(sc->ev.ctx, l->count + 1);
         if (!layer)
             return mci_fail_nomem(err, "reading a DXF file");
@@ -768,9 +769,9 @@ static mcsg_status shadow_loops(const mci_ctx *ctx, shadow *sh, mcsg_error *err)
     st = order_patches(ctx, m, sh->up, count, err);
     o->loop_start[0] = 0;
     for (size_t i = 0; st == MCSG_OK && i < count; i++) {
+        const uint32_t *c = m->triangles + 3 * (size_t)sh->up[i];
         for (int k = 0; k < 3; k++)
-            memcpy(o->xy + 6 * i + 2 * k, m->vertices + 3 * (size_t)m->triangles[3 * (size_t)sh->up[i] + k],
-                   2 * sizeof *o->xy);
+            memcpy(o->xy + 6 * i + 2 * k, m->vertices + 3 * (size_t)c[k], 2 * sizeof *o->xy);
         o->loop_start[i + 1] = (uint32_t)(3 * (i + 1));
     }
     o->point_count = 3 * count;
