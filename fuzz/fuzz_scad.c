@@ -60,6 +60,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (contains(data, size, "import"))
         return 0;
     opts = capped_options(&b);
+    opts.threads = 1; /* the budget's counter is not atomic, and modules that evaluate
+                         their children (hull, projection, ...) run mcsg_eval */
     st = mcsg_scad_read_memory((const char *)data, size, "fuzz.scad", NULL, &opts, &tree, &err);
     if (st == MCSG_OK) {
         check_tree(tree);
